@@ -1,0 +1,267 @@
+//! Probes (particle averages recorded every step) and `[[expect]]` evaluation.
+
+use crate::dim::Dim;
+use crate::particles::Particles;
+use crate::world::Energies;
+use serde::Serialize;
+
+/// What a probe averages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProbeQty {
+    /// Displacement component (m).
+    Displacement,
+    /// Velocity component (m/s).
+    Velocity,
+    /// Position component (m).
+    Position,
+    /// Stress component (Pa).
+    Stress,
+    /// Strain component.
+    Strain,
+}
+
+/// Average of one component over a fixed particle set.
+#[derive(Clone, Debug)]
+pub struct Probe {
+    /// Name.
+    pub name: String,
+    /// Particles averaged.
+    pub particles: Vec<u32>,
+    /// Quantity.
+    pub qty: ProbeQty,
+    /// Component index (0..3 for vectors, 0..6 in xx, yy, zz, yz, xz, xy order for tensors).
+    pub comp: usize,
+    /// Initial centroid of the particles (m).
+    pub centre: [f64; 3],
+}
+
+impl Probe {
+    /// Current average.
+    pub fn sample<D: Dim>(&self, p: &Particles<D>) -> f64 {
+        let mut sum = 0.0;
+        for &i in &self.particles {
+            let i = i as usize;
+            sum += match self.qty {
+                ProbeQty::Displacement => p.u[i][self.comp],
+                ProbeQty::Velocity => p.v[i][self.comp],
+                ProbeQty::Position => p.x[i][self.comp],
+                ProbeQty::Stress => p.stress[i].to_array()[self.comp],
+                ProbeQty::Strain => p.strain[i].to_array()[self.comp],
+            };
+        }
+        sum / self.particles.len() as f64
+    }
+}
+
+/// A history row taken at the energy cadence.
+#[derive(Clone, Copy, Debug)]
+pub struct Row {
+    /// Step.
+    pub step: u64,
+    /// Time (s).
+    pub time: f64,
+    /// Energies (J).
+    pub energies: Energies,
+    /// Total momentum (kg m/s).
+    pub momentum: [f64; 3],
+    /// Sum of |m v| (kg m/s), the scale of momentum errors.
+    pub momentum_scale: f64,
+    /// Angular momentum about the initial centre of mass (kg m^2/s).
+    pub angular: [f64; 3],
+}
+
+/// Everything recorded over a run that expects are measured on.
+#[derive(Clone, Debug, Default)]
+pub struct History {
+    /// Time of every step's probe sample (s).
+    pub time: Vec<f64>,
+    /// Probe samples, one series per probe.
+    pub probes: Vec<Vec<f64>>,
+    /// Rows at the energy cadence.
+    pub rows: Vec<Row>,
+}
+
+/// What an expect measures.
+#[derive(Clone, Debug)]
+pub enum Measure {
+    /// Last sample of a probe.
+    Final(usize),
+    /// Largest sample of a probe.
+    Max(usize),
+    /// Smallest sample of a probe.
+    Min(usize),
+    /// Frequency of a probe's oscillation about its mean (Hz), from upward mean crossings.
+    Frequency(usize),
+    /// Distance between two probes over the difference of their arrival times (m/s); a
+    /// probe's arrival is when its change first reaches half its largest change.
+    WaveSpeed(usize, usize),
+    /// Largest |P(t) - P(0)| over the largest sum |m v| (relative).
+    MomentumDrift,
+    /// |E(end) - E(0)| over the largest K + W (relative), E = K + W - W_ext + W_damp.
+    EnergyDrift,
+    /// |L(end) - L(0)| / |L(0)| about the initial centre of mass (relative).
+    AngularMomentumDrift,
+}
+
+/// A checked expectation.
+#[derive(Clone, Debug)]
+pub struct Expect {
+    /// Quantity keyword from the scenario.
+    pub quantity: String,
+    /// Probes named.
+    pub probes: Vec<String>,
+    /// Measurement.
+    pub measure: Measure,
+    /// Reference value.
+    pub reference: f64,
+    /// Source of the reference.
+    pub source: String,
+    /// Tolerance (relative, or absolute for a zero reference).
+    pub tolerance: f64,
+}
+
+/// Outcome of one expect, as written to summary.json.
+#[derive(Clone, Debug, Serialize)]
+pub struct ExpectResult {
+    /// Quantity keyword.
+    pub quantity: String,
+    /// Probes named.
+    pub probes: Vec<String>,
+    /// Reference value.
+    pub reference: f64,
+    /// Measured value (null when it could not be measured).
+    pub value: Option<f64>,
+    /// Error: relative, or absolute for a zero reference.
+    pub error: Option<f64>,
+    /// Tolerance.
+    pub tolerance: f64,
+    /// Whether the error is within tolerance.
+    pub pass: bool,
+    /// Source of the reference.
+    pub source: String,
+}
+
+impl Expect {
+    /// Measures and compares.
+    pub fn evaluate(&self, h: &History, probes: &[Probe]) -> ExpectResult {
+        let value = measure(&self.measure, h, probes);
+        let error = value.map(|v| {
+            if self.reference == 0.0 {
+                (v - self.reference).abs()
+            } else {
+                ((v - self.reference) / self.reference).abs()
+            }
+        });
+        ExpectResult {
+            quantity: self.quantity.clone(),
+            probes: self.probes.clone(),
+            reference: self.reference,
+            value,
+            error,
+            tolerance: self.tolerance,
+            pass: error.is_some_and(|e| e <= self.tolerance),
+            source: self.source.clone(),
+        }
+    }
+}
+
+fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
+    let finite = |v: f64| v.is_finite().then_some(v);
+    match *m {
+        Measure::Final(p) => h.probes[p].last().copied().and_then(finite),
+        Measure::Max(p) => h.probes[p].iter().copied().reduce(f64::max),
+        Measure::Min(p) => h.probes[p].iter().copied().reduce(f64::min),
+        Measure::Frequency(p) => frequency(&h.time, &h.probes[p]),
+        Measure::WaveSpeed(a, b) => {
+            let ta = arrival(&h.time, &h.probes[a])?;
+            let tb = arrival(&h.time, &h.probes[b])?;
+            let (ca, cb) = (probes[a].centre, probes[b].centre);
+            let d = (0..3).map(|k| (cb[k] - ca[k]).powi(2)).sum::<f64>().sqrt();
+            finite(d / (tb - ta))
+        }
+        Measure::MomentumDrift => {
+            let first = h.rows.first()?;
+            let scale = h.rows.iter().map(|r| r.momentum_scale).fold(0.0, f64::max);
+            let worst = h
+                .rows
+                .iter()
+                .map(|r| norm3(sub3(r.momentum, first.momentum)))
+                .fold(0.0, f64::max);
+            finite(worst / scale)
+        }
+        Measure::EnergyDrift => {
+            let (first, last) = (h.rows.first()?, h.rows.last()?);
+            let total = |e: &Energies| e.kinetic + e.strain - e.external_work + e.damping_work;
+            let scale = h
+                .rows
+                .iter()
+                .map(|r| r.energies.kinetic + r.energies.strain)
+                .fold(0.0, f64::max);
+            finite((total(&last.energies) - total(&first.energies)).abs() / scale)
+        }
+        Measure::AngularMomentumDrift => {
+            let (first, last) = (h.rows.first()?, h.rows.last()?);
+            finite(norm3(sub3(last.angular, first.angular)) / norm3(first.angular))
+        }
+    }
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn norm3(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// Mean frequency from upward crossings of the series' mean (linear interpolation).
+pub fn frequency(t: &[f64], s: &[f64]) -> Option<f64> {
+    let mean = s.iter().sum::<f64>() / s.len() as f64;
+    let crossings: Vec<f64> = (1..s.len())
+        .filter(|&i| s[i - 1] < mean && s[i] >= mean)
+        .map(|i| {
+            let f = (mean - s[i - 1]) / (s[i] - s[i - 1]);
+            t[i - 1] + f * (t[i] - t[i - 1])
+        })
+        .collect();
+    if crossings.len() < 2 {
+        return None;
+    }
+    Some((crossings.len() - 1) as f64 / (crossings[crossings.len() - 1] - crossings[0]))
+}
+
+/// First time the change from the initial value reaches half its largest magnitude.
+pub fn arrival(t: &[f64], s: &[f64]) -> Option<f64> {
+    let s0 = *s.first()?;
+    let peak = s.iter().map(|v| (v - s0).abs()).fold(0.0, f64::max);
+    if peak == 0.0 {
+        return None;
+    }
+    let half = 0.5 * peak;
+    let i = s.iter().position(|v| (v - s0).abs() >= half)?;
+    if i == 0 {
+        return Some(t[0]);
+    }
+    let (a, b) = ((s[i - 1] - s0).abs(), (s[i] - s0).abs());
+    Some(t[i - 1] + (half - a) / (b - a) * (t[i] - t[i - 1]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frequency_of_a_sampled_sine() {
+        let t: Vec<f64> = (0..2000).map(|i| i as f64 * 1e-4).collect();
+        let s: Vec<f64> = t.iter().map(|t| (2.0 * std::f64::consts::PI * 37.0 * t).sin() + 3.0).collect();
+        let f = frequency(&t, &s).unwrap();
+        assert!((f - 37.0).abs() < 0.05, "{f}");
+    }
+
+    #[test]
+    fn arrival_of_a_ramp_front() {
+        let t: Vec<f64> = (0..100).map(|i| i as f64).collect();
+        let s: Vec<f64> = t.iter().map(|&t: &f64| ((t - 40.0) / 10.0).clamp(0.0, 1.0)).collect();
+        assert!((arrival(&t, &s).unwrap() - 45.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,5 @@
+//! Run outputs: history CSVs, VTK particle files, PNG plots and summary.json.
+
+pub mod plot;
+pub mod summary;
+pub mod vtk;

@@ -1,0 +1,49 @@
+//! summary.json: what ran, how fast, how much memory, and every expect's result.
+
+use crate::measure::ExpectResult;
+use crate::world::Energies;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// The run summary (DESIGN.md's output contract).
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Scenario name.
+    pub scenario: String,
+    /// 2 or 3.
+    pub dimension: usize,
+    /// "completed" or "unstable".
+    pub status: String,
+    /// Why the run stopped early, if it did.
+    pub message: Option<String>,
+    /// Particle count.
+    pub particles: usize,
+    /// Grid node count.
+    pub nodes: usize,
+    /// Steps taken.
+    pub steps: u64,
+    /// Simulated time reached (s).
+    pub time: f64,
+    /// Time step (s).
+    pub dt: f64,
+    /// Stability limit h_min / c_max (s).
+    pub dt_limit: f64,
+    /// Wall-clock seconds in the time-step loop.
+    pub wall_seconds: f64,
+    /// Particles times steps per wall second.
+    pub particle_steps_per_second: f64,
+    /// Worker threads.
+    pub threads: usize,
+    /// System names in execution order.
+    pub schedule: Vec<String>,
+    /// Wall seconds per system.
+    pub system_seconds: BTreeMap<String, f64>,
+    /// Bytes per particle held by the particle store.
+    pub bytes_per_particle: usize,
+    /// Bytes per node held by the grid store.
+    pub bytes_per_node: usize,
+    /// Energies at the end (J).
+    pub energies: Energies,
+    /// Results of the scenario's [[expect]] blocks.
+    pub expects: Vec<ExpectResult>,
+}

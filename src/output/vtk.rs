@@ -1,0 +1,119 @@
+//! VTK XML output for ParaView: particle `.vtu` files (appended raw binary) and a `.pvd`
+//! collection indexing them by time.
+
+use crate::dim::Dim;
+use crate::particles::Particles;
+use std::io::Write;
+use std::path::Path;
+
+/// One appended data array: its XML attributes and little-endian bytes.
+struct Array {
+    attrs: String,
+    bytes: Vec<u8>,
+}
+
+fn f64s(values: impl Iterator<Item = f64>) -> Vec<u8> {
+    values.flat_map(f64::to_le_bytes).collect()
+}
+
+/// Writes the particles as vertex cells to `path` with velocity, displacement, stress
+/// (ParaView's symmetric-tensor order xx, yy, zz, xy, yz, xz), mass and material.
+pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result<()> {
+    let n = p.len();
+    let vec3 = |c: &[D::Vec]| f64s(c.iter().flat_map(|v| D::to_xyz(*v)));
+    let point_data = vec![
+        Array {
+            attrs: r#"type="Float64" Name="velocity" NumberOfComponents="3""#.into(),
+            bytes: vec3(&p.v),
+        },
+        Array {
+            attrs: r#"type="Float64" Name="displacement" NumberOfComponents="3""#.into(),
+            bytes: vec3(&p.u),
+        },
+        Array {
+            attrs: r#"type="Float64" Name="stress" NumberOfComponents="6""#.into(),
+            bytes: f64s(
+                p.stress
+                    .iter()
+                    .flat_map(|s| [s.xx, s.yy, s.zz, s.xy, s.yz, s.xz]),
+            ),
+        },
+        Array {
+            attrs: r#"type="Float64" Name="mass" NumberOfComponents="1""#.into(),
+            bytes: f64s(p.mass.iter().copied()),
+        },
+        Array {
+            attrs: r#"type="Int32" Name="material" NumberOfComponents="1""#.into(),
+            bytes: p
+                .material
+                .iter()
+                .flat_map(|&m| (m as i32).to_le_bytes())
+                .collect(),
+        },
+    ];
+    let points = Array {
+        attrs: r#"type="Float64" Name="Points" NumberOfComponents="3""#.into(),
+        bytes: vec3(&p.x),
+    };
+    let cells = vec![
+        Array {
+            attrs: r#"type="Int64" Name="connectivity""#.into(),
+            bytes: (0..n as i64).flat_map(i64::to_le_bytes).collect(),
+        },
+        Array {
+            attrs: r#"type="Int64" Name="offsets""#.into(),
+            bytes: (1..=n as i64).flat_map(i64::to_le_bytes).collect(),
+        },
+        Array {
+            attrs: r#"type="UInt8" Name="types""#.into(),
+            bytes: vec![1u8; n],
+        },
+    ];
+    let mut offset = 0usize;
+    let mut tag = |a: &Array| {
+        let s = format!(r#"<DataArray {} format="appended" offset="{offset}"/>"#, a.attrs);
+        offset += 8 + a.bytes.len();
+        s
+    };
+    let mut xml = String::new();
+    xml.push_str("<?xml version=\"1.0\"?>\n");
+    xml.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
+    xml.push_str("<UnstructuredGrid>\n");
+    xml.push_str(&format!(
+        "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">\n<PointData Vectors=\"velocity\" Tensors=\"stress\">\n"
+    ));
+    for a in &point_data {
+        xml.push_str(&tag(a));
+        xml.push('\n');
+    }
+    xml.push_str("</PointData>\n<Points>\n");
+    xml.push_str(&tag(&points));
+    xml.push_str("\n</Points>\n<Cells>\n");
+    for a in &cells {
+        xml.push_str(&tag(a));
+        xml.push('\n');
+    }
+    xml.push_str("</Cells>\n</Piece>\n</UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_");
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    f.write_all(xml.as_bytes())?;
+    for a in point_data.iter().chain([&points]).chain(&cells) {
+        f.write_all(&(a.bytes.len() as u64).to_le_bytes())?;
+        f.write_all(&a.bytes)?;
+    }
+    f.write_all(b"\n</AppendedData>\n</VTKFile>\n")?;
+    f.flush()
+}
+
+/// Writes a `.pvd` collection of `(time, file name)` frames.
+pub fn write_collection(path: &Path, frames: &[(f64, String)]) -> std::io::Result<()> {
+    let mut s = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n",
+    );
+    for (t, file) in frames {
+        s.push_str(&format!(
+            "<DataSet timestep=\"{t:.9e}\" group=\"\" part=\"0\" file=\"{file}\"/>\n"
+        ));
+    }
+    s.push_str("</Collection>\n</VTKFile>\n");
+    std::fs::write(path, s)
+}

@@ -1,0 +1,92 @@
+//! Particle component store: one column per component (struct of arrays).
+
+use crate::dim::Dim;
+use crate::sym::Sym3;
+
+/// Material points. Columns a scene does not need stay empty (e.g. `half` unless uGIMP).
+#[derive(Clone, Debug)]
+pub struct Particles<D: Dim> {
+    /// Position (m).
+    pub x: Vec<D::Vec>,
+    /// Velocity (m/s).
+    pub v: Vec<D::Vec>,
+    /// Displacement from the initial position (m).
+    pub u: Vec<D::Vec>,
+    /// Mass (kg).
+    pub mass: Vec<f64>,
+    /// Initial volume (m^3; in 2D area times thickness).
+    pub volume: Vec<f64>,
+    /// Cauchy stress (Pa), small strain.
+    pub stress: Vec<Sym3>,
+    /// Small strain (tensor components).
+    pub strain: Vec<Sym3>,
+    /// Velocity gradient dv_i/dx_j (1/s) from the most recent gather.
+    pub grad_v: Vec<D::Mat>,
+    /// Index into the world's material table.
+    pub material: Vec<u16>,
+    /// Particle half-width per axis (m); only allocated for uGIMP.
+    pub half: Vec<D::Vec>,
+}
+
+impl<D: Dim> Default for Particles<D> {
+    fn default() -> Self {
+        Particles {
+            x: Vec::new(),
+            v: Vec::new(),
+            u: Vec::new(),
+            mass: Vec::new(),
+            volume: Vec::new(),
+            stress: Vec::new(),
+            strain: Vec::new(),
+            grad_v: Vec::new(),
+            material: Vec::new(),
+            half: Vec::new(),
+        }
+    }
+}
+
+impl<D: Dim> Particles<D> {
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Whether the store is empty.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Appends one particle at rest and unstressed.
+    pub fn push(&mut self, x: D::Vec, v: D::Vec, mass: f64, volume: f64, material: u16) {
+        self.x.push(x);
+        self.v.push(v);
+        self.u.push(D::zero());
+        self.mass.push(mass);
+        self.volume.push(volume);
+        self.stress.push(Sym3::default());
+        self.strain.push(Sym3::default());
+        self.grad_v.push(D::mat_zero());
+        self.material.push(material);
+    }
+
+    /// Bytes held per particle by the allocated columns.
+    pub fn bytes_per_particle(&self) -> usize {
+        let vec = std::mem::size_of::<D::Vec>();
+        let base = 3 * vec
+            + 2 * std::mem::size_of::<f64>()
+            + 2 * std::mem::size_of::<Sym3>()
+            + std::mem::size_of::<D::Mat>()
+            + std::mem::size_of::<u16>();
+        base + if self.half.is_empty() { 0 } else { vec }
+    }
+
+    /// Half-width of particle `p` (zero when the scene's shape function does not use one).
+    #[inline(always)]
+    pub fn half_of(&self, p: usize) -> D::Vec {
+        if self.half.is_empty() {
+            D::zero()
+        } else {
+            self.half[p]
+        }
+    }
+}

@@ -1,0 +1,663 @@
+//! Building a World from a parsed scenario, validating every value on the way.
+
+use super::schema::{BodySpec, BoxSpec};
+use super::source::Source;
+use crate::bodies::{Geometry, fill};
+use crate::dim::Dim;
+use crate::error::ScenarioError;
+use crate::grid::{Grid, GridGeom};
+use crate::loads::{Load, VelocityBc};
+use crate::material::{Elastic, Plane};
+use crate::measure::{Expect, Measure, Probe, ProbeQty};
+use crate::particles::Particles;
+use crate::shape::ShapeKind;
+use crate::tiles::{MIN_TILE, Tiles};
+use crate::world::{Settings, Work, World};
+
+/// Largest grid (nodes) and particle count a scenario may ask for.
+const MAX_NODES: f64 = 2.0e8;
+const MAX_PARTICLES: f64 = 2.0e8;
+
+/// Output cadence of a run.
+#[derive(Clone, Debug)]
+pub struct OutputPlan {
+    /// Simulated time between VTK frames (s).
+    pub interval: f64,
+    /// Simulated time between history rows (s).
+    pub history_interval: f64,
+    /// Write VTK files.
+    pub vtk: bool,
+    /// Write PNG plots.
+    pub plot: bool,
+}
+
+/// A World ready to run, with what the run records and checks.
+#[derive(Clone, Debug)]
+pub struct Scene<D: Dim> {
+    /// Scenario name.
+    pub name: String,
+    /// Initial state.
+    pub world: World<D>,
+    /// Probes.
+    pub probes: Vec<Probe>,
+    /// Expectations.
+    pub expects: Vec<Expect>,
+    /// Simulated duration (s).
+    pub duration: f64,
+    /// Output cadence.
+    pub output: OutputPlan,
+    /// Stability limit h_min / c_max (s).
+    pub dt_limit: f64,
+}
+
+type R<T> = Result<T, ScenarioError>;
+
+/// A D-vector from a scenario list, padded to 3 (checked length and finiteness).
+fn vec3<D: Dim>(src: &Source, key: &str, v: &[f64]) -> R<[f64; 3]> {
+    if v.len() != D::D {
+        return Err(src.error(
+            key,
+            format!("expected {} components in {}D, found {}", D::D, D::D, v.len()),
+        ));
+    }
+    if v.iter().any(|c| !c.is_finite()) {
+        return Err(src.error(key, "components must be finite numbers"));
+    }
+    let mut out = [0.0; 3];
+    out[..D::D].copy_from_slice(v);
+    Ok(out)
+}
+
+fn to_vec<D: Dim>(a: [f64; 3]) -> D::Vec {
+    D::from_slice(&a[..D::D])
+}
+
+fn axis_index<D: Dim>(src: &Source, key: &str, name: &str) -> R<usize> {
+    let a = match name {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        _ => return Err(src.error(key, format!("unknown axis `{name}` (use x, y or z)"))),
+    };
+    if a >= D::D {
+        return Err(src.error(key, format!("axis `{name}` does not exist in {}D", D::D)));
+    }
+    Ok(a)
+}
+
+fn positive(src: &Source, key: &str, v: f64, unit: &str) -> R<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(src.error(key, format!("must be a positive number ({unit}), got {v}")))
+    }
+}
+
+fn bounds<D: Dim>(src: &Source, key: &str, b: &BoxSpec) -> R<([f64; 3], [f64; 3])> {
+    let lo = vec3::<D>(src, &format!("{key}.min"), &b.min)?;
+    let hi = vec3::<D>(src, &format!("{key}.max"), &b.max)?;
+    if (0..D::D).any(|a| hi[a] < lo[a]) {
+        return Err(src.error(&format!("{key}.max"), "max must not be below min"));
+    }
+    Ok((lo, hi))
+}
+
+fn inside(x: [f64; 3], lo: [f64; 3], hi: [f64; 3], dims: usize, tol: [f64; 3]) -> bool {
+    (0..dims).all(|a| x[a] >= lo[a] - tol[a] && x[a] <= hi[a] + tol[a])
+}
+
+/// Builds the scene described by `src` in dimension `D`.
+pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
+    let sc = &src.scenario;
+    let sim = &sc.simulation;
+    if sim.dimension as usize != D::D {
+        return Err(src.error("simulation.dimension", "must be 2 or 3"));
+    }
+    let plane = match (D::D, sim.plane.as_deref()) {
+        (2, None | Some("strain")) => Plane::Strain,
+        (2, Some("stress")) => Plane::Stress,
+        (2, Some(other)) => {
+            return Err(src.error(
+                "simulation.plane",
+                format!("unknown plane mode `{other}` (use \"strain\" or \"stress\")"),
+            ));
+        }
+        (_, Some(_)) => return Err(src.error("simulation.plane", "applies to 2D scenes only")),
+        _ => Plane::None,
+    };
+    let thickness = match (D::D, sim.thickness) {
+        (2, Some(t)) => positive(src, "simulation.thickness", t, "m")?,
+        (2, None) => 1.0,
+        (_, Some(_)) => {
+            return Err(src.error("simulation.thickness", "applies to 2D scenes only"));
+        }
+        _ => 1.0,
+    };
+    let duration = positive(src, "simulation.duration", sim.duration, "s")?;
+    if !(sim.cfl > 0.0 && sim.cfl < 1.0) {
+        return Err(src.error(
+            "simulation.cfl",
+            format!("CFL factor must satisfy 0 < cfl < 1, got {}", sim.cfl),
+        ));
+    }
+    if !(sim.damping >= 0.0 && sim.damping.is_finite()) {
+        return Err(src.error("simulation.damping", "damping must be >= 0 (1/s)"));
+    }
+    let gravity = match &sim.gravity {
+        Some(g) => vec3::<D>(src, "simulation.gravity", g)?,
+        None => [0.0; 3],
+    };
+    let tile = sim.tile.unwrap_or(if D::D == 2 { 8 } else { 4 });
+    if tile < MIN_TILE {
+        return Err(src.error(
+            "simulation.tile",
+            format!("tiles must be at least {MIN_TILE} cells wide"),
+        ));
+    }
+
+    // Grid.
+    let gmin = vec3::<D>(src, "grid.min", &sc.grid.min)?;
+    let gmax = vec3::<D>(src, "grid.max", &sc.grid.max)?;
+    let cell = vec3::<D>(src, "grid.cell", &sc.grid.cell)?;
+    let mut cells = [1usize; 3];
+    let mut h = [1.0; 3];
+    let mut node_count = 1.0;
+    for a in 0..D::D {
+        h[a] = positive(src, "grid.cell", cell[a], "m")?;
+        if gmax[a] <= gmin[a] {
+            return Err(src.error("grid.max", "grid max must exceed grid min on every axis"));
+        }
+        let n = (gmax[a] - gmin[a]) / h[a];
+        if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
+            return Err(src.error(
+                "grid.cell",
+                format!("the grid extent on axis {a} is {n:.6} cells; it must be a whole number"),
+            ));
+        }
+        node_count *= n.round() + 1.0;
+        if node_count > MAX_NODES {
+            return Err(src.error("grid.cell", "grid too large (more than 2e8 nodes)"));
+        }
+        cells[a] = n.round() as usize;
+        if cells[a] < 2 {
+            return Err(src.error("grid.cell", "the grid needs at least 2 cells per axis"));
+        }
+    }
+    let geom = GridGeom::<D>::new(to_vec::<D>(gmin), to_vec::<D>(h), cells);
+
+    // Materials.
+    let mut materials = Vec::new();
+    for (i, m) in sc.materials.iter().enumerate() {
+        let key = |k: &str| format!("material[{i}].{k}");
+        if materials.iter().any(|e: &Elastic| e.name == m.name) {
+            return Err(src.error(&key("name"), format!("duplicate material `{}`", m.name)));
+        }
+        positive(src, &key("E"), m.youngs, "Pa")?;
+        positive(src, &key("rho"), m.rho, "kg/m^3")?;
+        if !(m.nu > -1.0 && m.nu < 0.5) {
+            return Err(src.error(
+                &key("nu"),
+                format!("Poisson's ratio must satisfy -1 < nu < 0.5, got {}", m.nu),
+            ));
+        }
+        materials.push(Elastic::new(&m.name, m.youngs, m.nu, m.rho));
+    }
+    if materials.len() > u16::MAX as usize {
+        return Err(src.error("material", "too many materials"));
+    }
+
+    // Bodies.
+    if sc.bodies.is_empty() {
+        return Err(src.error("body", "the scenario has no [[body]]"));
+    }
+    let mut particles = Particles::<D>::default();
+    let shape = sim.shape;
+    let mut used = vec![false; materials.len()];
+    for (b, body) in sc.bodies.iter().enumerate() {
+        add_body::<D>(
+            src, b, body, &geom, &materials, &mut used, shape, thickness, &mut particles,
+        )?;
+    }
+
+    // Time step.
+    let c_max = materials
+        .iter()
+        .zip(&used)
+        .filter(|(_, u)| **u)
+        .map(|(m, _)| m.wave_speed(plane))
+        .fold(0.0, f64::max);
+    let dt_limit = geom.min_cell() / c_max;
+    let dt = match sim.dt {
+        Some(dt) => {
+            positive(src, "simulation.dt", dt, "s")?;
+            if dt > dt_limit {
+                return Err(src.error(
+                    "simulation.dt",
+                    format!(
+                        "time step {dt:.4e} s is above the stability limit {dt_limit:.4e} s \
+                         (smallest cell / fastest wave speed {c_max:.1} m/s)"
+                    ),
+                ));
+            }
+            dt
+        }
+        None => sim.cfl * dt_limit,
+    };
+    if duration / dt > 1e10 {
+        return Err(src.error("simulation.duration", "more than 1e10 time steps"));
+    }
+
+    // Boundary conditions.
+    let mut bcs = Vec::new();
+    for (i, bc) in sc.boundaries.iter().enumerate() {
+        let key = |k: &str| format!("boundary[{i}].{k}");
+        let (nodes, normal) = match (&bc.region, &bc.plane) {
+            (Some(r), None) => {
+                let (lo, hi) = bounds::<D>(src, &key("region"), r)?;
+                let tol = h.map(|x| 1e-6 * x);
+                let nodes: Vec<u32> = (0..geom.node_count())
+                    .filter(|&n| {
+                        inside(D::to_xyz(geom.node_position(n)), lo, hi, D::D, tol)
+                    })
+                    .map(|n| n as u32)
+                    .collect();
+                (nodes, None)
+            }
+            (None, Some(p)) => {
+                let a = axis_index::<D>(src, &key("plane.axis"), &p.axis)?;
+                let nodes: Vec<u32> = (0..geom.node_count())
+                    .filter(|&n| (geom.node_position(n)[a] - p.at).abs() <= 1e-6 * h[a])
+                    .map(|n| n as u32)
+                    .collect();
+                (nodes, Some(a))
+            }
+            _ => {
+                return Err(src.error(
+                    &format!("boundary[{i}]"),
+                    "give exactly one of `region` or `plane`",
+                ));
+            }
+        };
+        if nodes.is_empty() {
+            return Err(src.error(
+                &format!("boundary[{i}]"),
+                "selects no grid node (a plane must lie on a grid line)",
+            ));
+        }
+        let mut axes = [false; 3];
+        match (&bc.fix, normal) {
+            (Some(list), _) => {
+                for (k, c) in list.iter().enumerate() {
+                    axes[axis_index::<D>(src, &format!("boundary[{i}].fix[{k}]"), c)?] = true;
+                }
+            }
+            (None, Some(a)) => axes[a] = true,
+            (None, None) => axes[..D::D].iter_mut().for_each(|x| *x = true),
+        }
+        let velocity = match &bc.velocity {
+            Some(v) => vec3::<D>(src, &key("velocity"), v)?,
+            None => [0.0; 3],
+        };
+        if let Some(msg) = bc.time.check() {
+            return Err(src.error(&key("time"), msg));
+        }
+        bcs.push(VelocityBc {
+            nodes,
+            axes,
+            velocity: to_vec::<D>(velocity),
+            time: bc.time,
+        });
+    }
+
+    // Loads.
+    let select = |key: &str, r: &BoxSpec| -> R<Vec<u32>> {
+        let (lo, hi) = bounds::<D>(src, key, r)?;
+        let sel: Vec<u32> = (0..particles.len())
+            .filter(|&p| inside(D::to_xyz(particles.x[p]), lo, hi, D::D, [0.0; 3]))
+            .map(|p| p as u32)
+            .collect();
+        if sel.is_empty() {
+            return Err(src.error(key, "the region contains no particle"));
+        }
+        Ok(sel)
+    };
+    let mut loads = Vec::new();
+    for (i, l) in sc.loads.iter().enumerate() {
+        let sel = select(&format!("load[{i}].region"), &l.region)?;
+        let f = vec3::<D>(src, &format!("load[{i}].force"), &l.force)?;
+        if let Some(msg) = l.time.check() {
+            return Err(src.error(&format!("load[{i}].time"), msg));
+        }
+        let n = sel.len() as f64;
+        loads.push(Load {
+            force: to_vec::<D>(f.map(|c| c / n)),
+            particles: sel,
+            time: l.time,
+        });
+    }
+
+    // Probes.
+    let mut probes: Vec<Probe> = Vec::new();
+    for (i, p) in sc.probes.iter().enumerate() {
+        let key = |k: &str| format!("probe[{i}].{k}");
+        if probes.iter().any(|q| q.name == p.name) {
+            return Err(src.error(&key("name"), format!("duplicate probe `{}`", p.name)));
+        }
+        let qty = match p.quantity.as_str() {
+            "displacement" => ProbeQty::Displacement,
+            "velocity" => ProbeQty::Velocity,
+            "position" => ProbeQty::Position,
+            "stress" => ProbeQty::Stress,
+            "strain" => ProbeQty::Strain,
+            other => {
+                return Err(src.error(
+                    &key("quantity"),
+                    format!(
+                        "unknown quantity `{other}` (displacement, velocity, position, stress, strain)"
+                    ),
+                ));
+            }
+        };
+        let comp = if matches!(qty, ProbeQty::Stress | ProbeQty::Strain) {
+            ["xx", "yy", "zz", "yz", "xz", "xy"]
+                .iter()
+                .position(|c| *c == p.component)
+                .ok_or_else(|| {
+                    src.error(&key("component"), "tensor component must be xx, yy, zz, yz, xz or xy")
+                })?
+        } else {
+            axis_index::<D>(src, &key("component"), &p.component)?
+        };
+        let sel = select(&key("region"), &p.region)?;
+        let mut centre = [0.0; 3];
+        for &q in &sel {
+            let x = D::to_xyz(particles.x[q as usize]);
+            for a in 0..3 {
+                centre[a] += x[a] / sel.len() as f64;
+            }
+        }
+        probes.push(Probe {
+            name: p.name.clone(),
+            particles: sel,
+            qty,
+            comp,
+            centre,
+        });
+    }
+
+    // Expectations.
+    let mut expects = Vec::new();
+    for (i, e) in sc.expects.iter().enumerate() {
+        let key = |k: &str| format!("expect[{i}].{k}");
+        let mut ids = Vec::new();
+        for name in &e.probes {
+            let id = probes.iter().position(|p| &p.name == name).ok_or_else(|| {
+                src.error(&key("probes"), format!("no probe named `{name}`"))
+            })?;
+            ids.push(id);
+        }
+        let need = match e.quantity.as_str() {
+            "wave_speed" => 2,
+            "final" | "max" | "min" | "frequency" => 1,
+            "momentum_drift" | "energy_drift" | "angular_momentum_drift" => 0,
+            other => {
+                return Err(src.error(
+                    &key("quantity"),
+                    format!(
+                        "unknown quantity `{other}` (final, max, min, frequency, wave_speed, \
+                         momentum_drift, energy_drift, angular_momentum_drift)"
+                    ),
+                ));
+            }
+        };
+        if ids.len() != need {
+            return Err(src.error(
+                &key("probes"),
+                format!("`{}` takes {need} probe name(s), got {}", e.quantity, ids.len()),
+            ));
+        }
+        let measure = match e.quantity.as_str() {
+            "final" => Measure::Final(ids[0]),
+            "max" => Measure::Max(ids[0]),
+            "min" => Measure::Min(ids[0]),
+            "frequency" => Measure::Frequency(ids[0]),
+            "wave_speed" => Measure::WaveSpeed(ids[0], ids[1]),
+            "momentum_drift" => Measure::MomentumDrift,
+            "energy_drift" => Measure::EnergyDrift,
+            _ => Measure::AngularMomentumDrift,
+        };
+        if !e.reference.is_finite() {
+            return Err(src.error(&key("reference"), "must be a finite number"));
+        }
+        positive(src, &key("tolerance"), e.tolerance, "relative, or absolute for reference 0")?;
+        expects.push(Expect {
+            quantity: e.quantity.clone(),
+            probes: e.probes.clone(),
+            measure,
+            reference: e.reference,
+            source: e.source.clone(),
+            tolerance: e.tolerance,
+        });
+    }
+
+    let out = &sc.output;
+    let interval = match out.interval {
+        Some(v) => positive(src, "output.interval", v, "s")?,
+        None => duration / 20.0,
+    };
+    let history_interval = match out.history_interval {
+        Some(v) => positive(src, "output.history_interval", v, "s")?,
+        None => duration / 400.0,
+    };
+    let min_mass = particles.mass.iter().copied().fold(f64::INFINITY, f64::min);
+    let world = World {
+        tiles: Tiles::new::<D>(tile, cells),
+        grid: Grid::new(geom),
+        particles,
+        materials,
+        settings: Settings {
+            shape,
+            update: sim.update,
+            plane,
+            damping: sim.damping,
+            gravity: to_vec::<D>(gravity),
+            dt,
+            mass_tol: 1e-12 * min_mass,
+        },
+        loads,
+        bcs,
+        time: 0.0,
+        step: 0,
+        work: Work::default(),
+    };
+    Ok(Scene {
+        name: src.name(),
+        world,
+        probes,
+        expects,
+        duration,
+        output: OutputPlan {
+            interval,
+            history_interval,
+            vtk: out.vtk.unwrap_or(true),
+            plot: out.plot.unwrap_or(true),
+        },
+        dt_limit,
+    })
+}
+
+/// The geometry of body `b`, from exactly one geometry key.
+fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
+    let key = |k: &str| format!("body[{b}].{k}");
+    let given = [
+        body.box_.is_some(),
+        body.disc.is_some(),
+        body.sphere.is_some(),
+        body.cylinder.is_some(),
+        body.polygon.is_some(),
+    ];
+    if given.iter().filter(|g| **g).count() != 1 {
+        return Err(src.error(
+            &format!("body[{b}]"),
+            "give exactly one geometry: box, disc (2D), sphere (3D), cylinder (3D) or polygon",
+        ));
+    }
+    if let Some(bx) = &body.box_ {
+        let (min, max) = bounds::<D>(src, &key("box"), bx)?;
+        return Ok(Geometry::Box { min, max });
+    }
+    if let Some(d) = &body.disc {
+        if D::D != 2 {
+            return Err(src.error(&key("disc"), "disc is 2D; use sphere or cylinder in 3D"));
+        }
+        return Ok(Geometry::Round {
+            center: vec3::<D>(src, &key("disc.center"), &d.center)?,
+            radius: positive(src, &key("disc.radius"), d.radius, "m")?,
+            sphere: false,
+        });
+    }
+    if let Some(s) = &body.sphere {
+        if D::D != 3 {
+            return Err(src.error(&key("sphere"), "sphere is 3D; use disc in 2D"));
+        }
+        return Ok(Geometry::Round {
+            center: vec3::<D>(src, &key("sphere.center"), &s.center)?,
+            radius: positive(src, &key("sphere.radius"), s.radius, "m")?,
+            sphere: true,
+        });
+    }
+    if let Some(c) = &body.cylinder {
+        if D::D != 3 {
+            return Err(src.error(&key("cylinder"), "cylinder is 3D; use disc in 2D"));
+        }
+        return Ok(Geometry::Cylinder {
+            center: vec3::<D>(src, &key("cylinder.center"), &c.center)?,
+            axis: axis_index::<D>(src, &key("cylinder.axis"), &c.axis)?,
+            radius: positive(src, &key("cylinder.radius"), c.radius, "m")?,
+            length: positive(src, &key("cylinder.length"), c.length, "m")?,
+        });
+    }
+    let p = body.polygon.as_ref().expect("one geometry is given");
+    if p.points.len() < 3 {
+        return Err(src.error(&key("polygon.points"), "a polygon needs at least 3 points"));
+    }
+    let mut points = Vec::new();
+    for (k, pt) in p.points.iter().enumerate() {
+        if pt.len() != 2 || pt.iter().any(|c| !c.is_finite()) {
+            return Err(src.error(
+                &key(&format!("polygon.points[{k}]")),
+                "polygon points are [x, y] pairs of finite numbers",
+            ));
+        }
+        points.push([pt[0], pt[1]]);
+    }
+    let z = match (&p.z, D::D) {
+        (Some(z), 3) if z.len() == 2 && z[1] > z[0] => Some([z[0], z[1]]),
+        (None, 2) => None,
+        (None, _) => {
+            return Err(src.error(&key("polygon"), "a 3D polygon needs its extrusion z = [z0, z1]"));
+        }
+        (Some(_), 2) => return Err(src.error(&key("polygon.z"), "z applies to 3D scenes only")),
+        (Some(_), _) => return Err(src.error(&key("polygon.z"), "z must be [z0, z1] with z1 > z0")),
+    };
+    Ok(Geometry::Polygon { points, z })
+}
+
+/// Fills body `b` with particles and appends them to the store.
+#[allow(clippy::too_many_arguments)]
+fn add_body<D: Dim>(
+    src: &Source,
+    b: usize,
+    body: &BodySpec,
+    geom: &GridGeom<D>,
+    materials: &[Elastic],
+    used: &mut [bool],
+    shape: ShapeKind,
+    thickness: f64,
+    particles: &mut Particles<D>,
+) -> R<()> {
+    let key = |k: &str| format!("body[{b}].{k}");
+    let mat = materials
+        .iter()
+        .position(|m| m.name == body.material)
+        .ok_or_else(|| {
+            src.error(
+                &key("material"),
+                format!("no [[material]] named `{}`", body.material),
+            )
+        })?;
+    used[mat] = true;
+    if !(1..=16).contains(&body.ppc) {
+        return Err(src.error(&key("ppc"), "particles per cell per direction must be 1..=16"));
+    }
+    let g = geometry::<D>(src, b, body)?;
+    let (lo, hi) = g.bounds();
+    let origin = D::to_xyz(geom.origin);
+    let h = D::to_xyz(geom.h);
+    let mut estimate = 1.0;
+    for a in 0..D::D {
+        estimate *= ((hi[a] - lo[a]) / h[a] + 2.0) * body.ppc as f64;
+    }
+    if estimate > MAX_PARTICLES {
+        return Err(src.error(&format!("body[{b}]"), "body would need more than 2e8 particles"));
+    }
+    let pts = fill(&g, D::D, origin, h, geom.cells, body.ppc);
+    if pts.is_empty() {
+        return Err(src.error(
+            &format!("body[{b}]"),
+            "body contains no particle (is it smaller than a particle spacing, or outside the grid?)",
+        ));
+    }
+    let n = body.ppc as f64;
+    let mut volume = thickness;
+    let mut half = [0.0; 3];
+    for a in 0..D::D {
+        volume *= h[a] / n;
+        half[a] = 0.5 * h[a] / n;
+    }
+    let v0 = match &body.velocity {
+        Some(v) => vec3::<D>(src, &key("velocity"), v)?,
+        None => [0.0; 3],
+    };
+    let omega = match &body.angular_velocity {
+        None => [0.0; 3],
+        Some(w) if D::D == 2 && w.len() == 1 => [0.0, 0.0, w[0]],
+        Some(w) if D::D == 3 && w.len() == 3 => [w[0], w[1], w[2]],
+        Some(_) => {
+            return Err(src.error(
+                &key("angular_velocity"),
+                "give one value (rad/s, about z) in 2D or three in 3D",
+            ));
+        }
+    };
+    let centre = match &body.spin_center {
+        Some(c) => vec3::<D>(src, &key("spin_center"), c)?,
+        None => [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a])),
+    };
+    let reach = to_vec::<D>([0, 1, 2].map(|a| shape.reach(half[a] / h[a]) * h[a]));
+    let rho = materials[mat].density;
+    for x in pts {
+        if !geom.holds(to_vec::<D>(x), reach) {
+            return Err(src.error(
+                &format!("body[{b}]"),
+                format!(
+                    "body extends beyond the grid: a particle at ({:.4e}, {:.4e}, {:.4e}) m needs \
+                     its shape-function support inside the grid; enlarge the grid by a cell",
+                    x[0], x[1], x[2]
+                ),
+            ));
+        }
+        let r = [0, 1, 2].map(|a| x[a] - centre[a]);
+        let spin = [
+            omega[1] * r[2] - omega[2] * r[1],
+            omega[2] * r[0] - omega[0] * r[2],
+            omega[0] * r[1] - omega[1] * r[0],
+        ];
+        let v = [0, 1, 2].map(|a| v0[a] + spin[a]);
+        particles.push(to_vec::<D>(x), to_vec::<D>(v), rho * volume, volume, mat as u16);
+        if shape == ShapeKind::Ugimp {
+            particles.half.push(to_vec::<D>(half));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,9 @@
+//! Scenario files: format ([`schema`]), reading with overrides ([`source`]) and building a
+//! World from them ([`build`]).
+
+pub mod build;
+pub mod schema;
+pub mod source;
+
+pub use build::{OutputPlan, Scene, build};
+pub use source::Source;

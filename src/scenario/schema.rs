@@ -1,0 +1,268 @@
+//! The scenario file format (TOML). Every table rejects unknown keys.
+
+use crate::shape::ShapeKind;
+use crate::timefn::TimeFn;
+use crate::world::Update;
+use serde::Deserialize;
+
+/// A whole scenario file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Name used in reports (default: the file stem).
+    pub name: Option<String>,
+    /// Free text.
+    pub description: Option<String>,
+    /// Time integration and kinematics.
+    pub simulation: Simulation,
+    /// Background grid.
+    pub grid: GridSpec,
+    /// Materials.
+    #[serde(default, rename = "material")]
+    pub materials: Vec<MaterialSpec>,
+    /// Bodies filled with particles.
+    #[serde(default, rename = "body")]
+    pub bodies: Vec<BodySpec>,
+    /// Prescribed grid velocities.
+    #[serde(default, rename = "boundary")]
+    pub boundaries: Vec<BoundarySpec>,
+    /// External particle forces.
+    #[serde(default, rename = "load")]
+    pub loads: Vec<LoadSpec>,
+    /// Recorded particle averages.
+    #[serde(default, rename = "probe")]
+    pub probes: Vec<ProbeSpec>,
+    /// Output cadence.
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// Self-checks against reference values.
+    #[serde(default, rename = "expect")]
+    pub expects: Vec<ExpectSpec>,
+}
+
+/// `[simulation]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Simulation {
+    /// 2 or 3.
+    pub dimension: u8,
+    /// 2D only: "strain" (default) or "stress".
+    pub plane: Option<String>,
+    /// 2D only: out-of-plane thickness (m), default 1.
+    pub thickness: Option<f64>,
+    /// Shape function.
+    #[serde(default)]
+    pub shape: ShapeKind,
+    /// Stress-update order.
+    #[serde(default)]
+    pub update: Update,
+    /// Simulated duration (s).
+    pub duration: f64,
+    /// Time step as a fraction of the stability limit (0 < cfl < 1).
+    #[serde(default = "default_cfl")]
+    pub cfl: f64,
+    /// Explicit time step (s); must not exceed the stability limit.
+    pub dt: Option<f64>,
+    /// Mass-proportional damping alpha = d_k/rho (1/s).
+    #[serde(default)]
+    pub damping: f64,
+    /// Body force per unit mass (m/s^2).
+    pub gravity: Option<Vec<f64>>,
+    /// Cells per tile edge (default 8 in 2D, 4 in 3D).
+    pub tile: Option<usize>,
+}
+
+fn default_cfl() -> f64 {
+    0.5
+}
+
+/// `[grid]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridSpec {
+    /// Lower corner (m).
+    pub min: Vec<f64>,
+    /// Upper corner (m).
+    pub max: Vec<f64>,
+    /// Cell size per axis (m).
+    pub cell: Vec<f64>,
+}
+
+/// `[[material]]`: isotropic linear elastic.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Name bodies refer to.
+    pub name: String,
+    /// Young's modulus (Pa).
+    #[serde(rename = "E")]
+    pub youngs: f64,
+    /// Poisson's ratio.
+    pub nu: f64,
+    /// Density (kg/m^3).
+    pub rho: f64,
+}
+
+/// An axis-aligned box (m).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    /// Lower corner.
+    pub min: Vec<f64>,
+    /// Upper corner.
+    pub max: Vec<f64>,
+}
+
+/// A disc (2D) or sphere (3D).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoundSpec {
+    /// Centre (m).
+    pub center: Vec<f64>,
+    /// Radius (m).
+    pub radius: f64,
+}
+
+/// A 3D circular cylinder.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CylinderSpec {
+    /// Centre of the base (m).
+    pub center: Vec<f64>,
+    /// Axis direction: "x", "y" or "z".
+    pub axis: String,
+    /// Radius (m).
+    pub radius: f64,
+    /// Length along the axis (m).
+    pub length: f64,
+}
+
+/// A polygon in the x-y plane; in 3D extruded over `z = [z0, z1]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolygonSpec {
+    /// Vertices (m), at least three, in either winding.
+    pub points: Vec<Vec<f64>>,
+    /// 3D only: extrusion range (m).
+    pub z: Option<Vec<f64>>,
+}
+
+/// `[[body]]`: a region filled with particles. Exactly one geometry key is given.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Optional name.
+    pub name: Option<String>,
+    /// Material name.
+    pub material: String,
+    /// Particles per cell per direction.
+    #[serde(default = "default_ppc")]
+    pub ppc: usize,
+    /// Initial velocity (m/s).
+    pub velocity: Option<Vec<f64>>,
+    /// Initial rigid spin (rad/s): one value (about z) in 2D, a vector in 3D.
+    pub angular_velocity: Option<Vec<f64>>,
+    /// Centre of the initial spin (m); default the centre of the body's bounding box.
+    pub spin_center: Option<Vec<f64>>,
+    /// Box geometry.
+    #[serde(rename = "box")]
+    pub box_: Option<BoxSpec>,
+    /// Disc geometry (2D).
+    pub disc: Option<RoundSpec>,
+    /// Sphere geometry (3D).
+    pub sphere: Option<RoundSpec>,
+    /// Cylinder geometry (3D).
+    pub cylinder: Option<CylinderSpec>,
+    /// Polygon geometry (2D, or extruded in 3D).
+    pub polygon: Option<PolygonSpec>,
+}
+
+fn default_ppc() -> usize {
+    2
+}
+
+/// A plane of nodes `axis = at` (m).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneSpec {
+    /// "x", "y" or "z".
+    pub axis: String,
+    /// Coordinate of the plane (m); must lie on a grid line.
+    pub at: f64,
+}
+
+/// `[[boundary]]`: prescribed velocity components on the nodes of a region or plane.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundarySpec {
+    /// Nodes inside this box (inclusive).
+    pub region: Option<BoxSpec>,
+    /// Nodes on this plane (a symmetry plane fixes its normal component).
+    pub plane: Option<PlaneSpec>,
+    /// Components to prescribe; default all (region) or the normal (plane).
+    pub fix: Option<Vec<String>>,
+    /// Prescribed velocity (m/s); default zero.
+    pub velocity: Option<Vec<f64>>,
+    /// Time multiplier on the velocity.
+    #[serde(default)]
+    pub time: TimeFn,
+}
+
+/// `[[load]]`: a total force spread over the particles initially inside a region.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// Particles initially inside this box are loaded.
+    pub region: BoxSpec,
+    /// Total force (N).
+    pub force: Vec<f64>,
+    /// Time multiplier.
+    #[serde(default)]
+    pub time: TimeFn,
+}
+
+/// `[[probe]]`: a particle average recorded at every step.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeSpec {
+    /// Name used by `[[expect]]` and in probes.csv.
+    pub name: String,
+    /// Particles initially inside this box are averaged.
+    pub region: BoxSpec,
+    /// "displacement", "velocity", "position", "stress" or "strain".
+    pub quantity: String,
+    /// "x", "y", "z" for vectors; "xx", "yy", "zz", "yz", "xz", "xy" for tensors.
+    pub component: String,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Simulated time between VTK frames (s); default duration / 20.
+    pub interval: Option<f64>,
+    /// Simulated time between energy.csv and probes.csv rows (s); default duration / 400.
+    pub history_interval: Option<f64>,
+    /// Write VTK particle files (default true).
+    pub vtk: Option<bool>,
+    /// Write PNG plots (default true).
+    pub plot: Option<bool>,
+}
+
+/// `[[expect]]`: a measured quantity checked against a reference.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpectSpec {
+    /// One of: final, max, min, frequency, wave_speed, momentum_drift, energy_drift,
+    /// angular_momentum_drift.
+    pub quantity: String,
+    /// Probe(s) the quantity is measured on (wave_speed takes two).
+    #[serde(default)]
+    pub probes: Vec<String>,
+    /// Reference value (SI).
+    pub reference: f64,
+    /// Where the reference comes from.
+    pub source: String,
+    /// Allowed error: relative to |reference|, or absolute when the reference is 0.
+    pub tolerance: f64,
+}

@@ -1,0 +1,116 @@
+//! Spatial tiles: particles binned by tile, tiles grouped into 2^D colour classes.
+//!
+//! Tiles of one colour are at least one tile apart on every axis, and a tile's particles
+//! reach at most one node below and two nodes above its cells, so with tiles wider than
+//! two cells the node sets touched by tiles of one colour are disjoint. P2G uses this to
+//! scatter in parallel without atomics and with a fixed summation order.
+
+use crate::dim::Dim;
+use rayon::prelude::*;
+
+/// Tiles wider than this many cells keep same-colour tiles' stencils disjoint.
+pub const MIN_TILE: usize = 3;
+
+/// Particle bins by tile (counting sort, stable in particle index).
+#[derive(Clone, Debug, Default)]
+pub struct Tiles {
+    /// Cells per tile edge.
+    pub size: usize,
+    /// Tiles per axis (1 on the third axis in 2D).
+    pub counts: [usize; 3],
+    /// `start[t]..start[t + 1]` indexes `order` for tile `t`.
+    pub start: Vec<u32>,
+    /// Particle indices sorted by tile.
+    pub order: Vec<u32>,
+    /// Non-empty tiles of each colour class.
+    pub colours: Vec<Vec<u32>>,
+    /// Scratch: tile of each particle.
+    pub tile_of: Vec<u32>,
+}
+
+/// Linear index of the tile holding `cell`, for tiles of `size` cells and `counts` tiles.
+#[inline(always)]
+pub fn tile_index(size: usize, counts: [usize; 3], cell: [usize; 3]) -> u32 {
+    let t = [cell[0] / size, cell[1] / size, cell[2] / size];
+    (t[0] + counts[0] * (t[1] + counts[1] * t[2])) as u32
+}
+
+impl Tiles {
+    /// Tiles of `size` cells per edge covering `cells`; `size` must exceed two cells.
+    pub fn new<D: Dim>(size: usize, cells: [usize; 3]) -> Self {
+        assert!(size >= MIN_TILE, "tile size below {MIN_TILE} cells");
+        let mut counts = [1; 3];
+        for a in 0..D::D {
+            counts[a] = cells[a].div_ceil(size);
+        }
+        let n = counts.iter().product::<usize>();
+        Tiles {
+            size,
+            counts,
+            start: vec![0; n + 1],
+            order: Vec::new(),
+            colours: vec![Vec::new(); D::COLOURS],
+            tile_of: Vec::new(),
+        }
+    }
+
+    /// Number of tiles.
+    pub fn len(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// Whether there are no tiles.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Colour class (0..2^D) of a tile: parity of its index on each axis.
+    pub fn colour(&self, t: usize) -> usize {
+        let i = t % self.counts[0];
+        let j = (t / self.counts[0]) % self.counts[1];
+        let k = t / (self.counts[0] * self.counts[1]);
+        (i & 1) | ((j & 1) << 1) | ((k & 1) << 2)
+    }
+
+    /// Particles in tile `t`, in ascending index order.
+    #[inline(always)]
+    pub fn particles(&self, t: u32) -> &[u32] {
+        let t = t as usize;
+        &self.order[self.start[t] as usize..self.start[t + 1] as usize]
+    }
+
+    /// Runs `f` on every non-empty tile: colour classes one after another, the tiles of a
+    /// class in parallel. Tiles of one class never share a node.
+    pub fn for_each_coloured(&self, f: impl Fn(u32) + Sync + Send) {
+        for class in &self.colours {
+            class.par_iter().for_each(|&t| f(t));
+        }
+    }
+
+    /// Rebuilds `start`, `order` and `colours` from `tile_of` (counting sort).
+    pub fn sort(&mut self) {
+        let nt = self.len();
+        self.start.iter_mut().for_each(|s| *s = 0);
+        for &t in &self.tile_of {
+            self.start[t as usize + 1] += 1;
+        }
+        for t in 0..nt {
+            self.start[t + 1] += self.start[t];
+        }
+        self.order.resize(self.tile_of.len(), 0);
+        let mut next: Vec<u32> = self.start[..nt].to_vec();
+        for (p, &t) in self.tile_of.iter().enumerate() {
+            self.order[next[t as usize] as usize] = p as u32;
+            next[t as usize] += 1;
+        }
+        for c in &mut self.colours {
+            c.clear();
+        }
+        for t in 0..nt {
+            if self.start[t + 1] > self.start[t] {
+                let c = self.colour(t);
+                self.colours[c].push(t as u32);
+            }
+        }
+    }
+}

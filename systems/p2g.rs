@@ -1,0 +1,137 @@
+//! `p2g`: particle-to-grid scatter of mass, momentum and forces (Guo & Nairn 2D (2004)
+//! Eqs. 3-6, single velocity field), tile by tile in colour classes.
+
+use crate::dim::Dim;
+use crate::grid::Grid;
+use crate::shape::Stencil;
+use crate::world::World;
+use rayon::prelude::*;
+use std::marker::PhantomData;
+
+/// Write access to the grid's scatter columns shared by the tiles of one colour class.
+struct NodeWriter<'a, D: Dim> {
+    mass: *mut f64,
+    momentum: *mut D::Vec,
+    force: *mut D::Vec,
+    len: usize,
+    _borrow: PhantomData<&'a mut Grid<D>>,
+}
+
+// SAFETY: the writer only hands out element writes through `add`, whose contract requires
+// that no two threads touch the same node at once; the pointed-to columns are exclusively
+// borrowed for the writer's lifetime.
+unsafe impl<D: Dim> Sync for NodeWriter<'_, D> {}
+// SAFETY: as for Sync; the raw pointers refer to heap columns that outlive the writer.
+unsafe impl<D: Dim> Send for NodeWriter<'_, D> {}
+
+impl<'a, D: Dim> NodeWriter<'a, D> {
+    fn new(mass: &'a mut [f64], momentum: &'a mut [D::Vec], force: &'a mut [D::Vec]) -> Self {
+        assert!(mass.len() == momentum.len() && mass.len() == force.len());
+        NodeWriter {
+            len: mass.len(),
+            mass: mass.as_mut_ptr(),
+            momentum: momentum.as_mut_ptr(),
+            force: force.as_mut_ptr(),
+            _borrow: PhantomData,
+        }
+    }
+
+    /// Adds to node `n`.
+    ///
+    /// # Safety
+    /// No other thread may access node `n` during the call.
+    #[inline(always)]
+    unsafe fn add(&self, n: usize, m: f64, p: D::Vec, f: D::Vec) {
+        assert!(n < self.len);
+        // SAFETY: n is in bounds (checked above) and the caller guarantees exclusive access
+        // to node n.
+        unsafe {
+            *self.mass.add(n) += m;
+            *self.momentum.add(n) += p;
+            *self.force.add(n) += f;
+        }
+    }
+}
+
+/// Scatters mass and momentum (and, when `internal`, the internal force -V sigma . grad S)
+/// to a zeroed grid, then adds the external particle loads.
+pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
+    let Grid {
+        geom,
+        mass,
+        momentum,
+        force,
+        ..
+    } = &mut world.grid;
+    mass.par_iter_mut().for_each(|m| *m = 0.0);
+    momentum.par_iter_mut().for_each(|m| *m = D::zero());
+    force.par_iter_mut().for_each(|f| *f = D::zero());
+    let writer = NodeWriter::<D>::new(mass, momentum, force);
+    let p = &world.particles;
+    let shape = world.settings.shape;
+    let geom = &*geom;
+    world.tiles.for_each_coloured(|t| {
+        for &i in world.tiles.particles(t) {
+            let i = i as usize;
+            let st = Stencil::new::<D>(shape, geom, p.x[i], p.half_of(i));
+            let (m, mv, vol, s) = (p.mass[i], p.v[i] * p.mass[i], p.volume[i], p.stress[i]);
+            st.for_each::<D>(&geom.stride, |n, w, g| {
+                let f = if internal {
+                    -D::stress_dot(&s, g) * vol
+                } else {
+                    D::zero()
+                };
+                // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and
+                // each tile is handled by one thread.
+                unsafe { writer.add(n, m * w, mv * w, f) };
+            });
+        }
+    });
+    scatter_loads(world);
+}
+
+/// Scatters the internal force -V sigma . grad S alone (USF and USAVG, after the first
+/// stress update).
+pub fn internal_force<D: Dim>(world: &mut World<D>) {
+    let Grid {
+        geom,
+        mass,
+        momentum,
+        force,
+        ..
+    } = &mut world.grid;
+    let writer = NodeWriter::<D>::new(mass, momentum, force);
+    let p = &world.particles;
+    let shape = world.settings.shape;
+    let geom = &*geom;
+    world.tiles.for_each_coloured(|t| {
+        for &i in world.tiles.particles(t) {
+            let i = i as usize;
+            let st = Stencil::new::<D>(shape, geom, p.x[i], p.half_of(i));
+            let (vol, s) = (p.volume[i], p.stress[i]);
+            st.for_each::<D>(&geom.stride, |n, _, g| {
+                // SAFETY: as in `run`: disjoint nodes per colour class, one thread per tile.
+                unsafe { writer.add(n, 0.0, D::zero(), -D::stress_dot(&s, g) * vol) };
+            });
+        }
+    });
+}
+
+/// Adds external particle forces to the grid (sequential, in load order) and books the
+/// first half of their work over the step.
+fn scatter_loads<D: Dim>(world: &mut World<D>) {
+    let (t, dt) = (world.time, world.settings.dt);
+    let p = &world.particles;
+    let geom = &world.grid.geom;
+    let mut work = 0.0;
+    for load in &world.loads {
+        let f = load.force * load.time.at(t);
+        for &i in &load.particles {
+            let i = i as usize;
+            let st = Stencil::new::<D>(world.settings.shape, geom, p.x[i], p.half_of(i));
+            st.for_each::<D>(&geom.stride, |n, w, _| world.grid.force[n] += f * w);
+            work += 0.5 * dt * D::dot(f, p.v[i]);
+        }
+    }
+    world.work.external += work;
+}
