@@ -1,6 +1,7 @@
 //! Regular background grid: geometry and the per-node component store.
 
 use crate::dim::Dim;
+use crate::shape::ShapeKind;
 
 /// Geometry of a regular grid whose cells may be non-cubic.
 #[derive(Clone, Debug)]
@@ -76,14 +77,13 @@ impl<D: Dim> GridGeom<D> {
         x
     }
 
-    /// Whether a particle at `x` whose support reaches `reach` (m per axis) beyond it keeps
-    /// its whole stencil inside the grid.
+    /// Whether the `shape` stencil of a particle at `x` with half-width `half` (m) lies
+    /// inside the grid (false for non-finite positions).
     #[inline(always)]
-    pub fn holds(&self, x: D::Vec, reach: D::Vec) -> bool {
+    pub fn fits(&self, shape: ShapeKind, x: D::Vec, half: D::Vec) -> bool {
         (0..D::D).all(|a| {
-            let lo = (x[a] - reach[a] - self.origin[a]) * self.inv_h[a];
-            let hi = (x[a] + reach[a] - self.origin[a]) * self.inv_h[a];
-            lo >= 0.0 && hi < self.cells[a] as f64
+            let xi = (x[a] - self.origin[a]) * self.inv_h[a];
+            shape.fits(xi, half[a] * self.inv_h[a], self.cells[a])
         })
     }
 }

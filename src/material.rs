@@ -56,10 +56,10 @@ impl Elastic {
         (modulus / self.density).sqrt()
     }
 
-    /// Stress and strain after a strain increment `de` (3D tensor; in 2D the zz entry is
-    /// filled in here: zero for plane strain, the value that keeps sigma_zz = 0 for plane stress).
+    /// Stress after a strain increment `de` (3D tensor; in 2D the zz entry is filled in
+    /// here: zero for plane strain, the value that keeps sigma_zz = 0 for plane stress).
     #[inline(always)]
-    pub fn update(&self, plane: Plane, mut de: Sym3, stress: &mut Sym3, strain: &mut Sym3) {
+    pub fn update(&self, plane: Plane, mut de: Sym3, stress: &mut Sym3) {
         if plane == Plane::Stress {
             de.zz = -self.lambda / (self.lambda + 2.0 * self.mu) * (de.xx + de.yy);
         }
@@ -71,13 +71,28 @@ impl Elastic {
         stress.yz += m2 * de.yz;
         stress.xz += m2 * de.xz;
         stress.xy += m2 * de.xy;
-        *strain += de;
+    }
+
+    /// Strain from stress through the 3D compliance, eps = ((1 + nu) sigma - nu tr(sigma) I)/E.
+    /// Linear elasticity starting unstressed keeps sigma = C : eps, so strain is not stored.
+    #[inline(always)]
+    pub fn strain(&self, s: &Sym3) -> Sym3 {
+        let (e, nu) = (self.youngs, self.poisson);
+        let t = nu * s.trace();
+        Sym3 {
+            xx: ((1.0 + nu) * s.xx - t) / e,
+            yy: ((1.0 + nu) * s.yy - t) / e,
+            zz: ((1.0 + nu) * s.zz - t) / e,
+            yz: (1.0 + nu) * s.yz / e,
+            xz: (1.0 + nu) * s.xz / e,
+            xy: (1.0 + nu) * s.xy / e,
+        }
     }
 
     /// Strain energy density W = sigma : eps / 2 (J/m^3).
     #[inline(always)]
-    pub fn energy_density(stress: &Sym3, strain: &Sym3) -> f64 {
-        0.5 * stress.ddot(strain)
+    pub fn energy_density(&self, stress: &Sym3) -> f64 {
+        0.5 * stress.ddot(&self.strain(stress))
     }
 }
 
@@ -89,15 +104,17 @@ mod tests {
     #[test]
     fn plane_stress_uniaxial_recovers_youngs_modulus() {
         let m = Elastic::new("m", 100e9, 0.3, 1000.0);
-        let (mut s, mut e) = (Sym3::default(), Sym3::default());
+        let mut s = Sym3::default();
         let nu_eff = m.poisson; // lateral contraction of a free plate: eps_yy = -nu eps_xx
         let de = Sym3 {
             xx: 1e-4,
             yy: -nu_eff * 1e-4,
             ..Sym3::default()
         };
-        m.update(Plane::Stress, de, &mut s, &mut e);
+        m.update(Plane::Stress, de, &mut s);
         assert!((s.xx - 100e9 * 1e-4).abs() < 1e-6 * 1e7);
         assert!(s.yy.abs() < 1e-6 * 1e7 && s.zz.abs() < 1e-6);
+        let e = m.strain(&s);
+        assert!((e.xx - 1e-4).abs() < 1e-15 && (e.yy + 0.3e-4).abs() < 1e-15);
     }
 }

@@ -1,6 +1,7 @@
 //! Probes (particle averages recorded every step) and `[[expect]]` evaluation.
 
 use crate::dim::Dim;
+use crate::material::Elastic;
 use crate::particles::Particles;
 use crate::world::Energies;
 use serde::Serialize;
@@ -37,7 +38,7 @@ pub struct Probe {
 
 impl Probe {
     /// Current average.
-    pub fn sample<D: Dim>(&self, p: &Particles<D>) -> f64 {
+    pub fn sample<D: Dim>(&self, p: &Particles<D>, materials: &[Elastic]) -> f64 {
         let mut sum = 0.0;
         for &i in &self.particles {
             let i = i as usize;
@@ -46,7 +47,9 @@ impl Probe {
                 ProbeQty::Velocity => p.v[i][self.comp],
                 ProbeQty::Position => p.x[i][self.comp],
                 ProbeQty::Stress => p.stress[i].to_array()[self.comp],
-                ProbeQty::Strain => p.strain[i].to_array()[self.comp],
+                ProbeQty::Strain => materials[p.material[i] as usize]
+                    .strain(&p.stress[i])
+                    .to_array()[self.comp],
             };
         }
         sum / self.particles.len() as f64
@@ -93,7 +96,8 @@ pub enum Measure {
     /// Frequency of a probe's oscillation about its mean (Hz), from upward mean crossings.
     Frequency(usize),
     /// Distance between two probes over the difference of their arrival times (m/s); a
-    /// probe's arrival is when its change first reaches half its largest change.
+    /// probe's arrival is when its change first reaches half its plateau (the mean change
+    /// over the last tenth of the run), which is insensitive to the overshoot at a front.
     WaveSpeed(usize, usize),
     /// Largest |P(t) - P(0)| over the largest sum |m v| (relative).
     MomentumDrift,
@@ -230,19 +234,22 @@ pub fn frequency(t: &[f64], s: &[f64]) -> Option<f64> {
     Some((crossings.len() - 1) as f64 / (crossings[crossings.len() - 1] - crossings[0]))
 }
 
-/// First time the change from the initial value reaches half its largest magnitude.
+/// First time the change from the initial value reaches half of its plateau, the mean
+/// change over the last tenth of the samples (linear interpolation between samples).
 pub fn arrival(t: &[f64], s: &[f64]) -> Option<f64> {
     let s0 = *s.first()?;
-    let peak = s.iter().map(|v| (v - s0).abs()).fold(0.0, f64::max);
-    if peak == 0.0 {
+    let tail = &s[s.len() - (s.len() / 10).max(1)..];
+    let plateau = tail.iter().map(|v| v - s0).sum::<f64>() / tail.len() as f64;
+    if plateau == 0.0 || !plateau.is_finite() {
         return None;
     }
-    let half = 0.5 * peak;
-    let i = s.iter().position(|v| (v - s0).abs() >= half)?;
+    let half = 0.5 * plateau.abs();
+    let rise = |v: f64| (v - s0) * plateau.signum();
+    let i = s.iter().position(|&v| rise(v) >= half)?;
     if i == 0 {
         return Some(t[0]);
     }
-    let (a, b) = ((s[i - 1] - s0).abs(), (s[i] - s0).abs());
+    let (a, b) = (rise(s[i - 1]), rise(s[i]));
     Some(t[i - 1] + (half - a) / (b - a) * (t[i] - t[i - 1]))
 }
 
@@ -253,7 +260,10 @@ mod tests {
     #[test]
     fn frequency_of_a_sampled_sine() {
         let t: Vec<f64> = (0..2000).map(|i| i as f64 * 1e-4).collect();
-        let s: Vec<f64> = t.iter().map(|t| (2.0 * std::f64::consts::PI * 37.0 * t).sin() + 3.0).collect();
+        let s: Vec<f64> = t
+            .iter()
+            .map(|t| (2.0 * std::f64::consts::PI * 37.0 * t).sin() + 3.0)
+            .collect();
         let f = frequency(&t, &s).unwrap();
         assert!((f - 37.0).abs() < 0.05, "{f}");
     }
@@ -261,7 +271,10 @@ mod tests {
     #[test]
     fn arrival_of_a_ramp_front() {
         let t: Vec<f64> = (0..100).map(|i| i as f64).collect();
-        let s: Vec<f64> = t.iter().map(|&t: &f64| ((t - 40.0) / 10.0).clamp(0.0, 1.0)).collect();
+        let s: Vec<f64> = t
+            .iter()
+            .map(|&t: &f64| ((t - 40.0) / 10.0).clamp(0.0, 1.0))
+            .collect();
         assert!((arrival(&t, &s).unwrap() - 45.0).abs() < 1e-12);
     }
 }

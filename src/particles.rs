@@ -18,8 +18,6 @@ pub struct Particles<D: Dim> {
     pub volume: Vec<f64>,
     /// Cauchy stress (Pa), small strain.
     pub stress: Vec<Sym3>,
-    /// Small strain (tensor components).
-    pub strain: Vec<Sym3>,
     /// Velocity gradient dv_i/dx_j (1/s) from the most recent gather.
     pub grad_v: Vec<D::Mat>,
     /// Index into the world's material table.
@@ -37,7 +35,6 @@ impl<D: Dim> Default for Particles<D> {
             mass: Vec::new(),
             volume: Vec::new(),
             stress: Vec::new(),
-            strain: Vec::new(),
             grad_v: Vec::new(),
             material: Vec::new(),
             half: Vec::new(),
@@ -64,7 +61,6 @@ impl<D: Dim> Particles<D> {
         self.mass.push(mass);
         self.volume.push(volume);
         self.stress.push(Sym3::default());
-        self.strain.push(Sym3::default());
         self.grad_v.push(D::mat_zero());
         self.material.push(material);
     }
@@ -74,10 +70,28 @@ impl<D: Dim> Particles<D> {
         let vec = std::mem::size_of::<D::Vec>();
         let base = 3 * vec
             + 2 * std::mem::size_of::<f64>()
-            + 2 * std::mem::size_of::<Sym3>()
+            + std::mem::size_of::<Sym3>()
             + std::mem::size_of::<D::Mat>()
             + std::mem::size_of::<u16>();
         base + if self.half.is_empty() { 0 } else { vec }
+    }
+
+    /// Reorders every column so that new particle `k` is old particle `order[k]`.
+    pub fn permute(&mut self, order: &[u32]) {
+        fn apply<T: Copy>(col: &mut Vec<T>, order: &[u32]) {
+            if !col.is_empty() {
+                *col = order.iter().map(|&i| col[i as usize]).collect();
+            }
+        }
+        apply(&mut self.x, order);
+        apply(&mut self.v, order);
+        apply(&mut self.u, order);
+        apply(&mut self.mass, order);
+        apply(&mut self.volume, order);
+        apply(&mut self.stress, order);
+        apply(&mut self.grad_v, order);
+        apply(&mut self.material, order);
+        apply(&mut self.half, order);
     }
 
     /// Half-width of particle `p` (zero when the scene's shape function does not use one).

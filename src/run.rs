@@ -62,14 +62,25 @@ impl Writers {
             .with_context(|| format!("cannot create output folder {}", dir.display()))?;
         let create = |name: &str| -> anyhow::Result<_> {
             let path = dir.join(name);
-            Ok(std::io::BufWriter::new(std::fs::File::create(&path).with_context(
-                || format!("cannot create {}", path.display()),
-            )?))
+            Ok(std::io::BufWriter::new(
+                std::fs::File::create(&path)
+                    .with_context(|| format!("cannot create {}", path.display()))?,
+            ))
         };
         let mut energy = create("energy.csv")?;
-        writeln!(energy, "step,time,kinetic,strain,external_work,damping_work")?;
+        writeln!(
+            energy,
+            "step,time,kinetic,strain,external_work,damping_work"
+        )?;
         let mut probes = create("probes.csv")?;
-        writeln!(probes, "step,time{}", probe_names.iter().map(|n| format!(",{n}")).collect::<String>())?;
+        writeln!(
+            probes,
+            "step,time{}",
+            probe_names
+                .iter()
+                .map(|n| format!(",{n}"))
+                .collect::<String>()
+        )?;
         Ok(Writers {
             dir: dir.to_path_buf(),
             energy,
@@ -87,7 +98,12 @@ impl Writers {
     }
 }
 
-fn record<D: Dim>(world: &World<D>, centre: D::Vec, history: &mut History, w: &mut Option<Writers>) -> anyhow::Result<()> {
+fn record<D: Dim>(
+    world: &World<D>,
+    centre: D::Vec,
+    history: &mut History,
+    w: &mut Option<Writers>,
+) -> anyhow::Result<()> {
     let e = world.energies();
     let p = &world.particles;
     let scale = (0..p.len())
@@ -165,7 +181,7 @@ fn drive<D: Dim>(scene: Scene<D>, opts: &RunOptions) -> anyhow::Result<Outcome> 
     let sample = |world: &World<D>, h: &mut History| {
         h.time.push(world.time);
         for (k, p) in probes.iter().enumerate() {
-            h.probes[k].push(p.sample(&world.particles));
+            h.probes[k].push(p.sample(&world.particles, &world.materials));
         }
     };
     sample(&world, &mut history);
@@ -217,14 +233,22 @@ fn drive<D: Dim>(scene: Scene<D>, opts: &RunOptions) -> anyhow::Result<Outcome> 
     let wall = t0.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let results = if failure.is_none() {
-        expects.iter().map(|e| e.evaluate(&history, &probes)).collect()
+        expects
+            .iter()
+            .map(|e| e.evaluate(&history, &probes))
+            .collect()
     } else {
         Vec::new()
     };
     let summary = Summary {
         scenario: name.clone(),
         dimension: D::D,
-        status: if failure.is_some() { "unstable" } else { "completed" }.into(),
+        status: if failure.is_some() {
+            "unstable"
+        } else {
+            "completed"
+        }
+        .into(),
         message: failure.as_ref().map(|e| e.to_string()),
         particles: world.particles.len(),
         nodes: world.grid.geom.node_count(),
@@ -233,9 +257,14 @@ fn drive<D: Dim>(scene: Scene<D>, opts: &RunOptions) -> anyhow::Result<Outcome> 
         dt,
         dt_limit,
         wall_seconds: wall,
-        particle_steps_per_second: world.particles.len() as f64 * world.step as f64 / wall.max(1e-12),
+        particle_steps_per_second: world.particles.len() as f64 * world.step as f64
+            / wall.max(1e-12),
         threads: rayon::current_num_threads(),
-        schedule: schedule.systems.iter().map(|s| s.name().to_string()).collect(),
+        schedule: schedule
+            .systems
+            .iter()
+            .map(|s| s.name().to_string())
+            .collect(),
         system_seconds: schedule
             .seconds_by_name()
             .into_iter()
@@ -270,10 +299,22 @@ fn drive<D: Dim>(scene: Scene<D>, opts: &RunOptions) -> anyhow::Result<Outcome> 
 fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
     let pick = |f: &dyn Fn(&Row) -> f64| h.rows.iter().map(|r| (r.time, f(r))).collect();
     let series = [
-        Series { label: "kinetic", points: pick(&|r| r.energies.kinetic) },
-        Series { label: "strain", points: pick(&|r| r.energies.strain) },
-        Series { label: "external work", points: pick(&|r| r.energies.external_work) },
-        Series { label: "damping work", points: pick(&|r| r.energies.damping_work) },
+        Series {
+            label: "kinetic",
+            points: pick(&|r| r.energies.kinetic),
+        },
+        Series {
+            label: "strain",
+            points: pick(&|r| r.energies.strain),
+        },
+        Series {
+            label: "external work",
+            points: pick(&|r| r.energies.external_work),
+        },
+        Series {
+            label: "damping work",
+            points: pick(&|r| r.energies.damping_work),
+        },
         Series {
             label: "K + W - W_ext + W_damp",
             points: pick(&|r| {
@@ -282,5 +323,11 @@ fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
             }),
         },
     ];
-    plot::lines(path, &format!("{name}: energies"), "time (s)", "energy (J)", &series)
+    plot::lines(
+        path,
+        &format!("{name}: energies"),
+        "time (s)",
+        "energy (J)",
+        &series,
+    )
 }

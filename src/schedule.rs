@@ -9,19 +9,20 @@ use std::time::Instant;
 /// One scheduled system invocation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum System {
-    /// Bin particles into tiles.
+    /// Bin particles into tiles (skipped when the bins are still fresh).
     Bin,
     /// Scatter mass and momentum (and internal forces when `internal`) plus loads.
     P2g {
         /// Also scatter the internal force.
         internal: bool,
     },
-    /// Set prescribed components of the extrapolated momenta.
-    MomentumBc,
-    /// Constitutive update over `fraction` of the step.
+    /// Set prescribed components of the grid momenta.
+    MomentumBc {
+        /// Use end-of-step values (after a remap).
+        end: bool,
+    },
+    /// Constitutive update over `fraction` of the step, from grad v gathered off the grid.
     Stress {
-        /// Gather grad v from extrapolated momenta first.
-        gather: bool,
         /// Fraction of the step.
         fraction: f64,
     },
@@ -29,11 +30,10 @@ pub enum System {
     InternalForce,
     /// Integrate nodal momenta, apply damping, gravity and prescribed velocities.
     GridUpdate,
-    /// Gather to particles.
-    G2p {
-        /// Also gather grad v from the new grid velocities.
-        gradient: bool,
-    },
+    /// Gather to particles: velocities, positions, displacements.
+    G2p,
+    /// Re-scatter updated particle momenta for the final stress update.
+    Remap,
 }
 
 impl System {
@@ -42,11 +42,12 @@ impl System {
         match self {
             System::Bin => "bin",
             System::P2g { .. } => "p2g",
-            System::MomentumBc => "grid_bc",
+            System::MomentumBc { .. } => "grid_bc",
             System::Stress { .. } => "stress",
             System::InternalForce => "internal_force",
             System::GridUpdate => "grid_update",
-            System::G2p { .. } => "g2p",
+            System::G2p => "g2p",
+            System::Remap => "remap",
         }
     }
 }
@@ -61,50 +62,38 @@ pub struct Schedule {
 }
 
 impl Schedule {
-    /// The systems this scene needs, in order: USF, USL and USAVG differ in where the
-    /// stress update sits; prescribed velocities add `grid_bc`.
+    /// The systems this scene needs, in order. USF updates stress before the internal
+    /// forces; USL after the particles move (on remapped momenta); USAVG does half of each.
+    /// Prescribed velocities add `grid_bc` after each scatter of momenta.
     pub fn for_world<D: Dim>(world: &World<D>) -> Self {
         use System::*;
         let bc = !world.bcs.is_empty();
-        let mut systems = vec![Bin];
-        let first = |s: &mut Vec<System>, fraction| {
-            s.push(P2g { internal: false });
+        let update = world.settings.update;
+        let mut s = vec![Bin];
+        s.push(P2g {
+            internal: update == Update::Usl,
+        });
+        if bc {
+            s.push(MomentumBc { end: false });
+        }
+        if update != Update::Usl {
+            let fraction = if update == Update::Usf { 1.0 } else { 0.5 };
+            s.extend([Stress { fraction }, InternalForce]);
+        }
+        s.extend([GridUpdate, G2p]);
+        if update != Update::Usf {
+            s.extend([Bin, Remap]);
             if bc {
-                s.push(MomentumBc);
+                s.push(MomentumBc { end: true });
             }
-            s.push(Stress {
-                gather: true,
-                fraction,
-            });
-            s.push(InternalForce);
-        };
-        match world.settings.update {
-            Update::Usf => first(&mut systems, 1.0),
-            Update::Usavg => first(&mut systems, 0.5),
-            Update::Usl => {
-                systems.push(P2g { internal: true });
-                if bc {
-                    systems.push(MomentumBc);
-                }
-            }
+            let fraction = if update == Update::Usl { 1.0 } else { 0.5 };
+            s.push(Stress { fraction });
         }
-        systems.push(GridUpdate);
-        match world.settings.update {
-            Update::Usf => systems.push(G2p { gradient: false }),
-            Update::Usl | Update::Usavg => {
-                systems.push(G2p { gradient: true });
-                systems.push(Stress {
-                    gather: false,
-                    fraction: if world.settings.update == Update::Usl {
-                        1.0
-                    } else {
-                        0.5
-                    },
-                });
-            }
+        let seconds = vec![0.0; s.len()];
+        Schedule {
+            systems: s,
+            seconds,
         }
-        let seconds = vec![0.0; systems.len()];
-        Schedule { systems, seconds }
     }
 
     /// Advances the world one time step.
@@ -114,11 +103,12 @@ impl Schedule {
             match *sys {
                 System::Bin => bin::run(world)?,
                 System::P2g { internal } => p2g::run(world, internal),
-                System::MomentumBc => grid_update::momentum_bc(world),
-                System::Stress { gather, fraction } => stress::run(world, gather, fraction),
+                System::MomentumBc { end } => grid_update::momentum_bc(world, end),
+                System::Stress { fraction } => stress::run(world, fraction),
                 System::InternalForce => p2g::internal_force(world),
                 System::GridUpdate => grid_update::run(world),
-                System::G2p { gradient } => g2p::run(world, gradient),
+                System::G2p => g2p::run(world),
+                System::Remap => p2g::remap(world),
             }
             self.seconds[k] += t0.elapsed().as_secs_f64();
         }

@@ -21,9 +21,18 @@ pub enum ShapeKind {
 }
 
 impl ShapeKind {
-    /// How far the support reaches beyond the particle position, in units of the cell size
-    /// (`l` is the particle half-width over the cell size, used by uGIMP).
-    pub fn reach(self, l: f64) -> f64 {
+    /// Nodes per axis in a stencil.
+    pub fn nodes(self) -> usize {
+        match self {
+            ShapeKind::Linear => 2,
+            ShapeKind::Ugimp | ShapeKind::Bspline => 3,
+        }
+    }
+
+    /// Offset (cell units) from the particle position to the start of the interval whose
+    /// floor is the stencil's first node (`l` is the particle half-width in cell units).
+    #[inline(always)]
+    pub fn offset(self, l: f64) -> f64 {
         match self {
             ShapeKind::Linear => 0.0,
             ShapeKind::Ugimp => l,
@@ -31,36 +40,42 @@ impl ShapeKind {
         }
     }
 
-    /// 1D weights on one axis: first node index, weights and d/dx for up to three nodes.
-    /// `xi` is the position in cell units from the grid origin, `l` the half-width in cell
-    /// units, `inv_h` the inverse cell size. Callers ensure the stencil lies in the grid.
+    /// Whether the stencil of a particle at `xi` (cell units) lies within nodes `0..=cells`.
     #[inline(always)]
-    pub fn axis(self, xi: f64, l: f64, inv_h: f64) -> (usize, usize, [f64; 3], [f64; 3]) {
+    pub fn fits(self, xi: f64, l: f64, cells: usize) -> bool {
+        let lo = xi - self.offset(l);
+        lo >= 0.0 && lo < (cells + 2 - self.nodes()) as f64
+    }
+
+    /// 1D weights on one axis: first node index, weights and d/dx for the stencil's nodes.
+    /// `xi` is the position in cell units from the grid origin, `l` the half-width in cell
+    /// units, `inv_h` the inverse cell size. Callers ensure the stencil [`fits`](Self::fits),
+    /// so every floor below is of a non-negative number and truncation computes it cheaply.
+    #[inline(always)]
+    pub fn axis(self, xi: f64, l: f64, inv_h: f64) -> (usize, [f64; 3], [f64; 3]) {
         match self {
             ShapeKind::Linear => {
-                let base = xi.floor();
-                let f = xi - base;
-                (base as usize, 2, [1.0 - f, f, 0.0], [-inv_h, inv_h, 0.0])
+                let base = xi as usize;
+                let f = xi - base as f64;
+                (base, [1.0 - f, f, 0.0], [-inv_h, inv_h, 0.0])
             }
             ShapeKind::Ugimp => {
-                let base = (xi - l).floor();
+                let base = (xi - l) as usize;
                 let mut w = [0.0; 3];
                 let mut dw = [0.0; 3];
                 for a in 0..3 {
-                    let r = xi - (base + a as f64);
-                    let (s, g) = gimp_1d(r, l);
+                    let (s, g) = gimp_1d(xi - (base + a) as f64, l);
                     w[a] = s;
                     dw[a] = g * inv_h;
                 }
-                (base as usize, 3, w, dw)
+                (base, w, dw)
             }
             ShapeKind::Bspline => {
-                let base = (xi - 0.5).floor();
-                let f = xi - base;
+                let base = (xi - 0.5) as usize;
+                let f = xi - base as f64;
                 let (a, b, c) = (1.5 - f, f - 1.0, f - 0.5);
                 (
-                    base as usize,
-                    3,
+                    base,
                     [0.5 * a * a, 0.75 - b * b, 0.5 * c * c],
                     [-a * inv_h, -2.0 * b * inv_h, c * inv_h],
                 )
@@ -70,51 +85,48 @@ impl ShapeKind {
 }
 
 /// uGIMP weight and its derivative (per cell unit) at signed distance `r` (cell units) from
-/// a node, particle half-width `l` (Bardenhagen & Kober 2004, Eq. 39 in 1D).
+/// a node, particle half-width `l` (Bardenhagen & Kober 2004, Eq. 39 in 1D): the tent
+/// function averaged over the particle, S = (H(r + l) - H(r - l)) / (2 l) with H the tent's
+/// antiderivative. Written with clamps instead of branches, which mispredict here.
 #[inline(always)]
 fn gimp_1d(r: f64, l: f64) -> (f64, f64) {
-    let d = r.abs();
-    let sign = r.signum();
-    if d < l {
-        (1.0 - (r * r + l * l) / (2.0 * l), -r / l)
-    } else if d < 1.0 - l {
-        (1.0 - d, -sign)
-    } else if d < 1.0 + l {
-        let e = 1.0 + l - d;
-        (e * e / (4.0 * l), -sign * e / (2.0 * l))
-    } else {
-        (0.0, 0.0)
-    }
+    let anti = |x: f64| {
+        let c = x.clamp(-1.0, 1.0);
+        0.5 + c - 0.5 * c * c.abs()
+    };
+    let tent = |x: f64| (1.0 - x.abs()).max(0.0);
+    let inv = 0.5 / l;
+    (
+        (anti(r + l) - anti(r - l)) * inv,
+        (tent(r + l) - tent(r - l)) * inv,
+    )
 }
 
-/// Shape-function values and gradients of one particle on its stencil nodes.
+/// Shape-function values and gradients of one particle on its `N` nodes per axis.
 #[derive(Clone, Copy, Debug)]
-pub struct Stencil {
+pub struct Stencil<const N: usize> {
     /// First node index per axis.
     pub base: [usize; 3],
-    /// Nodes per axis (1 on the unused third axis in 2D).
-    pub n: [usize; 3],
-    /// 1D weights per axis.
+    /// 1D weights per axis (the unused third axis in 2D has weight 1 on its only node).
     pub w: [[f64; 3]; 3],
     /// 1D derivatives per axis (1/m).
     pub dw: [[f64; 3]; 3],
 }
 
-impl Stencil {
+impl<const N: usize> Stencil<N> {
     /// Evaluates the stencil at `x` with particle half-width `half` (m, used by uGIMP only).
     #[inline(always)]
     pub fn new<D: Dim>(shape: ShapeKind, geom: &GridGeom<D>, x: D::Vec, half: D::Vec) -> Self {
+        debug_assert_eq!(shape.nodes(), N);
         let mut st = Stencil {
             base: [0; 3],
-            n: [1; 3],
             w: [[1.0, 0.0, 0.0]; 3],
             dw: [[0.0; 3]; 3],
         };
         for a in 0..D::D {
             let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
-            let (b, n, w, dw) = shape.axis(xi, half[a] * geom.inv_h[a], geom.inv_h[a]);
+            let (b, w, dw) = shape.axis(xi, half[a] * geom.inv_h[a], geom.inv_h[a]);
             st.base[a] = b;
-            st.n[a] = n;
             st.w[a] = w;
             st.dw[a] = dw;
         }
@@ -124,13 +136,13 @@ impl Stencil {
     /// Calls `f(node, weight, gradient)` for every node of the stencil, in a fixed order.
     #[inline(always)]
     pub fn for_each<D: Dim>(&self, stride: &[usize; 3], mut f: impl FnMut(usize, f64, D::Vec)) {
-        for k in 0..self.n[2] {
-            for j in 0..self.n[1] {
-                let row = self.base[0]
-                    + stride[1] * (self.base[1] + j)
-                    + stride[2] * (self.base[2] + k);
+        let nk = if D::D == 3 { N } else { 1 };
+        for k in 0..nk {
+            for j in 0..N {
+                let row =
+                    self.base[0] + stride[1] * (self.base[1] + j) + stride[2] * (self.base[2] + k);
                 let wjk = self.w[1][j] * self.w[2][k];
-                for i in 0..self.n[0] {
+                for i in 0..N {
                     f(
                         row + i,
                         self.w[0][i] * wjk,
@@ -142,9 +154,53 @@ impl Stencil {
     }
 }
 
+/// Calls `$body` with the const `$n` bound to the shape's nodes per axis (2 or 3), so
+/// stencil loops are unrolled for each shape function.
+#[macro_export]
+macro_rules! with_nodes {
+    ($shape:expr, $n:ident => $body:expr) => {
+        match $shape.nodes() {
+            2 => {
+                const $n: usize = 2;
+                $body
+            }
+            _ => {
+                const $n: usize = 3;
+                $body
+            }
+        }
+    };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The clamped uGIMP form matches the piecewise definition of Bardenhagen & Kober (2004).
+    #[test]
+    fn gimp_matches_piecewise_form() {
+        let l = 0.25;
+        for s in 0..400 {
+            let r = -1.5 + s as f64 * 0.0075;
+            let d = r.abs();
+            let (want, dwant) = if d < l {
+                (1.0 - (r * r + l * l) / (2.0 * l), -r / l)
+            } else if d < 1.0 - l {
+                (1.0 - d, -r.signum())
+            } else if d < 1.0 + l {
+                let e = 1.0 + l - d;
+                (e * e / (4.0 * l), -r.signum() * e / (2.0 * l))
+            } else {
+                (0.0, 0.0)
+            };
+            let (got, dgot) = gimp_1d(r, l);
+            assert!((got - want).abs() < 1e-14, "S at r={r}: {got} vs {want}");
+            assert!(
+                (dgot - dwant).abs() < 1e-13,
+                "dS at r={r}: {dgot} vs {dwant}"
+            );
+        }
+    }
 
     /// Partition of unity, zero gradient sum and linear completeness hold for every kind.
     #[test]
@@ -152,7 +208,8 @@ mod tests {
         for shape in [ShapeKind::Linear, ShapeKind::Ugimp, ShapeKind::Bspline] {
             for s in 0..200 {
                 let xi = 3.0 + s as f64 * 0.0137;
-                let (base, n, w, dw) = shape.axis(xi, 0.25, 2.0);
+                let (base, w, dw) = shape.axis(xi, 0.25, 2.0);
+                let n = shape.nodes();
                 let sum: f64 = w[..n].iter().sum();
                 let dsum: f64 = dw[..n].iter().sum();
                 let first: f64 = (0..n).map(|a| w[a] * (base + a) as f64).sum();

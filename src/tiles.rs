@@ -26,13 +26,10 @@ pub struct Tiles {
     pub colours: Vec<Vec<u32>>,
     /// Scratch: tile of each particle.
     pub tile_of: Vec<u32>,
-}
-
-/// Linear index of the tile holding `cell`, for tiles of `size` cells and `counts` tiles.
-#[inline(always)]
-pub fn tile_index(size: usize, counts: [usize; 3], cell: [usize; 3]) -> u32 {
-    let t = [cell[0] / size, cell[1] / size, cell[2] / size];
-    (t[0] + counts[0] * (t[1] + counts[1] * t[2])) as u32
+    /// Whether the bins match the current particle positions (cleared when particles move).
+    pub fresh: bool,
+    /// Per axis, each cell's contribution to its tile's linear index (avoids divisions).
+    pub cell_part: [Vec<u32>; 3],
 }
 
 impl Tiles {
@@ -44,7 +41,15 @@ impl Tiles {
             counts[a] = cells[a].div_ceil(size);
         }
         let n = counts.iter().product::<usize>();
+        let stride = [1, counts[0], counts[0] * counts[1]];
+        let cell_part = [0, 1, 2].map(|a| {
+            (0..cells[a].max(1))
+                .map(|c| ((c / size) * stride[a]) as u32)
+                .collect()
+        });
         Tiles {
+            fresh: false,
+            cell_part,
             size,
             counts,
             start: vec![0; n + 1],
@@ -52,6 +57,12 @@ impl Tiles {
             colours: vec![Vec::new(); D::COLOURS],
             tile_of: Vec::new(),
         }
+    }
+
+    /// Linear index of the tile holding `cell` (which must be inside the grid).
+    #[inline(always)]
+    pub fn tile_of_cell(&self, cell: [usize; 3]) -> u32 {
+        self.cell_part[0][cell[0]] + self.cell_part[1][cell[1]] + self.cell_part[2][cell[2]]
     }
 
     /// Number of tiles.
@@ -112,5 +123,6 @@ impl Tiles {
                 self.colours[c].push(t as u32);
             }
         }
+        self.fresh = true;
     }
 }

@@ -97,20 +97,19 @@ impl<D: Dim> World<D> {
     /// Kinetic and strain energy now, with the accumulated work.
     pub fn energies(&self) -> Energies {
         let p = &self.particles;
+        let mats = &self.materials;
         let parts: Vec<(f64, f64)> = (0..p.len().div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
                 let (mut k, mut w) = (0.0, 0.0);
                 for i in c * CHUNK..((c + 1) * CHUNK).min(p.len()) {
                     k += 0.5 * p.mass[i] * D::dot(p.v[i], p.v[i]);
-                    w += p.volume[i] * Elastic::energy_density(&p.stress[i], &p.strain[i]);
+                    w += p.volume[i] * mats[p.material[i] as usize].energy_density(&p.stress[i]);
                 }
                 (k, w)
             })
             .collect();
-        let (kinetic, strain) = parts
-            .iter()
-            .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+        let (kinetic, strain) = parts.iter().fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
         Energies {
             kinetic,
             strain,

@@ -3,18 +3,21 @@
 
 use crate::dim::Dim;
 use crate::error::Unstable;
-use crate::tiles::tile_index;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
-/// Bins every particle by the tile of the cell that contains it.
+/// Bins every particle by the tile of the cell that contains it (nothing to do when the
+/// particles have not moved since the last binning).
 pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
+    if world.tiles.fresh {
+        return Ok(());
+    }
     let p = &world.particles;
     let geom = &world.grid.geom;
     let tiles = &mut world.tiles;
-    let l_reach = world.settings.shape;
-    let (size, counts) = (tiles.size, tiles.counts);
+    let shape = world.settings.shape;
     let mut tile_of = std::mem::take(&mut tiles.tile_of);
+    let tiles_ref = &*tiles;
     tile_of.resize(p.len(), 0);
     let bad = tile_of
         .par_chunks_mut(CHUNK)
@@ -23,18 +26,14 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
             for (k, t) in out.iter_mut().enumerate() {
                 let i = c * CHUNK + k;
                 let x = p.x[i];
-                let mut reach = p.half_of(i);
-                for a in 0..D::D {
-                    reach[a] = l_reach.reach(reach[a] * geom.inv_h[a]) * geom.h[a];
-                }
-                if !geom.holds(x, reach) {
+                if !geom.fits(shape, x, p.half_of(i)) {
                     return Some(i);
                 }
                 let mut cell = [0; 3];
                 for a in 0..D::D {
                     cell[a] = ((x[a] - geom.origin[a]) * geom.inv_h[a]) as usize;
                 }
-                *t = tile_index(size, counts, cell);
+                *t = tiles_ref.tile_of_cell(cell);
             }
             None
         })

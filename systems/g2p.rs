@@ -1,60 +1,47 @@
-//! `g2p`: grid-to-particle gather. FLIP velocity update, position and displacement update,
-//! and (when the stress is updated last) the velocity gradient from the new grid velocities.
+//! `g2p`: grid-to-particle gather. FLIP velocity update, position and displacement update.
 
 use crate::dim::Dim;
 use crate::particles::Particles;
 use crate::shape::Stencil;
+use crate::with_nodes;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Updates particle velocities (v += dt sum S a_i), positions and displacements
-/// (x += dt sum S v_i'), and, when `gradient`, grad_v = sum v_i' ⊗ grad S.
-pub fn run<D: Dim>(world: &mut World<D>, gradient: bool) {
+/// (x += dt sum S v_i'); the particles' bins are stale afterwards.
+pub fn run<D: Dim>(world: &mut World<D>) {
     let dt = world.settings.dt;
     let shape = world.settings.shape;
     let grid = &world.grid;
     let geom = &grid.geom;
-    let Particles {
-        x,
-        v,
-        u,
-        grad_v,
-        half,
-        ..
-    } = &mut world.particles;
+    let Particles { x, v, u, half, .. } = &mut world.particles;
     let half = &*half;
     (
         x.par_chunks_mut(CHUNK),
         v.par_chunks_mut(CHUNK),
         u.par_chunks_mut(CHUNK),
-        grad_v.par_chunks_mut(CHUNK),
     )
         .into_par_iter()
         .enumerate()
-        .for_each(|(c, (x, v, u, gv))| {
-            for k in 0..x.len() {
+        .for_each(|(c, (x, v, u))| {
+            with_nodes!(shape, N => for k in 0..x.len() {
                 let hw = if half.is_empty() {
                     D::zero()
                 } else {
                     half[c * CHUNK + k]
                 };
-                let st = Stencil::new::<D>(shape, geom, x[k], hw);
-                let (mut dv, mut vn, mut l) = (D::zero(), D::zero(), D::mat_zero());
-                st.for_each::<D>(&geom.stride, |n, w, g| {
+                let st = Stencil::<N>::new::<D>(shape, geom, x[k], hw);
+                let (mut dv, mut vn) = (D::zero(), D::zero());
+                st.for_each::<D>(&geom.stride, |n, w, _| {
                     dv += grid.accel[n] * w;
                     vn += grid.velocity[n] * w;
-                    if gradient {
-                        l = l + D::outer(grid.velocity[n], g);
-                    }
                 });
                 v[k] += dv * dt;
                 x[k] += vn * dt;
                 u[k] += vn * dt;
-                if gradient {
-                    gv[k] = l;
-                }
-            }
+            })
         });
+    world.tiles.fresh = false;
     load_work_end(world);
 }
 

@@ -10,9 +10,9 @@ use rayon::prelude::*;
 const NODE_CHUNK: usize = 4096;
 
 /// Overwrites prescribed components of the extrapolated momenta so that p/m equals the
-/// prescribed velocity at the start of the step (needed before a USF stress update).
-pub fn momentum_bc<D: Dim>(world: &mut World<D>) {
-    let t = world.time;
+/// prescribed velocity at the start of the step, or at its end when `end` (after a remap).
+pub fn momentum_bc<D: Dim>(world: &mut World<D>, end: bool) {
+    let t = world.time + if end { world.settings.dt } else { 0.0 };
     let g = &mut world.grid;
     for bc in &world.bcs {
         for &n in &bc.nodes {
@@ -40,7 +40,10 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         ..
     } = &mut world.grid;
     let (mass, momentum, force) = (&*mass, &*momentum, &*force);
-    let sums: Vec<(f64, f64)> = (velocity.par_chunks_mut(NODE_CHUNK), accel.par_chunks_mut(NODE_CHUNK))
+    let sums: Vec<(f64, f64)> = (
+        velocity.par_chunks_mut(NODE_CHUNK),
+        accel.par_chunks_mut(NODE_CHUNK),
+    )
         .into_par_iter()
         .enumerate()
         .map(|(c, (vel, acc))| {

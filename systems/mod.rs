@@ -1,7 +1,7 @@
 //! The systems, one file each, in pipeline order. Each is a plain function over the World.
 
 pub mod bin;
-pub mod p2g;
-pub mod grid_update;
 pub mod g2p;
+pub mod grid_update;
+pub mod p2g;
 pub mod stress;

@@ -4,6 +4,7 @@
 use crate::dim::Dim;
 use crate::grid::Grid;
 use crate::shape::Stencil;
+use crate::with_nodes;
 use crate::world::World;
 use rayon::prelude::*;
 use std::marker::PhantomData;
@@ -71,9 +72,9 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
     let shape = world.settings.shape;
     let geom = &*geom;
     world.tiles.for_each_coloured(|t| {
-        for &i in world.tiles.particles(t) {
+        with_nodes!(shape, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
-            let st = Stencil::new::<D>(shape, geom, p.x[i], p.half_of(i));
+            let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
             let (m, mv, vol, s) = (p.mass[i], p.v[i] * p.mass[i], p.volume[i], p.stress[i]);
             st.for_each::<D>(&geom.stride, |n, w, g| {
                 let f = if internal {
@@ -85,9 +86,40 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
                 // each tile is handled by one thread.
                 unsafe { writer.add(n, m * w, mv * w, f) };
             });
-        }
+        })
     });
     scatter_loads(world);
+}
+
+/// Re-scatters mass and the updated particle momenta at the new positions, so that the
+/// final stress update reads grid velocities that are mass-weighted averages of particle
+/// velocities (the modified USL of Sulsky, Zhou & Schreyer 1995). Without it, nodes with a
+/// tiny share of mass get huge velocities and linear shape functions go unstable.
+pub fn remap<D: Dim>(world: &mut World<D>) {
+    let Grid {
+        geom,
+        mass,
+        momentum,
+        force,
+        ..
+    } = &mut world.grid;
+    mass.par_iter_mut().for_each(|m| *m = 0.0);
+    momentum.par_iter_mut().for_each(|m| *m = D::zero());
+    let writer = NodeWriter::<D>::new(mass, momentum, force);
+    let p = &world.particles;
+    let shape = world.settings.shape;
+    let geom = &*geom;
+    world.tiles.for_each_coloured(|t| {
+        with_nodes!(shape, N => for &i in world.tiles.particles(t) {
+            let i = i as usize;
+            let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
+            let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
+            st.for_each::<D>(&geom.stride, |n, w, _| {
+                // SAFETY: as in `run`: disjoint nodes per colour class, one thread per tile.
+                unsafe { writer.add(n, m * w, mv * w, D::zero()) };
+            });
+        })
+    });
 }
 
 /// Scatters the internal force -V sigma . grad S alone (USF and USAVG, after the first
@@ -105,15 +137,15 @@ pub fn internal_force<D: Dim>(world: &mut World<D>) {
     let shape = world.settings.shape;
     let geom = &*geom;
     world.tiles.for_each_coloured(|t| {
-        for &i in world.tiles.particles(t) {
+        with_nodes!(shape, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
-            let st = Stencil::new::<D>(shape, geom, p.x[i], p.half_of(i));
+            let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
             let (vol, s) = (p.volume[i], p.stress[i]);
             st.for_each::<D>(&geom.stride, |n, _, g| {
                 // SAFETY: as in `run`: disjoint nodes per colour class, one thread per tile.
                 unsafe { writer.add(n, 0.0, D::zero(), -D::stress_dot(&s, g) * vol) };
             });
-        }
+        })
     });
 }
 
@@ -123,13 +155,16 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
     let (t, dt) = (world.time, world.settings.dt);
     let p = &world.particles;
     let geom = &world.grid.geom;
+    let shape = world.settings.shape;
     let mut work = 0.0;
     for load in &world.loads {
         let f = load.force * load.time.at(t);
         for &i in &load.particles {
             let i = i as usize;
-            let st = Stencil::new::<D>(world.settings.shape, geom, p.x[i], p.half_of(i));
-            st.for_each::<D>(&geom.stride, |n, w, _| world.grid.force[n] += f * w);
+            with_nodes!(shape, N => {
+                let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
+                st.for_each::<D>(&geom.stride, |n, w, _| world.grid.force[n] += f * w);
+            });
             work += 0.5 * dt * D::dot(f, p.v[i]);
         }
     }

@@ -71,7 +71,10 @@ pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result
     ];
     let mut offset = 0usize;
     let mut tag = |a: &Array| {
-        let s = format!(r#"<DataArray {} format="appended" offset="{offset}"/>"#, a.attrs);
+        let s = format!(
+            r#"<DataArray {} format="appended" offset="{offset}"/>"#,
+            a.attrs
+        );
         offset += 8 + a.bytes.len();
         s
     };

@@ -57,7 +57,12 @@ fn vec3<D: Dim>(src: &Source, key: &str, v: &[f64]) -> R<[f64; 3]> {
     if v.len() != D::D {
         return Err(src.error(
             key,
-            format!("expected {} components in {}D, found {}", D::D, D::D, v.len()),
+            format!(
+                "expected {} components in {}D, found {}",
+                D::D,
+                D::D,
+                v.len()
+            ),
         ));
     }
     if v.iter().any(|c| !c.is_finite()) {
@@ -215,9 +220,32 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     let mut used = vec![false; materials.len()];
     for (b, body) in sc.bodies.iter().enumerate() {
         add_body::<D>(
-            src, b, body, &geom, &materials, &mut used, shape, thickness, &mut particles,
+            src,
+            b,
+            body,
+            &geom,
+            &materials,
+            &mut used,
+            shape,
+            thickness,
+            &mut particles,
         )?;
     }
+
+    // Store particles tile by tile, so the tile-ordered scatter streams through memory.
+    let tiles = Tiles::new::<D>(tile, cells);
+    let mut keyed: Vec<(u32, u32)> = (0..particles.len())
+        .map(|i| {
+            let x = particles.x[i];
+            let mut cell = [0; 3];
+            for a in 0..D::D {
+                cell[a] = ((x[a] - geom.origin[a]) * geom.inv_h[a]) as usize;
+            }
+            (tiles.tile_of_cell(cell), i as u32)
+        })
+        .collect();
+    keyed.sort_unstable();
+    particles.permute(&keyed.iter().map(|k| k.1).collect::<Vec<_>>());
 
     // Time step.
     let c_max = materials
@@ -256,9 +284,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 let (lo, hi) = bounds::<D>(src, &key("region"), r)?;
                 let tol = h.map(|x| 1e-6 * x);
                 let nodes: Vec<u32> = (0..geom.node_count())
-                    .filter(|&n| {
-                        inside(D::to_xyz(geom.node_position(n)), lo, hi, D::D, tol)
-                    })
+                    .filter(|&n| inside(D::to_xyz(geom.node_position(n)), lo, hi, D::D, tol))
                     .map(|n| n as u32)
                     .collect();
                 (nodes, None)
@@ -363,7 +389,10 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 .iter()
                 .position(|c| *c == p.component)
                 .ok_or_else(|| {
-                    src.error(&key("component"), "tensor component must be xx, yy, zz, yz, xz or xy")
+                    src.error(
+                        &key("component"),
+                        "tensor component must be xx, yy, zz, yz, xz or xy",
+                    )
                 })?
         } else {
             axis_index::<D>(src, &key("component"), &p.component)?
@@ -391,9 +420,10 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let key = |k: &str| format!("expect[{i}].{k}");
         let mut ids = Vec::new();
         for name in &e.probes {
-            let id = probes.iter().position(|p| &p.name == name).ok_or_else(|| {
-                src.error(&key("probes"), format!("no probe named `{name}`"))
-            })?;
+            let id = probes
+                .iter()
+                .position(|p| &p.name == name)
+                .ok_or_else(|| src.error(&key("probes"), format!("no probe named `{name}`")))?;
             ids.push(id);
         }
         let need = match e.quantity.as_str() {
@@ -413,7 +443,11 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         if ids.len() != need {
             return Err(src.error(
                 &key("probes"),
-                format!("`{}` takes {need} probe name(s), got {}", e.quantity, ids.len()),
+                format!(
+                    "`{}` takes {need} probe name(s), got {}",
+                    e.quantity,
+                    ids.len()
+                ),
             ));
         }
         let measure = match e.quantity.as_str() {
@@ -429,7 +463,12 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         if !e.reference.is_finite() {
             return Err(src.error(&key("reference"), "must be a finite number"));
         }
-        positive(src, &key("tolerance"), e.tolerance, "relative, or absolute for reference 0")?;
+        positive(
+            src,
+            &key("tolerance"),
+            e.tolerance,
+            "relative, or absolute for reference 0",
+        )?;
         expects.push(Expect {
             quantity: e.quantity.clone(),
             probes: e.probes.clone(),
@@ -451,7 +490,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     };
     let min_mass = particles.mass.iter().copied().fold(f64::INFINITY, f64::min);
     let world = World {
-        tiles: Tiles::new::<D>(tile, cells),
+        tiles,
         grid: Grid::new(geom),
         particles,
         materials,
@@ -555,7 +594,10 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
         (Some(z), 3) if z.len() == 2 && z[1] > z[0] => Some([z[0], z[1]]),
         (None, 2) => None,
         (None, _) => {
-            return Err(src.error(&key("polygon"), "a 3D polygon needs its extrusion z = [z0, z1]"));
+            return Err(src.error(
+                &key("polygon"),
+                "a 3D polygon needs its extrusion z = [z0, z1]",
+            ));
         }
         (Some(_), 2) => return Err(src.error(&key("polygon.z"), "z applies to 3D scenes only")),
         (Some(_), _) => return Err(src.error(&key("polygon.z"), "z must be [z0, z1] with z1 > z0")),
@@ -588,7 +630,10 @@ fn add_body<D: Dim>(
         })?;
     used[mat] = true;
     if !(1..=16).contains(&body.ppc) {
-        return Err(src.error(&key("ppc"), "particles per cell per direction must be 1..=16"));
+        return Err(src.error(
+            &key("ppc"),
+            "particles per cell per direction must be 1..=16",
+        ));
     }
     let g = geometry::<D>(src, b, body)?;
     let (lo, hi) = g.bounds();
@@ -599,7 +644,10 @@ fn add_body<D: Dim>(
         estimate *= ((hi[a] - lo[a]) / h[a] + 2.0) * body.ppc as f64;
     }
     if estimate > MAX_PARTICLES {
-        return Err(src.error(&format!("body[{b}]"), "body would need more than 2e8 particles"));
+        return Err(src.error(
+            &format!("body[{b}]"),
+            "body would need more than 2e8 particles",
+        ));
     }
     let pts = fill(&g, D::D, origin, h, geom.cells, body.ppc);
     if pts.is_empty() {
@@ -634,10 +682,9 @@ fn add_body<D: Dim>(
         Some(c) => vec3::<D>(src, &key("spin_center"), c)?,
         None => [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a])),
     };
-    let reach = to_vec::<D>([0, 1, 2].map(|a| shape.reach(half[a] / h[a]) * h[a]));
     let rho = materials[mat].density;
     for x in pts {
-        if !geom.holds(to_vec::<D>(x), reach) {
+        if !geom.fits(shape, to_vec::<D>(x), to_vec::<D>(half)) {
             return Err(src.error(
                 &format!("body[{b}]"),
                 format!(
@@ -654,7 +701,13 @@ fn add_body<D: Dim>(
             omega[0] * r[1] - omega[1] * r[0],
         ];
         let v = [0, 1, 2].map(|a| v0[a] + spin[a]);
-        particles.push(to_vec::<D>(x), to_vec::<D>(v), rho * volume, volume, mat as u16);
+        particles.push(
+            to_vec::<D>(x),
+            to_vec::<D>(v),
+            rho * volume,
+            volume,
+            mat as u16,
+        );
         if shape == ShapeKind::Ugimp {
             particles.half.push(to_vec::<D>(half));
         }

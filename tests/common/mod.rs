@@ -1,0 +1,173 @@
+//! Helpers shared by the integration tests: scenario text for bars, running to a history.
+#![allow(dead_code)]
+
+use fissure::dim::Dim;
+use fissure::measure::History;
+use fissure::run::{Outcome, RunOptions, run};
+use fissure::scenario::{Source, build};
+use fissure::schedule::Schedule;
+use fissure::world::World;
+
+/// Parses scenario text (panics with the located error if it does not parse).
+pub fn source(text: &str) -> Source {
+    Source::parse("test.toml", text, &[]).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Runs scenario text without writing files.
+pub fn run_text(text: &str) -> Outcome {
+    run(&source(text), &RunOptions::default()).unwrap_or_else(|e| panic!("{e:#}"))
+}
+
+/// Runs scenario text and returns its history.
+pub fn history(text: &str) -> History {
+    run_text(text).history
+}
+
+/// Builds the scene and steps it to the end on `threads` threads, returning the world.
+pub fn final_world<D: Dim>(text: &str, threads: usize) -> World<D> {
+    let src = source(text);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let scene = build::<D>(&src).unwrap_or_else(|e| panic!("{e}"));
+        let mut world = scene.world;
+        let mut schedule = Schedule::for_world(&world);
+        let steps = (scene.duration / world.settings.dt).ceil() as u64;
+        while world.step < steps {
+            schedule.step(&mut world).unwrap_or_else(|e| panic!("{e}"));
+        }
+        world
+    })
+}
+
+/// A D-dimensional list "[a, b(, c)]" with `first` on x and `rest` on the other axes.
+pub fn v(dim: usize, first: f64, rest: f64) -> String {
+    let mut parts = vec![format!("{first:e}")];
+    parts.extend((1..dim).map(|_| format!("{rest:e}")));
+    format!("[{}]", parts.join(", "))
+}
+
+/// A bar along x: length `len`, square section `w`, cell `h`, margins of two cells.
+pub struct Bar {
+    pub dim: usize,
+    pub len: f64,
+    pub w: f64,
+    pub h: f64,
+    pub e: f64,
+    pub nu: f64,
+    pub rho: f64,
+    pub shape: &'static str,
+    pub update: &'static str,
+    pub plane: &'static str,
+    pub duration: f64,
+    pub damping: f64,
+    pub velocity: f64,
+    /// Extra TOML appended (loads, boundaries, probes).
+    pub extra: String,
+}
+
+impl Default for Bar {
+    fn default() -> Self {
+        Bar {
+            dim: 2,
+            len: 0.1,
+            w: 0.01,
+            h: 0.002,
+            e: 200e9,
+            nu: 0.0,
+            rho: 8000.0,
+            shape: "ugimp",
+            update: "usavg",
+            plane: "stress",
+            duration: 1e-5,
+            damping: 0.0,
+            velocity: 0.0,
+            extra: String::new(),
+        }
+    }
+}
+
+impl Bar {
+    /// Section area (m^2): w^2 (2D plane thickness = w).
+    pub fn area(&self) -> f64 {
+        self.w * self.w
+    }
+
+    /// Region covering the particles with x in [x0, x1], the whole section.
+    pub fn region(&self, x0: f64, x1: f64) -> String {
+        format!(
+            "{{ min = {}, max = {} }}",
+            v(self.dim, x0, 0.0),
+            v(self.dim, x1, self.w)
+        )
+    }
+
+    /// Region of nodes with x <= 0 (a clamp at the left end).
+    pub fn left_nodes(&self) -> String {
+        let m = 2.0 * self.h;
+        format!(
+            "{{ min = {}, max = {} }}",
+            v(self.dim, -m, -m),
+            v(self.dim, 0.0, self.w + m)
+        )
+    }
+
+    /// The scenario text.
+    pub fn toml(&self) -> String {
+        let m = 2.0 * self.h;
+        let plane = if self.dim == 2 {
+            format!("plane = \"{}\"\nthickness = {:e}\n", self.plane, self.w)
+        } else {
+            String::new()
+        };
+        format!(
+            r#"
+[simulation]
+dimension = {dim}
+{plane}shape = "{shape}"
+update = "{update}"
+duration = {duration:e}
+cfl = 0.5
+damping = {damping:e}
+
+[grid]
+min = {gmin}
+max = {gmax}
+cell = {cell}
+
+[[material]]
+name = "m"
+E = {e:e}
+nu = {nu}
+rho = {rho:e}
+
+[[body]]
+material = "m"
+box = {{ min = {bmin}, max = {bmax} }}
+velocity = {vel}
+
+[output]
+history_interval = {hist:e}
+{extra}
+"#,
+            dim = self.dim,
+            shape = self.shape,
+            update = self.update,
+            duration = self.duration,
+            damping = self.damping,
+            gmin = v(self.dim, -m, -m),
+            gmax = v(self.dim, self.len + m, self.w + m),
+            cell = v(self.dim, self.h, self.h),
+            e = self.e,
+            nu = self.nu,
+            rho = self.rho,
+            bmin = v(self.dim, 0.0, 0.0),
+            bmax = v(self.dim, self.len, self.w),
+            vel = v(self.dim, self.velocity, 0.0),
+            hist = self.duration / 2000.0,
+            extra = self.extra,
+        )
+    }
+}
