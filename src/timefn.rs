@@ -47,8 +47,12 @@ impl TimeFn {
     /// A problem with the parameters, if any.
     pub fn check(&self) -> Option<&'static str> {
         match *self {
-            TimeFn::Ramp { rise, .. } if !(rise > 0.0) => Some("ramp rise time must be > 0 s"),
-            TimeFn::Pulse { width, .. } if !(width > 0.0) => Some("pulse width must be > 0 s"),
+            TimeFn::Ramp { rise, .. } if !rise.is_finite() || rise <= 0.0 => {
+                Some("ramp rise time must be > 0 s")
+            }
+            TimeFn::Pulse { width, .. } if !width.is_finite() || width <= 0.0 => {
+                Some("pulse width must be > 0 s")
+            }
             _ => None,
         }
     }

@@ -1,0 +1,158 @@
+//! Bad input gets a clear error naming file, line and key, never a panic; the launcher
+//! exits with code 2.
+
+use fissure::dim::D2;
+use fissure::error::ScenarioError;
+use fissure::scenario::{Source, build};
+
+const GOOD: &str = r#"name = "good"
+[simulation]
+dimension = 2
+duration = 1e-4
+cfl = 0.5
+[grid]
+min = [0.0, 0.0]
+max = [0.02, 0.02]
+cell = [0.002, 0.002]
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 7800.0
+[[body]]
+material = "steel"
+box = { min = [0.004, 0.004], max = [0.016, 0.016] }
+"#;
+
+/// Loads `GOOD` with `overrides` and returns the error it must produce.
+fn error_with(overrides: &[&str]) -> ScenarioError {
+    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    match Source::parse("bad.toml", GOOD, &ov) {
+        Err(e) => e,
+        Ok(src) => build::<D2>(&src).expect_err("scenario must be refused"),
+    }
+}
+
+fn assert_error(e: &ScenarioError, key: &str, line: Option<usize>, words: &str) {
+    let msg = e.to_string();
+    assert_eq!(e.key.as_deref(), Some(key), "{msg}");
+    if line.is_some() {
+        assert_eq!(e.line, line, "{msg}");
+    }
+    assert!(msg.contains(words), "`{msg}` should mention `{words}`");
+    assert!(msg.starts_with("bad.toml"), "{msg}");
+}
+
+#[test]
+fn good_scenario_builds() {
+    let src = Source::parse("good.toml", GOOD, &[]).unwrap();
+    // A 12 mm square at 2 mm cells and 2 particles per cell per axis: 12 x 12 particles.
+    assert_eq!(build::<D2>(&src).unwrap().world.particles.len(), 144);
+}
+
+#[test]
+fn unknown_key_names_line_and_key() {
+    let text = GOOD.replace("cfl = 0.5", "cfl = 0.5\ncourant = 0.3");
+    let e = Source::parse("bad.toml", &text, &[]).unwrap_err();
+    assert_eq!(e.line, Some(6), "{e}");
+    assert!(e.to_string().contains("courant"), "{e}");
+}
+
+#[test]
+fn wrong_type_names_line_and_key() {
+    let text = GOOD.replace("nu = 0.3", "nu = \"a third\"");
+    let e = Source::parse("bad.toml", &text, &[]).unwrap_err();
+    assert_eq!(e.line, Some(13), "{e}");
+    assert_eq!(e.key.as_deref(), Some("material[0].nu"), "{e}");
+}
+
+#[test]
+fn missing_material() {
+    let e = error_with(&["body[0].material=\"titanium\""]);
+    assert_error(
+        &e,
+        "body[0].material",
+        Some(16),
+        "no [[material]] named `titanium`",
+    );
+}
+
+#[test]
+fn body_outside_the_grid() {
+    let e = error_with(&["body[0].box.max=[0.03, 0.016]"]);
+    assert_error(&e, "body[0]", None, "beyond the grid");
+}
+
+#[test]
+fn non_positive_modulus_and_density() {
+    assert_error(
+        &error_with(&["material[0].E=-1.0"]),
+        "material[0].E",
+        Some(12),
+        "positive",
+    );
+    assert_error(
+        &error_with(&["material[0].rho=0.0"]),
+        "material[0].rho",
+        Some(14),
+        "positive",
+    );
+}
+
+#[test]
+fn poisson_ratio_at_or_above_half() {
+    let e = error_with(&["material[0].nu=0.5"]);
+    assert_error(&e, "material[0].nu", Some(13), "nu < 0.5");
+}
+
+#[test]
+fn cfl_at_or_above_one() {
+    let e = error_with(&["simulation.cfl=1.0"]);
+    assert_error(&e, "simulation.cfl", Some(5), "0 < cfl < 1");
+}
+
+#[test]
+fn time_step_above_the_stability_limit() {
+    // limit = 2 mm / c_d, c_d = sqrt((lambda + 2 mu)/rho) = 5875 m/s: 3.4e-7 s.
+    let e = error_with(&["simulation.dt=1e-6"]);
+    assert_error(&e, "simulation.dt", None, "above the stability limit");
+}
+
+#[test]
+fn empty_body() {
+    let e = error_with(&["body[0].box.max=[0.0045, 0.0045]"]);
+    assert_error(&e, "body[0]", None, "no particle");
+}
+
+#[test]
+fn malformed_override_is_refused() {
+    let e = Source::parse("bad.toml", GOOD, &["simulation.cfl".into()]).unwrap_err();
+    assert!(
+        e.to_string().contains("KEY=VALUE") || e.to_string().contains("path.to.key=value"),
+        "{e}"
+    );
+}
+
+#[test]
+fn launcher_exits_with_code_2_on_bad_input() {
+    let dir = std::env::temp_dir().join(format!("fissure-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("bad.toml");
+    std::fs::write(&file, GOOD.replace("nu = 0.3", "nu = 0.7")).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+        .args(["check", file.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("bad.toml:13") && stderr.contains("material[0].nu"),
+        "{stderr}"
+    );
+    let missing = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+        .args(["run", dir.join("nope.toml").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(missing.status.code(), Some(2));
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -1,0 +1,142 @@
+//! Numerically hard cases: particles crossing cells, and runs that go unstable.
+
+mod common;
+use common::{final_world, source};
+use fissure::dim::D2;
+use fissure::run::{RunOptions, run};
+
+/// A soft 1D column dropping onto a fixed base under gravity, compressed by a few cells so
+/// that particles cross cell boundaries. rho g H = 1000 * 10 * 0.1 = 1 kPa and E = 10 kPa:
+/// the top settles by rho g H^2/(2E) = 5 mm, two cells of 2.5 mm (four at the first
+/// overshoot) for E = 10 kPa.
+fn column(shape: &str, youngs: f64, duration: f64, damping: f64) -> String {
+    format!(
+        r#"
+[simulation]
+dimension = 2
+plane = "strain"
+shape = "{shape}"
+update = "usavg"
+duration = {duration:e}
+cfl = 0.5
+damping = {damping:e}
+gravity = [0.0, -10.0]
+[grid]
+min = [-0.005, -0.005]
+max = [0.015, 0.11]
+cell = [0.0025, 0.0025]
+[[material]]
+name = "soft"
+E = {youngs:e}
+nu = 0.0
+rho = 1000.0
+[[body]]
+material = "soft"
+box = {{ min = [0.0, 0.0], max = [0.01, 0.1] }}
+[[boundary]]
+region = {{ min = [-0.005, -0.005], max = [0.015, 0.11] }}
+fix = ["x"]
+[[boundary]]
+region = {{ min = [-0.005, -0.005], max = [0.015, 0.0] }}
+fix = ["y"]
+"#
+    )
+}
+
+/// RMS second difference of sigma_yy between vertically adjacent particles, relative to
+/// rho g H: near zero for a smooth field, large where cell crossings kick the stress.
+fn stress_roughness(text: &str) -> f64 {
+    let w = final_world::<D2>(text, 2);
+    let p = &w.particles;
+    let mut columns: Vec<(i64, f64, f64)> = (0..p.len())
+        .map(|i| ((p.x[i].x * 1e6).round() as i64, p.x[i].y, p.stress[i].yy))
+        .collect();
+    columns.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let (mut sum, mut n) = (0.0, 0);
+    for k in 1..columns.len() - 1 {
+        let (a, b, c) = (columns[k - 1], columns[k], columns[k + 1]);
+        if a.0 == b.0 && b.0 == c.0 {
+            sum += (a.2 - 2.0 * b.2 + c.2).powi(2);
+            n += 1;
+        }
+    }
+    (sum / n as f64).sqrt() / 1000.0
+}
+
+/// Cell-crossing noise: while the column first compresses (0.06 s, the top down by a cell
+/// and a half), uGIMP's stress is far smoother than linear's.
+#[test]
+fn ugimp_has_less_cell_crossing_noise_than_linear() {
+    let linear = stress_roughness(&column("linear", 1e4, 0.06, 0.0));
+    let gimp = stress_roughness(&column("ugimp", 1e4, 0.06, 0.0));
+    println!("roughness: linear {linear:.4}, ugimp {gimp:.4}");
+    assert!(
+        gimp < 0.5 * linear,
+        "uGIMP roughness {gimp} vs linear {linear}"
+    );
+}
+
+/// Damped to rest, a stiffer column (strain 1e-3, so small-strain kinematics hold) carries
+/// its weight: the lowest particle row, a quarter cell above the base, carries the weight
+/// of all but 1/160 of the column, sigma_yy = -rho g H (1 - 1/160).
+#[test]
+fn column_carries_its_weight_at_rest() {
+    // omega_1 = 2 pi c / (4 H) = 497 rad/s; alpha = 2 omega_1; 30 / omega_1 of settling.
+    let w = final_world::<D2>(&column("ugimp", 1e6, 0.06, 1000.0), 2);
+    let p = &w.particles;
+    let lowest = p.x.iter().map(|x| x.y).fold(f64::MAX, f64::min);
+    let row: Vec<usize> = (0..p.len())
+        .filter(|&i| (p.x[i].y - lowest).abs() < 1e-4)
+        .collect();
+    let mean = row.iter().map(|&i| p.stress[i].yy).sum::<f64>() / row.len() as f64;
+    let want = -1000.0 * (1.0 - 1.0 / 160.0);
+    assert!(
+        (mean - want).abs() / want.abs() < 0.01,
+        "lowest-row stress {mean} Pa vs {want} Pa"
+    );
+}
+
+/// A load far beyond anything the grid can hold throws particles out: the run stops with
+/// a message naming the step, the time and the particle, and keeps what it wrote.
+#[test]
+fn unstable_run_stops_with_a_message_and_keeps_files() {
+    let text = r#"
+[simulation]
+dimension = 2
+duration = 1e-3
+[grid]
+min = [0.0, 0.0]
+max = [0.02, 0.02]
+cell = [0.002, 0.002]
+[[material]]
+name = "m"
+E = 1e9
+nu = 0.3
+rho = 1000.0
+[[body]]
+material = "m"
+box = { min = [0.006, 0.006], max = [0.014, 0.014] }
+[[load]]
+region = { min = [0.006, 0.006], max = [0.008, 0.014] }
+force = [-1e9, 0.0]
+[output]
+history_interval = 1e-6
+"#;
+    let dir = std::env::temp_dir().join(format!("fissure-unstable-{}", std::process::id()));
+    let opts = RunOptions {
+        out: Some(dir.clone()),
+        ..RunOptions::default()
+    };
+    let err = run(&source(text), &opts)
+        .expect_err("must go unstable")
+        .to_string();
+    assert!(
+        err.contains("unstable at step") && err.contains("particle"),
+        "{err}"
+    );
+    let energy = std::fs::read_to_string(dir.join("energy.csv")).unwrap();
+    assert!(energy.lines().count() >= 2, "energy.csv keeps its rows");
+    let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    assert!(summary.contains("\"status\": \"unstable\""), "{summary}");
+    std::fs::remove_dir_all(dir).ok();
+}
