@@ -54,6 +54,10 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     fn stress_dot(s: &Sym3, g: Self::Vec) -> Self::Vec;
     /// Cross product of position and momentum, padded to 3 components (z only in 2D).
     fn cross(r: Self::Vec, p: Self::Vec) -> [f64; 3];
+    /// The unit vector along x.
+    fn unit_x() -> Self::Vec;
+    /// The vector (0, gy) in 2D or (0, gy, gz) in 3D.
+    fn yz(gy: f64, gz: f64) -> Self::Vec;
     /// Gradient of the tensor-product shape function for stencil offsets (i, j, k).
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, k: usize) -> Self::Vec;
 }
@@ -117,6 +121,14 @@ impl Dim for D2 {
         [0.0, 0.0, r.perp_dot(p)]
     }
     #[inline(always)]
+    fn unit_x() -> DVec2 {
+        DVec2::X
+    }
+    #[inline(always)]
+    fn yz(gy: f64, _gz: f64) -> DVec2 {
+        DVec2::new(0.0, gy)
+    }
+    #[inline(always)]
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, _k: usize) -> DVec2 {
         DVec2::new(dw[0][i] * w[1][j], w[0][i] * dw[1][j])
     }
@@ -175,6 +187,14 @@ impl Dim for D3 {
     }
     fn cross(r: DVec3, p: DVec3) -> [f64; 3] {
         r.cross(p).to_array()
+    }
+    #[inline(always)]
+    fn unit_x() -> DVec3 {
+        DVec3::X
+    }
+    #[inline(always)]
+    fn yz(gy: f64, gz: f64) -> DVec3 {
+        DVec3::new(0.0, gy, gz)
     }
     #[inline(always)]
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, k: usize) -> DVec3 {

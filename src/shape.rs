@@ -154,6 +154,24 @@ impl<const N: usize> Stencil<N> {
     }
 }
 
+impl<const N: usize> Stencil<N> {
+    /// Calls `f(first_node, q, g_yz)` for each row of `N` nodes along x, where node `i` of the
+    /// row has weight `w[0][i] * q` and gradient `dw[0][i] * q * x̂ + w[0][i] * g_yz`. Hot
+    /// loops factor their per-row work out of the per-node work this way.
+    #[inline(always)]
+    pub fn for_each_row<D: Dim>(&self, stride: &[usize; 3], mut f: impl FnMut(usize, f64, D::Vec)) {
+        let nk = if D::D == 3 { N } else { 1 };
+        for k in 0..nk {
+            for j in 0..N {
+                let row =
+                    self.base[0] + stride[1] * (self.base[1] + j) + stride[2] * (self.base[2] + k);
+                let (w1, w2) = (self.w[1][j], self.w[2][k]);
+                f(row, w1 * w2, D::yz(self.dw[1][j] * w2, w1 * self.dw[2][k]));
+            }
+        }
+    }
+}
+
 /// Calls `$body` with the const `$n` bound to the shape's nodes per axis (2 or 3), so
 /// stencil loops are unrolled for each shape function.
 #[macro_export]

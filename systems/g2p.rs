@@ -32,9 +32,15 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 };
                 let st = Stencil::<N>::new::<D>(shape, geom, x[k], hw);
                 let (mut dv, mut vn) = (D::zero(), D::zero());
-                st.for_each::<D>(&geom.stride, |n, w, _| {
-                    dv += grid.accel[n] * w;
-                    vn += grid.velocity[n] * w;
+                st.for_each_row::<D>(&geom.stride, |row, q, _| {
+                    let (mut da, mut dn) = (D::zero(), D::zero());
+                    for a in 0..N {
+                        let w = st.w[0][a];
+                        da += grid.accel[row + a] * w;
+                        dn += grid.velocity[row + a] * w;
+                    }
+                    dv += da * q;
+                    vn += dn * q;
                 });
                 v[k] += dv * dt;
                 x[k] += vn * dt;

@@ -52,6 +52,21 @@ impl<'a, D: Dim> NodeWriter<'a, D> {
             *self.force.add(n) += f;
         }
     }
+
+    /// Adds mass and momentum only to node `n`.
+    ///
+    /// # Safety
+    /// No other thread may access node `n` during the call.
+    #[inline(always)]
+    unsafe fn add_mass(&self, n: usize, m: f64, p: D::Vec) {
+        assert!(n < self.len);
+        // SAFETY: n is in bounds (checked above) and the caller guarantees exclusive access
+        // to node n.
+        unsafe {
+            *self.mass.add(n) += m;
+            *self.momentum.add(n) += p;
+        }
+    }
 }
 
 /// Scatters mass and momentum (and, when `internal`, the internal force -V sigma . grad S)
@@ -75,16 +90,19 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
         with_nodes!(shape, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
             let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
-            let (m, mv, vol, s) = (p.mass[i], p.v[i] * p.mass[i], p.volume[i], p.stress[i]);
-            st.for_each::<D>(&geom.stride, |n, w, g| {
-                let f = if internal {
-                    -D::stress_dot(&s, g) * vol
-                } else {
-                    D::zero()
-                };
-                // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and
-                // each tile is handled by one thread.
-                unsafe { writer.add(n, m * w, mv * w, f) };
+            let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
+            // Internal force -V sigma . grad S, split as in `Stencil::for_each_row`.
+            let (s, vol) = (p.stress[i], if internal { -p.volume[i] } else { 0.0 });
+            let sx = D::stress_dot(&s, D::unit_x()) * vol;
+            st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
+                let (mq, mvq, sxq) = (m * q, mv * q, sx * q);
+                let syz = D::stress_dot(&s, gyz) * vol;
+                for a in 0..N {
+                    let (w, dw) = (st.w[0][a], st.dw[0][a]);
+                    // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and
+                    // each tile is handled by one thread.
+                    unsafe { writer.add(row + a, mq * w, mvq * w, sxq * dw + syz * w) };
+                }
             });
         })
     });
@@ -114,9 +132,13 @@ pub fn remap<D: Dim>(world: &mut World<D>) {
             let i = i as usize;
             let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
-            st.for_each::<D>(&geom.stride, |n, w, _| {
-                // SAFETY: as in `run`: disjoint nodes per colour class, one thread per tile.
-                unsafe { writer.add(n, m * w, mv * w, D::zero()) };
+            st.for_each_row::<D>(&geom.stride, |row, q, _| {
+                let (mq, mvq) = (m * q, mv * q);
+                for a in 0..N {
+                    let w = st.w[0][a];
+                    // SAFETY: as in `run`: disjoint nodes per colour class, one thread per tile.
+                    unsafe { writer.add_mass(row + a, mq * w, mvq * w) };
+                }
             });
         })
     });
@@ -140,10 +162,15 @@ pub fn internal_force<D: Dim>(world: &mut World<D>) {
         with_nodes!(shape, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
             let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
-            let (vol, s) = (p.volume[i], p.stress[i]);
-            st.for_each::<D>(&geom.stride, |n, _, g| {
-                // SAFETY: as in `run`: disjoint nodes per colour class, one thread per tile.
-                unsafe { writer.add(n, 0.0, D::zero(), -D::stress_dot(&s, g) * vol) };
+            let (s, vol) = (p.stress[i], -p.volume[i]);
+            let sx = D::stress_dot(&s, D::unit_x()) * vol;
+            st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
+                let (sxq, syz) = (sx * q, D::stress_dot(&s, gyz) * vol);
+                for a in 0..N {
+                    let f = sxq * st.dw[0][a] + syz * st.w[0][a];
+                    // SAFETY: as in `run`: disjoint nodes per colour class, one thread per tile.
+                    unsafe { writer.add(row + a, 0.0, D::zero(), f) };
+                }
             });
         })
     });

@@ -9,14 +9,12 @@ use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Gathers grad v = sum (p_i/m_i) ⊗ grad S into the particles' grad_v column and updates
-/// the stress over `fraction` of the step.
+/// the stress over `fraction` of the step. The grid's velocity column is overwritten with
+/// p/m first (grid_update rewrites it with end-of-step velocities afterwards).
 pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
+    node_velocities(world);
     let dt = world.settings.dt * fraction;
-    let (shape, plane, tol) = (
-        world.settings.shape,
-        world.settings.plane,
-        world.settings.mass_tol,
-    );
+    let (shape, plane) = (world.settings.shape, world.settings.plane);
     let grid = &world.grid;
     let geom = &grid.geom;
     let materials = &world.materials;
@@ -37,16 +35,40 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
                 let i = c * CHUNK + k;
                 let hw = if half.is_empty() { D::zero() } else { half[i] };
                 let st = Stencil::<N>::new::<D>(shape, geom, x[i], hw);
+                // grad v = sum_rows (sum_i v_i dw_i) ⊗ q x̂ + (sum_i v_i w_i) ⊗ g_yz.
                 let mut l = D::mat_zero();
-                st.for_each::<D>(&geom.stride, |n, _, g| {
-                    let m = grid.mass[n];
-                    if m > tol {
-                        l = l + D::outer(grid.momentum[n] * (1.0 / m), g);
+                st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
+                    let (mut vd, mut vw) = (D::zero(), D::zero());
+                    for a in 0..N {
+                        let v = grid.velocity[row + a];
+                        vd += v * st.dw[0][a];
+                        vw += v * st.w[0][a];
                     }
+                    l = l + D::outer(vd, D::unit_x() * q) + D::outer(vw, gyz);
                 });
                 gv[k] = l;
                 let de = D::sym_part(&gv[k]) * dt;
                 materials[material[i] as usize].update(plane, de, &mut s[k]);
             })
+        });
+}
+
+/// Sets the grid velocity column to p/m (zero on nodes lighter than the mass tolerance).
+fn node_velocities<D: Dim>(world: &mut World<D>) {
+    let tol = world.settings.mass_tol;
+    let g = &mut world.grid;
+    let (mass, momentum) = (&g.mass, &g.momentum);
+    g.velocity
+        .par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(c, vel)| {
+            for (k, v) in vel.iter_mut().enumerate() {
+                let n = c * CHUNK + k;
+                *v = if mass[n] > tol {
+                    momentum[n] * (1.0 / mass[n])
+                } else {
+                    D::zero()
+                };
+            }
         });
 }

@@ -110,11 +110,10 @@ fn fixed_free_bar_first_mode_2d() {
         (f - f0).abs() / f0 < 0.02,
         "2D first mode {f} Hz vs c0/(4L) = {f0} Hz"
     );
-    // Undamped energy drift over five periods. USAVG with FLIP dissipates at first order in
-    // the cell size (measured: 1.3 % with 100 cells along the bar,
-    // 3.7 % with 50); bound it at 5 % for these 50 cells. A growing energy would mean an
-    // unstable scheme, so the drift's sign is checked too.
-    assert!(drift.abs() < 0.05, "energy drift over 5 periods {drift}");
+    // Undamped energy drift over five periods. With the momentum remap before the final
+    // stress update the scheme is nearly conservative (measured -0.05 % here; without the
+    // remap it lost 3.7 %); bound it at 0.5 %. A growing energy would mean instability.
+    assert!(drift.abs() < 5e-3, "energy drift over 5 periods {drift}");
     assert!(drift <= 1e-9, "energy grew: {drift}");
 }
 
