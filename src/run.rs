@@ -270,7 +270,7 @@ fn drive<D: Dim>(scene: Scene<D>, opts: &RunOptions) -> anyhow::Result<Outcome> 
             .into_iter()
             .map(|(n, s)| (n.to_string(), s))
             .collect(),
-        bytes_per_particle: world.particles.bytes_per_particle(),
+        bytes_per_particle: world.bytes_per_particle(),
         bytes_per_node: crate::grid::Grid::<D>::bytes_per_node(),
         energies: world.energies(),
         expects: results,

@@ -5,6 +5,8 @@
 
 use crate::dim::Dim;
 use crate::grid::GridGeom;
+use crate::world::CHUNK;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Which shape function maps particles to the grid.
@@ -169,6 +171,71 @@ impl<const N: usize> Stencil<N> {
                 f(row, w1 * w2, D::yz(self.dw[1][j] * w2, w1 * self.dw[2][k]));
             }
         }
+    }
+}
+
+/// Every particle's stencil, evaluated once after the particles move and read by each
+/// system that needs it until they move again (up to four times a step).
+#[derive(Clone, Debug, Default)]
+pub struct StencilCache {
+    /// First node per axis of each particle.
+    pub base: Vec<[u32; 3]>,
+    /// Per particle and axis: three weights then three derivatives (1/m).
+    pub weights: Vec<f64>,
+}
+
+impl StencilCache {
+    /// Evaluates the stencils of particles at `x` with half-widths `half` (empty unless uGIMP).
+    pub fn fill<D: Dim>(
+        &mut self,
+        shape: ShapeKind,
+        geom: &GridGeom<D>,
+        x: &[D::Vec],
+        half: &[D::Vec],
+    ) {
+        let per = 6 * D::D;
+        self.base.resize(x.len(), [0; 3]);
+        self.weights.resize(x.len() * per, 0.0);
+        (
+            self.base.par_chunks_mut(CHUNK),
+            self.weights.par_chunks_mut(CHUNK * per),
+        )
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, (base, weights))| {
+                for k in 0..base.len() {
+                    let i = c * CHUNK + k;
+                    let hw = if half.is_empty() { D::zero() } else { half[i] };
+                    for a in 0..D::D {
+                        let xi = (x[i][a] - geom.origin[a]) * geom.inv_h[a];
+                        let (b, w, dw) = shape.axis(xi, hw[a] * geom.inv_h[a], geom.inv_h[a]);
+                        base[k][a] = b as u32;
+                        let out = &mut weights[k * per + 6 * a..k * per + 6 * a + 6];
+                        out[..3].copy_from_slice(&w);
+                        out[3..].copy_from_slice(&dw);
+                    }
+                }
+            });
+    }
+}
+
+impl<const N: usize> Stencil<N> {
+    /// The cached stencil of particle `i`.
+    #[inline(always)]
+    pub fn cached<D: Dim>(cache: &StencilCache, i: usize) -> Self {
+        let per = 6 * D::D;
+        let b = cache.base[i];
+        let mut st = Stencil {
+            base: [b[0] as usize, b[1] as usize, b[2] as usize],
+            w: [[1.0, 0.0, 0.0]; 3],
+            dw: [[0.0; 3]; 3],
+        };
+        let src = &cache.weights[i * per..(i + 1) * per];
+        for a in 0..D::D {
+            st.w[a].copy_from_slice(&src[6 * a..6 * a + 3]);
+            st.dw[a].copy_from_slice(&src[6 * a + 3..6 * a + 6]);
+        }
+        st
     }
 }
 

@@ -1,4 +1,5 @@
-//! Spatial tiles: particles binned by tile, tiles grouped into 2^D colour classes.
+//! Spatial tiles: particles binned by tile, tiles grouped into 2^D colour classes; and the
+//! particles' stencils, which share the bins' lifetime.
 //!
 //! Tiles of one colour are at least one tile apart on every axis, and a tile's particles
 //! reach at most one node below and two nodes above its cells, so with tiles wider than
@@ -6,6 +7,7 @@
 //! scatter in parallel without atomics and with a fixed summation order.
 
 use crate::dim::Dim;
+use crate::shape::StencilCache;
 use rayon::prelude::*;
 
 /// Tiles wider than this many cells keep same-colour tiles' stencils disjoint.
@@ -26,8 +28,11 @@ pub struct Tiles {
     pub colours: Vec<Vec<u32>>,
     /// Scratch: tile of each particle.
     pub tile_of: Vec<u32>,
-    /// Whether the bins match the current particle positions (cleared when particles move).
+    /// Whether the bins and stencils match the current particle positions (cleared when
+    /// particles move).
     pub fresh: bool,
+    /// Every particle's stencil at the binned positions.
+    pub stencils: StencilCache,
     /// Per axis, each cell's contribution to its tile's linear index (avoids divisions).
     pub cell_part: [Vec<u32>; 3],
 }
@@ -49,6 +54,7 @@ impl Tiles {
         });
         Tiles {
             fresh: false,
+            stencils: StencilCache::default(),
             cell_part,
             size,
             counts,

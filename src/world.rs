@@ -118,6 +118,12 @@ impl<D: Dim> World<D> {
         }
     }
 
+    /// Bytes held per particle: the particle columns plus the bins (tile and order, 4 bytes
+    /// each) and the cached stencil (12 bytes of base plus 48 per axis).
+    pub fn bytes_per_particle(&self) -> usize {
+        self.particles.bytes_per_particle() + 8 + 12 + 48 * D::D
+    }
+
     /// Total linear momentum (kg m/s).
     pub fn momentum(&self) -> D::Vec {
         let p = &self.particles;

@@ -1,5 +1,5 @@
-//! `bin`: sort particle indices into spatial tiles (counting sort) and stop the run if a
-//! particle has left the grid or has a non-finite position.
+//! `bin`: sort particle indices into spatial tiles (counting sort), evaluate every particle's
+//! stencil, and stop the run if a particle has left the grid or has a non-finite position.
 
 use crate::dim::Dim;
 use crate::error::Unstable;
@@ -65,8 +65,8 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
     }
     if moved || !sorted {
         tiles.sort();
-    } else {
-        tiles.fresh = true;
     }
+    tiles.stencils.fill(shape, geom, &p.x, &p.half);
+    tiles.fresh = true;
     Ok(())
 }

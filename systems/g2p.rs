@@ -14,8 +14,8 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let shape = world.settings.shape;
     let grid = &world.grid;
     let geom = &grid.geom;
-    let Particles { x, v, u, half, .. } = &mut world.particles;
-    let half = &*half;
+    let stencils = &world.tiles.stencils;
+    let Particles { x, v, u, .. } = &mut world.particles;
     (
         x.par_chunks_mut(CHUNK),
         v.par_chunks_mut(CHUNK),
@@ -25,12 +25,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         .enumerate()
         .for_each(|(c, (x, v, u))| {
             with_nodes!(shape, N => for k in 0..x.len() {
-                let hw = if half.is_empty() {
-                    D::zero()
-                } else {
-                    half[c * CHUNK + k]
-                };
-                let st = Stencil::<N>::new::<D>(shape, geom, x[k], hw);
+                let st = Stencil::<N>::cached::<D>(stencils, c * CHUNK + k);
                 let (mut dv, mut vn) = (D::zero(), D::zero());
                 st.for_each_row::<D>(&geom.stride, |row, q, _| {
                     let (mut da, mut dn) = (D::zero(), D::zero());

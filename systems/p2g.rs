@@ -89,7 +89,7 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
     world.tiles.for_each_coloured(|t| {
         with_nodes!(shape, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
-            let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
+            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
             // Internal force -V sigma . grad S, split as in `Stencil::for_each_row`.
             let (s, vol) = (p.stress[i], if internal { -p.volume[i] } else { 0.0 });
@@ -130,7 +130,7 @@ pub fn remap<D: Dim>(world: &mut World<D>) {
     world.tiles.for_each_coloured(|t| {
         with_nodes!(shape, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
-            let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
+            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
             st.for_each_row::<D>(&geom.stride, |row, q, _| {
                 let (mq, mvq) = (m * q, mv * q);
@@ -161,7 +161,7 @@ pub fn internal_force<D: Dim>(world: &mut World<D>) {
     world.tiles.for_each_coloured(|t| {
         with_nodes!(shape, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
-            let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
+            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
             let (s, vol) = (p.stress[i], -p.volume[i]);
             let sx = D::stress_dot(&s, D::unit_x()) * vol;
             st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
@@ -189,7 +189,7 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
         for &i in &load.particles {
             let i = i as usize;
             with_nodes!(shape, N => {
-                let st = Stencil::<N>::new::<D>(shape, geom, p.x[i], p.half_of(i));
+                let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
                 st.for_each::<D>(&geom.stride, |n, w, _| world.grid.force[n] += f * w);
             });
             work += 0.5 * dt * D::dot(f, p.v[i]);

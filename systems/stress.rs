@@ -18,23 +18,21 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let grid = &world.grid;
     let geom = &grid.geom;
     let materials = &world.materials;
+    let stencils = &world.tiles.stencils;
     let Particles {
-        x,
-        half,
         grad_v,
         stress,
         material,
         ..
     } = &mut world.particles;
-    let (x, half, material) = (&*x, &*half, &*material);
+    let material = &*material;
     (grad_v.par_chunks_mut(CHUNK), stress.par_chunks_mut(CHUNK))
         .into_par_iter()
         .enumerate()
         .for_each(|(c, (gv, s))| {
             with_nodes!(shape, N => for k in 0..gv.len() {
                 let i = c * CHUNK + k;
-                let hw = if half.is_empty() { D::zero() } else { half[i] };
-                let st = Stencil::<N>::new::<D>(shape, geom, x[i], hw);
+                let st = Stencil::<N>::cached::<D>(stencils, i);
                 // grad v = sum_rows (sum_i v_i dw_i) ⊗ q x̂ + (sum_i v_i w_i) ⊗ g_yz.
                 let mut l = D::mat_zero();
                 st.for_each_row::<D>(&geom.stride, |row, q, gyz| {

@@ -163,3 +163,63 @@ fn damped_bar_elongation_3d() {
     let err = damped_elongation_case(3);
     assert!(err.abs() < 0.02, "3D elongation error {err}");
 }
+
+/// Non-cubic cells (1 x 2.5 mm): the front still travels at c0 along the bar.
+#[test]
+fn bar_wave_speed_with_non_cubic_cells() {
+    let bar = Bar {
+        h: 0.001,
+        duration: 0.95 * 0.1 / 5000.0 * 1.2,
+        ..Bar::default()
+    };
+    // Same bar, grid rows 2.5 mm tall: replace the [grid] table.
+    let full = bar.toml();
+    let start = full.find("[grid]").unwrap();
+    let end = full.find("[[material]]").unwrap();
+    let grid = "[grid]\nmin = [-2e-3, -5e-3]\nmax = [0.102, 0.015]\ncell = [1e-3, 2.5e-3]\n\n";
+    let text = format!("{}{grid}{}", &full[..start], &full[end..]);
+    assert!(text.contains("cell = [1e-3, 2.5e-3]"), "{text}");
+    let (l, h) = (bar.len, bar.h);
+    let extra = format!(
+        "{}{}\n[[load]]\nregion = {}\nforce = [1e4, 0.0]\ntime = {{ kind = \"step\" }}\n",
+        probe(&bar, "a", 0.25 * l, 0.25 * l + h, "velocity"),
+        probe(&bar, "b", 0.75 * l, 0.75 * l + h, "velocity"),
+        bar.region(0.0, h),
+    );
+    let hist = history(&format!("{text}{extra}"));
+    let ta = arrival(&hist.time, &hist.probes[0]).expect("front reaches a");
+    let tb = arrival(&hist.time, &hist.probes[1]).expect("front reaches b");
+    let c = 0.5 * l / (tb - ta);
+    assert!(
+        (c - 5000.0).abs() / 5000.0 < 0.02,
+        "speed {c} with 1 x 2.5 mm cells"
+    );
+}
+
+/// A grip moving at a prescribed velocity drags the end of a clamped bar with it: after
+/// the ramp the end particles follow the grip's displacement v (t - t_ramp/2).
+#[test]
+fn prescribed_velocity_moves_the_grip() {
+    let mut bar = Bar {
+        duration: 2e-5,
+        ..Bar::default()
+    };
+    let m = 2.0 * bar.h;
+    bar.extra = format!(
+        "\n[[boundary]]\nregion = {}\nfix = [\"x\"]\n\n[[boundary]]\nregion = {{ min = [{:e}, {:e}], max = [{:e}, {:e}] }}\nfix = [\"x\"]\nvelocity = [0.5, 0.0]\ntime = {{ kind = \"ramp\", rise = 4e-6 }}\n{}",
+        bar.left_nodes(),
+        bar.len,
+        -m,
+        bar.len + m,
+        bar.w + m,
+        probe(&bar, "end", bar.len - 0.25 * bar.h, bar.len, "displacement"),
+    );
+    let hist = history(&bar.toml());
+    let t = *hist.time.last().unwrap();
+    let want = 0.5 * (t - 2e-6);
+    let got = *hist.probes[0].last().unwrap();
+    assert!(
+        (got - want).abs() / want < 0.02,
+        "grip displacement {got} vs {want}"
+    );
+}
