@@ -68,15 +68,6 @@ impl<D: Dim> GridGeom<D> {
         (0..D::D).map(|a| self.h[a]).fold(f64::INFINITY, f64::min)
     }
 
-    /// Upper corner of the grid (m).
-    pub fn max_corner(&self) -> D::Vec {
-        let mut x = self.origin;
-        for a in 0..D::D {
-            x[a] += self.cells[a] as f64 * self.h[a];
-        }
-        x
-    }
-
     /// Whether the `shape` stencil of a particle at `x` with half-width `half` (m) lies
     /// inside the grid (false for non-finite positions).
     #[inline(always)]

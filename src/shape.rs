@@ -116,25 +116,6 @@ pub struct Stencil<const N: usize> {
 }
 
 impl<const N: usize> Stencil<N> {
-    /// Evaluates the stencil at `x` with particle half-width `half` (m, used by uGIMP only).
-    #[inline(always)]
-    pub fn new<D: Dim>(shape: ShapeKind, geom: &GridGeom<D>, x: D::Vec, half: D::Vec) -> Self {
-        debug_assert_eq!(shape.nodes(), N);
-        let mut st = Stencil {
-            base: [0; 3],
-            w: [[1.0, 0.0, 0.0]; 3],
-            dw: [[0.0; 3]; 3],
-        };
-        for a in 0..D::D {
-            let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
-            let (b, w, dw) = shape.axis(xi, half[a] * geom.inv_h[a], geom.inv_h[a]);
-            st.base[a] = b;
-            st.w[a] = w;
-            st.dw[a] = dw;
-        }
-        st
-    }
-
     /// Calls `f(node, weight, gradient)` for every node of the stencil, in a fixed order.
     #[inline(always)]
     pub fn for_each<D: Dim>(&self, stride: &[usize; 3], mut f: impl FnMut(usize, f64, D::Vec)) {
@@ -154,9 +135,7 @@ impl<const N: usize> Stencil<N> {
             }
         }
     }
-}
 
-impl<const N: usize> Stencil<N> {
     /// Calls `f(first_node, q, g_yz)` for each row of `N` nodes along x, where node `i` of the
     /// row has weight `w[0][i] * q` and gradient `dw[0][i] * q * x̂ + w[0][i] * g_yz`. Hot
     /// loops factor their per-row work out of the per-node work this way.
