@@ -1,8 +1,9 @@
 //! Per-system microbenchmarks and one full step, in particle throughput.
 //!
 //! `cargo bench --bench systems` (all cores) or `RAYON_NUM_THREADS=1 cargo bench --bench
-//! systems` (one thread). Scenes: a block filling the grid at 2 particles per cell per axis,
-//! 2D 256 x 256 cells (262,144 particles), 3D 40 x 40 x 40 cells (512,000 particles).
+//! systems` (one thread). USAVG unless the label says otherwise. Scenes: a block filling
+//! the grid at 2 particles per cell per axis, 2D 256 x 256 cells (262,144 particles), 3D
+//! 40 x 40 x 40 cells (512,000 particles).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use fissure::dim::{D2, D3, Dim};
@@ -45,8 +46,8 @@ velocity = [{vel}]
     )
 }
 
-fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, shape: &str) {
-    let text = scene_text(D::D, shape, "usavg");
+fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, shape: &str, update: &str) {
+    let text = scene_text(D::D, shape, update);
     let src = Source::parse(label, &text, &[]).expect("bench scene parses");
     let mut world = build::<D>(&src).expect("bench scene builds").world;
     let mut schedule = Schedule::for_world(&world);
@@ -75,10 +76,11 @@ fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, shape: &str) {
 }
 
 fn systems(c: &mut Criterion) {
-    bench_scene::<D2>(c, "2d-linear", "linear");
-    bench_scene::<D2>(c, "2d-ugimp", "ugimp");
-    bench_scene::<D3>(c, "3d-ugimp", "ugimp");
-    bench_scene::<D3>(c, "3d-bspline", "bspline");
+    bench_scene::<D2>(c, "2d-linear", "linear", "usavg");
+    bench_scene::<D2>(c, "2d-linear-usl", "linear", "usl");
+    bench_scene::<D2>(c, "2d-ugimp", "ugimp", "usavg");
+    bench_scene::<D3>(c, "3d-ugimp", "ugimp", "usavg");
+    bench_scene::<D3>(c, "3d-bspline", "bspline", "usavg");
 }
 
 criterion_group!(benches, systems);
