@@ -8,7 +8,7 @@ use crate::output::summary::Summary;
 use crate::output::vtk;
 use crate::scenario::{Scene, Source, build};
 use crate::schedule::Schedule;
-use crate::world::World;
+use crate::world::{Energies, World};
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
@@ -98,13 +98,14 @@ impl Writers {
     }
 }
 
+/// Appends a history row with energies `e` (and the probes' latest samples to probes.csv).
 fn record<D: Dim>(
     world: &World<D>,
+    e: Energies,
     centre: D::Vec,
     history: &mut History,
     w: &mut Option<Writers>,
 ) -> anyhow::Result<()> {
-    let e = world.energies();
     let p = &world.particles;
     let scale = (0..p.len())
         .map(|i| p.mass[i] * D::dot(p.v[i], p.v[i]).sqrt())
@@ -133,9 +134,8 @@ fn record<D: Dim>(
     Ok(())
 }
 
-/// Checks the energies for NaN and names the first particle with a non-finite state.
-fn check_finite<D: Dim>(world: &World<D>) -> Result<(), Unstable> {
-    let e = world.energies();
+/// Checks the energies `e` for NaN and names the first particle with a non-finite state.
+fn check_finite<D: Dim>(world: &World<D>, e: &Energies) -> Result<(), Unstable> {
     if (e.kinetic + e.strain).is_finite() {
         return Ok(());
     }
@@ -185,7 +185,7 @@ fn drive<D: Dim>(scene: Scene<D>, opts: &RunOptions) -> anyhow::Result<Outcome> 
         }
     };
     sample(&world, &mut history);
-    record(&world, centre, &mut history, &mut writers)?;
+    record(&world, world.energies(), centre, &mut history, &mut writers)?;
     let vtk = output.vtk && writers.is_some();
     if vtk && let Some(w) = &mut writers {
         w.frame(&world)?;
@@ -213,11 +213,12 @@ fn drive<D: Dim>(scene: Scene<D>, opts: &RunOptions) -> anyhow::Result<Outcome> 
         let last = world.step == steps;
         if world.time >= next_history * (1.0 - 1e-9) || last {
             next_history += output.history_interval;
-            if let Err(e) = check_finite(&world) {
+            let energies = world.energies();
+            if let Err(e) = check_finite(&world, &energies) {
                 failure = Some(e);
                 break;
             }
-            record(&world, centre, &mut history, &mut writers)?;
+            record(&world, energies, centre, &mut history, &mut writers)?;
         }
         if vtk && (world.time >= next_frame * (1.0 - 1e-9) || last) {
             next_frame += output.interval;

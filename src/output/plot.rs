@@ -53,6 +53,7 @@ pub fn lines(
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
         .margin(12)
+        .margin_right(48)
         .x_label_area_size(45)
         .y_label_area_size(90)
         .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
