@@ -227,8 +227,8 @@ fn drive<D: Dim>(scene: Scene<D>, opts: &RunOptions) -> anyhow::Result<Outcome> 
             }
         }
         if world.step % 64 == 0 {
-            bar.set_position(world.step);
             bar.set_message(format!("{:.4e} s", world.time));
+            bar.set_position(world.step);
         }
     }
     let wall = t0.elapsed().as_secs_f64();
