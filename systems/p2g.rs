@@ -37,20 +37,16 @@ impl<'a, D: Dim> NodeWriter<'a, D> {
         }
     }
 
-    /// Adds to node `n`.
+    /// Adds a force to node `n`.
     ///
     /// # Safety
     /// No other thread may access node `n` during the call.
     #[inline(always)]
-    unsafe fn add(&self, n: usize, m: f64, p: D::Vec, f: D::Vec) {
+    unsafe fn add_force(&self, n: usize, f: D::Vec) {
         assert!(n < self.len);
         // SAFETY: n is in bounds (checked above) and the caller guarantees exclusive access
         // to node n.
-        unsafe {
-            *self.mass.add(n) += m;
-            *self.momentum.add(n) += p;
-            *self.force.add(n) += f;
-        }
+        unsafe { *self.force.add(n) += f };
     }
 
     /// Adds mass and momentum only to node `n`.
@@ -72,40 +68,12 @@ impl<'a, D: Dim> NodeWriter<'a, D> {
 /// Scatters mass and momentum (and, when `internal`, the internal force -V sigma . grad S)
 /// to a zeroed grid, then adds the external particle loads.
 pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
-    let Grid {
-        geom,
-        mass,
-        momentum,
-        force,
-        ..
-    } = &mut world.grid;
-    mass.par_iter_mut().for_each(|m| *m = 0.0);
-    momentum.par_iter_mut().for_each(|m| *m = D::zero());
-    force.par_iter_mut().for_each(|f| *f = D::zero());
-    let writer = NodeWriter::<D>::new(mass, momentum, force);
-    let p = &world.particles;
-    let shape = world.settings.shape;
-    let geom = &*geom;
-    world.tiles.for_each_coloured(|t| {
-        with_nodes!(shape, N => for &i in world.tiles.particles(t) {
-            let i = i as usize;
-            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
-            let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
-            // Internal force -V sigma . grad S, split as in `Stencil::for_each_row`.
-            let (s, vol) = (p.stress[i], if internal { -p.volume[i] } else { 0.0 });
-            let sx = D::stress_dot(&s, D::unit_x()) * vol;
-            st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
-                let (mq, mvq, sxq) = (m * q, mv * q, sx * q);
-                let syz = D::stress_dot(&s, gyz) * vol;
-                for a in 0..N {
-                    let (w, dw) = (st.w[0][a], st.dw[0][a]);
-                    // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and
-                    // each tile is handled by one thread.
-                    unsafe { writer.add(row + a, mq * w, mvq * w, sxq * dw + syz * w) };
-                }
-            });
-        })
-    });
+    world.grid.force.par_iter_mut().for_each(|f| *f = D::zero());
+    if internal {
+        scatter::<D, true, true>(world);
+    } else {
+        scatter::<D, true, false>(world);
+    }
     scatter_loads(world);
 }
 
@@ -114,6 +82,20 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
 /// velocities (the modified USL of Sulsky, Zhou & Schreyer 1995). Without it, nodes with a
 /// tiny share of mass get huge velocities and linear shape functions go unstable.
 pub fn remap<D: Dim>(world: &mut World<D>) {
+    scatter::<D, true, false>(world);
+}
+
+/// Scatters the internal force -V sigma . grad S alone (USF and USAVG, after the first
+/// stress update).
+pub fn internal_force<D: Dim>(world: &mut World<D>) {
+    scatter::<D, false, true>(world);
+}
+
+/// One scatter pass over the tiles, colour class by colour class (Guo & Nairn 2D (2004)
+/// Eqs. 3 and 6, single velocity field): mass and momentum (zeroed first) when `MASS`, the
+/// internal force -V sigma . grad S when `FORCE`. Compile-time flags keep the hot loop
+/// free of branches.
+fn scatter<D: Dim, const MASS: bool, const FORCE: bool>(world: &mut World<D>) {
     let Grid {
         geom,
         mass,
@@ -121,8 +103,10 @@ pub fn remap<D: Dim>(world: &mut World<D>) {
         force,
         ..
     } = &mut world.grid;
-    mass.par_iter_mut().for_each(|m| *m = 0.0);
-    momentum.par_iter_mut().for_each(|m| *m = D::zero());
+    if MASS {
+        mass.par_iter_mut().for_each(|m| *m = 0.0);
+        momentum.par_iter_mut().for_each(|m| *m = D::zero());
+    }
     let writer = NodeWriter::<D>::new(mass, momentum, force);
     let p = &world.particles;
     let shape = world.settings.shape;
@@ -132,44 +116,24 @@ pub fn remap<D: Dim>(world: &mut World<D>) {
             let i = i as usize;
             let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
-            st.for_each_row::<D>(&geom.stride, |row, q, _| {
-                let (mq, mvq) = (m * q, mv * q);
-                for a in 0..N {
-                    let w = st.w[0][a];
-                    // SAFETY: as in `run`: disjoint nodes per colour class, one thread per tile.
-                    unsafe { writer.add_mass(row + a, mq * w, mvq * w) };
-                }
-            });
-        })
-    });
-}
-
-/// Scatters the internal force -V sigma . grad S alone (USF and USAVG, after the first
-/// stress update).
-pub fn internal_force<D: Dim>(world: &mut World<D>) {
-    let Grid {
-        geom,
-        mass,
-        momentum,
-        force,
-        ..
-    } = &mut world.grid;
-    let writer = NodeWriter::<D>::new(mass, momentum, force);
-    let p = &world.particles;
-    let shape = world.settings.shape;
-    let geom = &*geom;
-    world.tiles.for_each_coloured(|t| {
-        with_nodes!(shape, N => for &i in world.tiles.particles(t) {
-            let i = i as usize;
-            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
+            // Internal force split as in `Stencil::for_each_row`.
             let (s, vol) = (p.stress[i], -p.volume[i]);
             let sx = D::stress_dot(&s, D::unit_x()) * vol;
             st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
-                let (sxq, syz) = (sx * q, D::stress_dot(&s, gyz) * vol);
+                let (mq, mvq, sxq) = (m * q, mv * q, sx * q);
+                let syz = D::stress_dot(&s, gyz) * vol;
                 for a in 0..N {
-                    let f = sxq * st.dw[0][a] + syz * st.w[0][a];
-                    // SAFETY: as in `run`: disjoint nodes per colour class, one thread per tile.
-                    unsafe { writer.add(row + a, 0.0, D::zero(), f) };
+                    let (w, dw) = (st.w[0][a], st.dw[0][a]);
+                    // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and
+                    // each tile is handled by one thread.
+                    unsafe {
+                        if MASS {
+                            writer.add_mass(row + a, mq * w, mvq * w);
+                        }
+                        if FORCE {
+                            writer.add_force(row + a, sxq * dw + syz * w);
+                        }
+                    }
                 }
             });
         })
