@@ -175,7 +175,7 @@ fn drive<D: Dim>(scene: Scene<D>, opts: &RunOptions) -> anyhow::Result<Outcome> 
         centre += world.particles.x[i] * (world.particles.mass[i] / total_mass);
     }
     let mut history = History {
-        probes: vec![Vec::with_capacity(steps as usize + 1); probes.len()],
+        probes: vec![Vec::with_capacity((steps as usize + 1).min(1 << 20)); probes.len()],
         ..History::default()
     };
     let sample = |world: &World<D>, h: &mut History| {
