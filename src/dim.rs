@@ -5,6 +5,7 @@
 //! Grid indices are always `[usize; 3]` with a unit third axis in 2D, so stencil loops are
 //! written once.
 
+use crate::snapshot::Columnar;
 use crate::sym::Sym3;
 use glam::{DMat2, DMat3, DVec2, DVec3};
 use std::fmt::Debug;
@@ -30,9 +31,16 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
         + SubAssign
         + MulAssign<f64>
         + Index<usize, Output = f64>
-        + IndexMut<usize>;
+        + IndexMut<usize>
+        + Columnar;
     /// Velocity-gradient matrices, column-major: `m.col(j)[i] = dv_i/dx_j`.
-    type Mat: Copy + Send + Sync + Debug + Add<Output = Self::Mat> + Mul<f64, Output = Self::Mat>;
+    type Mat: Copy
+        + Send
+        + Sync
+        + Debug
+        + Add<Output = Self::Mat>
+        + Mul<f64, Output = Self::Mat>
+        + Columnar;
 
     /// The zero vector.
     fn zero() -> Self::Vec;

@@ -18,6 +18,7 @@ pub mod run;
 pub mod scenario;
 pub mod schedule;
 pub mod shape;
+pub mod snapshot;
 pub mod sym;
 pub mod tiles;
 pub mod timefn;

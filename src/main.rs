@@ -3,11 +3,15 @@
 use clap::{Parser, Subcommand};
 use fissure::dim::{D2, D3};
 use fissure::error::ScenarioError;
-use fissure::run::{RunOptions, run};
+use fissure::run::checkpoint::resolve;
+use fissure::run::{Outcome, RunOptions, resume, run};
 use fissure::scenario::{Source, build};
 use fissure::schedule::Schedule;
+use fissure::snapshot::{Reader, SnapshotError};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Dynamic fracture with the material point method.
@@ -33,6 +37,28 @@ enum Command {
         /// Override a key: --set simulation.duration=1e-3 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         overrides: Vec<String>,
+        /// Simulated end time in seconds (default: the scenario's duration).
+        #[arg(long)]
+        until: Option<f64>,
+    },
+    /// Continue a run from a snapshot (a .fsnap file, or a run folder: its newest snapshot).
+    Resume {
+        /// Snapshot file or run folder.
+        snapshot: PathBuf,
+        /// Output folder (default: the run folder the snapshot is in).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Worker threads (default: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Simulated end time in seconds (default: the scenario's duration).
+        #[arg(long)]
+        until: Option<f64>,
+    },
+    /// Print a snapshot's header and column table, and verify every checksum.
+    Inspect {
+        /// Snapshot file or run folder.
+        snapshot: PathBuf,
     },
     /// Validate a scenario without running it.
     Check {
@@ -67,7 +93,15 @@ fn main() -> ExitCode {
             out,
             threads,
             overrides,
-        } => cmd_run(&scenario, out, threads, &overrides),
+            until,
+        } => cmd_run(&scenario, out, threads, until, &overrides),
+        Command::Resume {
+            snapshot,
+            out,
+            threads,
+            until,
+        } => cmd_resume(&snapshot, out, threads, until),
+        Command::Inspect { snapshot } => cmd_inspect(&snapshot),
         Command::Check {
             scenario,
             overrides,
@@ -89,18 +123,88 @@ fn bad_input(e: &ScenarioError) -> ExitCode {
     ExitCode::from(BAD_INPUT)
 }
 
-/// Runs an error through: scenario problems exit 2, anything else 1.
+/// Exit code of a run stopped on request (128 + SIGINT, as shells report it).
+const INTERRUPTED: u8 = 130;
+
+/// Runs an error through: scenario and snapshot problems exit 2, anything else 1.
 fn report(e: anyhow::Error) -> ExitCode {
-    match e.downcast_ref::<ScenarioError>() {
-        Some(s) => bad_input(s),
-        None => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
+    if let Some(s) = e.downcast_ref::<ScenarioError>() {
+        return bad_input(s);
+    }
+    eprintln!("error: {e:#}");
+    if e.downcast_ref::<SnapshotError>().is_some() {
+        ExitCode::from(BAD_INPUT)
+    } else {
+        ExitCode::FAILURE
     }
 }
 
-fn cmd_run(path: &Path, out: Option<PathBuf>, threads: usize, overrides: &[String]) -> ExitCode {
+/// A flag set by Ctrl-C or SIGTERM, so the run stops cleanly after the current step and
+/// writes a snapshot; a second signal exits at once.
+fn stop_flag() -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let f = flag.clone();
+    let installed = ctrlc::set_handler(move || {
+        if f.swap(true, Ordering::SeqCst) {
+            std::process::exit(i32::from(INTERRUPTED));
+        }
+        eprintln!("\nstopping after this step (signal again to abort at once)");
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: no clean stop on Ctrl-C: {e}");
+    }
+    flag
+}
+
+/// Prints a finished run's line and its expects; the exit code says how it ended.
+fn finish(o: &Outcome, out: &Path) -> ExitCode {
+    let s = &o.summary;
+    if s.status == "interrupted" {
+        eprintln!("{}", s.message.as_deref().unwrap_or("interrupted"));
+        return ExitCode::from(INTERRUPTED);
+    }
+    println!(
+        "{}: {} particles, {} steps in {:.2} s ({:.3e} particle-steps/s, {} threads); outputs in {}",
+        s.scenario,
+        s.particles,
+        s.steps,
+        s.wall_seconds,
+        s.particle_steps_per_second,
+        s.threads,
+        out.display()
+    );
+    if let Some(p) = &s.snapshot {
+        println!(
+            "  newest snapshot {p} ({:.1} MB written in {:.2} s)",
+            s.snapshot_bytes as f64 / 1e6,
+            s.snapshot_seconds
+        );
+    }
+    for e in &s.expects {
+        println!(
+            "  {} {:<22} value {:>12} reference {:>12.5e} error {:>10} tol {:.2e}",
+            if e.pass { "pass" } else { "FAIL" },
+            e.quantity,
+            e.value.map_or("-".into(), |v| format!("{v:.5e}")),
+            e.reference,
+            e.error.map_or("-".into(), |v| format!("{v:.3e}")),
+            e.tolerance
+        );
+    }
+    if s.expects.iter().all(|e| e.pass) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
+
+fn cmd_run(
+    path: &Path,
+    out: Option<PathBuf>,
+    threads: usize,
+    until: Option<f64>,
+    overrides: &[String],
+) -> ExitCode {
     let src = match Source::load(path, overrides) {
         Ok(s) => s,
         Err(e) => return bad_input(&e),
@@ -110,37 +214,106 @@ fn cmd_run(path: &Path, out: Option<PathBuf>, threads: usize, overrides: &[Strin
         out: Some(out.clone()),
         threads,
         progress: true,
+        until,
+        pause_after: None,
+        stop: Some(stop_flag()),
     };
     match run(&src, &opts) {
-        Ok(o) => {
-            let s = &o.summary;
+        Ok(o) => finish(&o, &out),
+        Err(e) => report(e),
+    }
+}
+
+fn cmd_resume(path: &Path, out: Option<PathBuf>, threads: usize, until: Option<f64>) -> ExitCode {
+    let out = match out {
+        Some(o) => o,
+        None => match default_out(path) {
+            Ok(o) => o,
+            Err(e) => return report(e),
+        },
+    };
+    let opts = RunOptions {
+        out: Some(out.clone()),
+        threads,
+        progress: true,
+        until,
+        pause_after: None,
+        stop: Some(stop_flag()),
+    };
+    match resume(path, &opts) {
+        Ok(o) => finish(&o, &out),
+        Err(e) => report(e),
+    }
+}
+
+/// The run folder a snapshot belongs to: the parent of its `snapshots/` folder, or else
+/// out/<scenario name>.
+fn default_out(path: &Path) -> anyhow::Result<PathBuf> {
+    let file = resolve(path)?;
+    let dir = file
+        .parent()
+        .filter(|d| d.file_name() == Some("snapshots".as_ref()));
+    match dir.and_then(|d| d.parent()) {
+        Some(run) => Ok(run.to_path_buf()),
+        None => Ok(PathBuf::from("out").join(Reader::open(&file)?.header.scenario)),
+    }
+}
+
+fn cmd_inspect(path: &Path) -> ExitCode {
+    let inspect = || -> anyhow::Result<bool> {
+        let file = resolve(path)?;
+        let mut r = Reader::open(&file)?;
+        let h = r.header.clone();
+        let size = std::fs::metadata(&file)?.len();
+        println!(
+            "snapshot   {} ({:.3} MB)",
+            file.display(),
+            size as f64 / 1e6
+        );
+        println!(
+            "format     version {}, written by fissure {}",
+            fissure::snapshot::format::FORMAT_VERSION,
+            h.build
+        );
+        println!(
+            "scenario   {} (text hash {:016x})",
+            h.scenario, h.scenario_hash
+        );
+        println!(
+            "counts     {}D, {} particles, {} nodes",
+            h.dimension, h.particles, h.nodes
+        );
+        println!(
+            "time       step {}, t = {:.9e} s, dt = {:.6e} s",
+            h.step, h.time, h.dt
+        );
+        println!(
+            "{:<24} {:>5} {:>12} {:>14} {:>16}  checksum",
+            "column", "type", "scalars", "offset", "xxh3"
+        );
+        let checks = r.verify()?;
+        for (c, (_, ok)) in h.columns.iter().zip(&checks) {
             println!(
-                "{}: {} particles, {} steps in {:.2} s ({:.3e} particle-steps/s, {} threads); outputs in {}",
-                s.scenario,
-                s.particles,
-                s.steps,
-                s.wall_seconds,
-                s.particle_steps_per_second,
-                s.threads,
-                out.display()
+                "{:<24} {:>5} {:>12} {:>14} {:>16x}  {}",
+                c.name,
+                format!("{:?}", c.elem).to_lowercase(),
+                c.len,
+                r.offset_of(&c.name).unwrap_or(c.offset),
+                c.checksum,
+                if *ok { "ok" } else { "MISMATCH" }
             );
-            for e in &s.expects {
-                println!(
-                    "  {} {:<22} value {:>12} reference {:>12.5e} error {:>10} tol {:.2e}",
-                    if e.pass { "pass" } else { "FAIL" },
-                    e.quantity,
-                    e.value.map_or("-".into(), |v| format!("{v:.5e}")),
-                    e.reference,
-                    e.error.map_or("-".into(), |v| format!("{v:.3e}")),
-                    e.tolerance
-                );
-            }
-            if s.expects.iter().all(|e| e.pass) {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::FAILURE
-            }
         }
+        let bad = checks.iter().filter(|c| !c.1).count();
+        if bad == 0 {
+            println!("all {} column checksums ok", checks.len());
+        } else {
+            println!("{bad} column(s) fail their checksum");
+        }
+        Ok(bad == 0)
+    };
+    match inspect() {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(BAD_INPUT),
         Err(e) => report(e),
     }
 }
@@ -223,7 +396,7 @@ fn cmd_validate(
         let opts = RunOptions {
             out: out.as_ref().map(|o| o.join(src.name())),
             threads,
-            progress: false,
+            ..RunOptions::default()
         };
         match run(&src, &opts) {
             Ok(o) => {

@@ -1,10 +1,11 @@
 //! Symmetric 3x3 tensors (stress, strain), stored as six components in 2D and 3D alike.
 
+use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 use std::ops::{Add, AddAssign, Mul};
 
 /// A symmetric 3x3 tensor; shear entries are tensor (not engineering) components.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, Pod, Zeroable)]
 #[repr(C)]
 pub struct Sym3 {
     /// xx component.

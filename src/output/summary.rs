@@ -12,7 +12,7 @@ pub struct Summary {
     pub scenario: String,
     /// 2 or 3.
     pub dimension: usize,
-    /// "completed" or "unstable".
+    /// "completed", "interrupted" (stopped on request) or "unstable".
     pub status: String,
     /// Why the run stopped early, if it did.
     pub message: Option<String>,
@@ -44,6 +44,14 @@ pub struct Summary {
     pub bytes_per_node: usize,
     /// Energies at the end (J).
     pub energies: Energies,
-    /// Results of the scenario's [[expect]] blocks.
+    /// Results of the scenario's [[expect]] blocks (only for a completed run).
     pub expects: Vec<ExpectResult>,
+    /// Snapshot this run continued from.
+    pub resumed_from: Option<String>,
+    /// Newest snapshot written (or resumed from).
+    pub snapshot: Option<String>,
+    /// Wall seconds spent writing snapshots.
+    pub snapshot_seconds: f64,
+    /// Bytes of snapshot columns written.
+    pub snapshot_bytes: u64,
 }

@@ -31,6 +31,19 @@ pub struct OutputPlan {
     pub plot: bool,
 }
 
+/// When a run writes snapshots.
+#[derive(Clone, Debug)]
+pub struct CheckpointPlan {
+    /// Every this many steps.
+    pub every_steps: Option<u64>,
+    /// Every this much simulated time (s).
+    pub every_time: Option<f64>,
+    /// Every this much wall-clock time.
+    pub every_wall: Option<std::time::Duration>,
+    /// Newest snapshots kept.
+    pub keep: usize,
+}
+
 /// A World ready to run, with what the run records and checks.
 #[derive(Clone, Debug)]
 pub struct Scene<D: Dim> {
@@ -48,6 +61,8 @@ pub struct Scene<D: Dim> {
     pub output: OutputPlan,
     /// Stability limit h_min / c_max (s).
     pub dt_limit: f64,
+    /// Snapshot cadence.
+    pub checkpoint: CheckpointPlan,
 }
 
 type R<T> = Result<T, ScenarioError>;
@@ -488,6 +503,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         Some(v) => positive(src, "output.history_interval", v, "s")?,
         None => duration / 400.0,
     };
+    let checkpoint = checkpoint_plan(src)?;
     let min_mass = particles.mass.iter().copied().fold(f64::INFINITY, f64::min);
     let world = World {
         tiles,
@@ -522,6 +538,33 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             plot: out.plot.unwrap_or(true),
         },
         dt_limit,
+        checkpoint,
+    })
+}
+
+/// The `[checkpoint]` table, checked.
+fn checkpoint_plan(src: &Source) -> R<CheckpointPlan> {
+    let c = &src.scenario.checkpoint;
+    if c.every_steps == Some(0) {
+        return Err(src.error("checkpoint.every_steps", "must be at least 1"));
+    }
+    let every_time = c
+        .every_time
+        .map(|t| positive(src, "checkpoint.every_time", t, "s"))
+        .transpose()?;
+    let every_wall = c
+        .every_wall_minutes
+        .map(|m| positive(src, "checkpoint.every_wall_minutes", m, "min"))
+        .transpose()?
+        .map(|m| std::time::Duration::from_secs_f64((m * 60.0).min(1e12)));
+    if c.keep == Some(0) {
+        return Err(src.error("checkpoint.keep", "must keep at least 1 snapshot"));
+    }
+    Ok(CheckpointPlan {
+        every_steps: c.every_steps,
+        every_time,
+        every_wall,
+        keep: c.keep.unwrap_or(2),
     })
 }
 

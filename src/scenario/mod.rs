@@ -5,5 +5,5 @@ pub mod build;
 pub mod schema;
 pub mod source;
 
-pub use build::{OutputPlan, Scene, build};
+pub use build::{CheckpointPlan, OutputPlan, Scene, build};
 pub use source::Source;

@@ -35,6 +35,9 @@ pub struct Scenario {
     /// Output cadence.
     #[serde(default)]
     pub output: OutputSpec,
+    /// Snapshot cadence for checkpoint and restart.
+    #[serde(default)]
+    pub checkpoint: CheckpointSpec,
     /// Self-checks against reference values.
     #[serde(default, rename = "expect")]
     pub expects: Vec<ExpectSpec>,
@@ -247,6 +250,21 @@ pub struct OutputSpec {
     pub vtk: Option<bool>,
     /// Write PNG plots (default true).
     pub plot: Option<bool>,
+}
+
+/// `[checkpoint]`: when to write snapshots into `<out>/snapshots/` (any combination; none
+/// set means snapshots only on a clean stop).
+#[derive(Debug, Clone, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct CheckpointSpec {
+    /// Every this many steps.
+    pub every_steps: Option<u64>,
+    /// Every this much simulated time (s).
+    pub every_time: Option<f64>,
+    /// Every this many minutes of wall-clock time.
+    pub every_wall_minutes: Option<f64>,
+    /// How many of the newest snapshots to keep (default 2).
+    pub keep: Option<usize>,
 }
 
 /// `[[expect]]`: a measured quantity checked against a reference.

@@ -171,3 +171,57 @@ history_interval = {hist:e}
         )
     }
 }
+
+/// A box with an initial velocity, gravity, damping, a clamp and a ramped load, and a
+/// disc (sphere in 3D) in flight: most of what a step does, in a small scene.
+pub fn mixed_scene(dim: usize, shape: &str, update: &str) -> String {
+    let v = |a: f64, b: f64| self::v(dim, a, b);
+    format!(
+        r#"
+[simulation]
+dimension = {dim}
+shape = "{shape}"
+update = "{update}"
+duration = 1e-5
+damping = 1000.0
+gravity = {g}
+[grid]
+min = {gmin}
+max = {gmax}
+cell = {cell}
+[[material]]
+name = "m"
+E = 70e9
+nu = 0.33
+rho = 2700.0
+[[body]]
+material = "m"
+box = {{ min = {bmin}, max = {bmax} }}
+velocity = {vel}
+[[body]]
+material = "m"
+{disc}
+[[boundary]]
+region = {{ min = {gmin}, max = {fix} }}
+[[load]]
+region = {{ min = {lmin}, max = {bmax} }}
+force = {force}
+time = {{ kind = "ramp", rise = 5e-6 }}
+"#,
+        g = v(0.0, -9.81),
+        gmin = v(0.0, 0.0),
+        gmax = v(0.064, if dim == 2 { 0.032 } else { 0.016 }),
+        cell = v(0.001, 0.001),
+        bmin = v(0.002, 0.002),
+        bmax = v(0.04, 0.012),
+        vel = v(3.0, -1.0),
+        disc = if dim == 2 {
+            "disc = { center = [0.05, 0.022], radius = 0.006 }"
+        } else {
+            "sphere = { center = [0.05, 0.008, 0.008], radius = 0.005 }"
+        },
+        fix = v(0.003, if dim == 2 { 0.032 } else { 0.016 }),
+        lmin = v(0.038, 0.002),
+        force = v(2e4, 5e3),
+    )
+}

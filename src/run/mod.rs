@@ -1,0 +1,377 @@
+//! Running a scene: the step loop, instability checks, output and checkpoint cadence, and
+//! the summary. A run starts from a scenario ([`run`]) or from a snapshot ([`resume`]).
+
+pub mod checkpoint;
+pub mod state;
+pub mod writers;
+
+use crate::dim::{D2, D3, Dim};
+use crate::error::Unstable;
+use crate::measure::{History, Row};
+use crate::output::plot::{self, Series};
+use crate::output::summary::Summary;
+use crate::scenario::{Scene, Source, build};
+use crate::schedule::Schedule;
+use crate::snapshot::Reader;
+use crate::snapshot::state::restore;
+use crate::world::{Energies, World};
+use anyhow::Context;
+use checkpoint::Checkpointer;
+use indicatif::{ProgressBar, ProgressStyle};
+use state::RunState;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+use writers::Writers;
+
+/// How to run a scenario.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Output folder; None writes nothing (tests, validate without --out).
+    pub out: Option<PathBuf>,
+    /// Worker threads (0: rayon's default, the number of cores).
+    pub threads: usize,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+    /// Simulated end time (s) instead of the scenario's duration.
+    pub until: Option<f64>,
+    /// Stop cleanly after this step, as on Ctrl-C.
+    pub pause_after: Option<u64>,
+    /// When set (by a signal handler), stop cleanly after the current step.
+    pub stop: Option<Arc<AtomicBool>>,
+}
+
+/// Result of a run: its summary and the recorded history.
+#[derive(Debug)]
+pub struct Outcome {
+    /// The summary (also written to summary.json).
+    pub summary: Summary,
+    /// Recorded history.
+    pub history: History,
+    /// The newest snapshot written (or resumed from), if any.
+    pub snapshot: Option<PathBuf>,
+}
+
+fn pool(opts: &RunOptions) -> anyhow::Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads)
+        .build()
+        .context("cannot build the thread pool")
+}
+
+/// Runs `src` with `opts` in a thread pool of the requested size.
+pub fn run(src: &Source, opts: &RunOptions) -> anyhow::Result<Outcome> {
+    pool(opts)?.install(|| match src.scenario.simulation.dimension {
+        2 => drive::<D2>(src, build::<D2>(src)?, None, opts),
+        3 => drive::<D3>(src, build::<D3>(src)?, None, opts),
+        _ => Err(src.error("simulation.dimension", "must be 2 or 3").into()),
+    })
+}
+
+/// Continues the run stored in the snapshot at `path` (a file, or a run folder whose
+/// newest snapshot is taken).
+pub fn resume(path: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
+    let file = checkpoint::resolve(path)?;
+    let mut reader = Reader::open(&file)?;
+    fn go<D: Dim>(r: &mut Reader, file: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
+        let restored = restore::<D>(r)?;
+        let resumed = (restored.state, file.to_path_buf());
+        drive::<D>(&restored.source, restored.scene, Some(resumed), opts)
+    }
+    pool(opts)?.install(|| match reader.header.dimension {
+        2 => go::<D2>(&mut reader, &file, opts),
+        3 => go::<D3>(&mut reader, &file, opts),
+        d => Err(reader
+            .invalid(format!("dimension {d} in the header (corrupt)"))
+            .into()),
+    })
+}
+
+/// Checks the energies `e` for NaN and names the first particle with a non-finite state.
+fn check_finite<D: Dim>(world: &World<D>, e: &Energies) -> Result<(), Unstable> {
+    if (e.kinetic + e.strain).is_finite() {
+        return Ok(());
+    }
+    let p = &world.particles;
+    let bad = (0..p.len())
+        .find(|&i| !(D::dot(p.v[i], p.v[i]).is_finite() && p.stress[i].max_abs().is_finite()))
+        .unwrap_or(0);
+    Err(Unstable {
+        step: world.step,
+        time: world.time,
+        particle: bad,
+        what: "has a non-finite velocity or stress (NaN)".into(),
+    })
+}
+
+/// How the step loop ended.
+enum Stop {
+    /// Reached the end time.
+    Completed,
+    /// Stopped on request, with a snapshot when there is an output folder.
+    Interrupted,
+    /// Went unstable.
+    Unstable(Unstable),
+}
+
+fn drive<D: Dim>(
+    src: &Source,
+    scene: Scene<D>,
+    resumed: Option<(RunState, PathBuf)>,
+    opts: &RunOptions,
+) -> anyhow::Result<Outcome> {
+    let Scene {
+        name,
+        mut world,
+        probes,
+        expects,
+        duration,
+        output,
+        dt_limit,
+        checkpoint,
+    } = scene;
+    let mut schedule = Schedule::for_world(&world);
+    let dt = world.settings.dt;
+    let end = opts.until.unwrap_or(duration);
+    if !(end.is_finite() && end > world.time) {
+        anyhow::bail!(
+            "the end time {end:e} s must be after the current time {:e} s",
+            world.time
+        );
+    }
+    let steps = (end / dt).ceil() as u64;
+    let names: Vec<String> = probes.iter().map(|p| p.name.clone()).collect();
+    let resumed_from = resumed.as_ref().map(|r| r.1.clone());
+    let mut state = match resumed {
+        Some((s, _)) => s,
+        None => RunState::start(
+            &world,
+            probes.len(),
+            steps,
+            output.history_interval,
+            output.interval,
+            checkpoint.every_time,
+        ),
+    };
+    let mut writers = match &opts.out {
+        Some(dir) => Some(Writers::open(dir, &names, &state.history)?),
+        None => None,
+    };
+    let mut checkpoints = match &opts.out {
+        Some(dir) => Some(Checkpointer::new(
+            dir,
+            checkpoint,
+            resumed_from.clone().map(|p| (p, world.step)),
+        )?),
+        None => None,
+    };
+    let vtk = output.vtk && writers.is_some();
+    if resumed_from.is_none() {
+        state.sample(&world, &probes);
+        let row = *state.record(&world, world.energies());
+        if let Some(w) = &mut writers {
+            w.row(&row, &state.history)?;
+            if vtk {
+                w.frame(&world, &mut state)?;
+            }
+        }
+    }
+    let bar = if opts.progress {
+        let b = ProgressBar::new(steps);
+        b.set_style(
+            ProgressStyle::with_template("{bar:40} step {pos}/{len}  t = {msg}  ETA {eta}")
+                .expect("valid template"),
+        );
+        b.set_position(world.step);
+        b.reset_eta();
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let first_step = world.step;
+    let mut stop = Stop::Completed;
+    let t0 = Instant::now();
+    while world.step < steps {
+        if let Err(e) = schedule.step(&mut world) {
+            stop = Stop::Unstable(e);
+            break;
+        }
+        state.sample(&world, &probes);
+        let last = world.step == steps;
+        if world.time >= state.next_history * (1.0 - 1e-9) || last {
+            state.next_history += output.history_interval;
+            let energies = world.energies();
+            if let Err(e) = check_finite(&world, &energies) {
+                stop = Stop::Unstable(e);
+                break;
+            }
+            let row = *state.record(&world, energies);
+            if let Some(w) = &mut writers {
+                w.row(&row, &state.history)?;
+            }
+        }
+        if vtk && (world.time >= state.next_frame * (1.0 - 1e-9) || last) {
+            state.next_frame += output.interval;
+            if let Some(w) = &mut writers {
+                w.frame(&world, &mut state)?;
+            }
+        }
+        let requested = opts
+            .stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+            || opts.pause_after == Some(world.step);
+        if let Some(c) = &mut checkpoints
+            && (c.due(world.step, world.time, &mut state) || requested || (last && c.periodic()))
+        {
+            if let Err(e) = check_finite(&world, &world.energies()) {
+                stop = Stop::Unstable(e);
+                break;
+            }
+            if let Some(w) = &mut writers {
+                w.flush()?;
+            }
+            c.write(src, &world, &state)?;
+        }
+        if requested && !last {
+            stop = Stop::Interrupted;
+            break;
+        }
+        if world.step % 64 == 0 {
+            bar.set_message(format!("{:.4e} s", world.time));
+            bar.set_position(world.step);
+        }
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let snapshot = checkpoints.as_ref().and_then(|c| c.last.clone());
+    let results = match stop {
+        Stop::Completed => expects
+            .iter()
+            .map(|e| e.evaluate(&state.history, &probes))
+            .collect(),
+        _ => Vec::new(),
+    };
+    let (status, message) = match &stop {
+        Stop::Completed => ("completed", None),
+        Stop::Interrupted => (
+            "interrupted",
+            Some(match &snapshot {
+                Some((p, _)) => format!(
+                    "stopped on request at step {} (t = {:.6e} s); snapshot {}; continue with `fissure resume {}`",
+                    world.step,
+                    world.time,
+                    p.display(),
+                    p.display()
+                ),
+                None => format!(
+                    "stopped on request at step {} (t = {:.6e} s); no output folder, so no snapshot",
+                    world.step, world.time
+                ),
+            }),
+        ),
+        Stop::Unstable(e) => (
+            "unstable",
+            Some(match &snapshot {
+                Some((p, s)) => format!("{e}; last good snapshot {} (step {s})", p.display()),
+                None => e.to_string(),
+            }),
+        ),
+    };
+    let summary = Summary {
+        scenario: name.clone(),
+        dimension: D::D,
+        status: status.into(),
+        message: message.clone(),
+        particles: world.particles.len(),
+        nodes: world.grid.geom.node_count(),
+        steps: world.step,
+        time: world.time,
+        dt,
+        dt_limit,
+        wall_seconds: wall,
+        particle_steps_per_second: world.particles.len() as f64 * (world.step - first_step) as f64
+            / wall.max(1e-12),
+        threads: rayon::current_num_threads(),
+        schedule: schedule
+            .systems
+            .iter()
+            .map(|s| s.name().to_string())
+            .collect(),
+        system_seconds: schedule
+            .seconds_by_name()
+            .into_iter()
+            .map(|(n, s)| (n.to_string(), s))
+            .collect(),
+        bytes_per_particle: world.bytes_per_particle(),
+        bytes_per_node: crate::grid::Grid::<D>::bytes_per_node(),
+        energies: world.energies(),
+        expects: results,
+        resumed_from: resumed_from.map(|p| p.display().to_string()),
+        snapshot: snapshot.as_ref().map(|s| s.0.display().to_string()),
+        snapshot_seconds: checkpoints.as_ref().map_or(0.0, |c| c.seconds),
+        snapshot_bytes: checkpoints.as_ref().map_or(0, |c| c.bytes),
+    };
+    if let Some(w) = &mut writers {
+        w.flush()?;
+        let json = serde_json::to_string_pretty(&summary)?;
+        std::fs::write(w.dir.join("summary.json"), json)?;
+        if output.plot {
+            plot_energies(&w.dir.join("energy.png"), &name, &state.history)
+                .map_err(|e| anyhow::anyhow!("cannot draw energy.png: {e}"))?;
+        }
+    }
+    if let Stop::Unstable(_) = stop {
+        let kept = opts
+            .out
+            .as_ref()
+            .map(|d| format!("; files written so far are kept in {}", d.display()))
+            .unwrap_or_default();
+        return Err(anyhow::anyhow!(
+            "{}{kept}",
+            message.expect("unstable runs have a message")
+        ));
+    }
+    Ok(Outcome {
+        summary,
+        history: state.history,
+        snapshot: snapshot.map(|s| s.0),
+    })
+}
+
+fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
+    let pick = |f: &dyn Fn(&Row) -> f64| h.rows.iter().map(|r| (r.time, f(r))).collect();
+    let series = [
+        Series {
+            label: "kinetic",
+            points: pick(&|r| r.energies.kinetic),
+        },
+        Series {
+            label: "strain",
+            points: pick(&|r| r.energies.strain),
+        },
+        Series {
+            label: "external work",
+            points: pick(&|r| r.energies.external_work),
+        },
+        Series {
+            label: "damping work",
+            points: pick(&|r| r.energies.damping_work),
+        },
+        Series {
+            label: "K + W - W_ext + W_damp",
+            points: pick(&|r| {
+                let e = &r.energies;
+                e.kinetic + e.strain - e.external_work + e.damping_work
+            }),
+        },
+    ];
+    plot::lines(
+        path,
+        &format!("{name}: energies"),
+        "time (s)",
+        "energy (J)",
+        &series,
+    )
+}

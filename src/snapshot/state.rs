@@ -1,0 +1,241 @@
+//! A run's state as snapshot columns, and back. The scene is rebuilt from the stored scenario
+//! text (loads, boundaries, probes, grid) and the evolving state is then put back from the
+//! columns; grid scratch and particle bins are rebuilt by the first step.
+
+use super::format::{ColumnSet, Header, Reader, SnapshotError};
+use crate::dim::Dim;
+use crate::material::Elastic;
+use crate::measure::{History, Row};
+use crate::run::state::RunState;
+use crate::scenario::{Scene, Source, build};
+use crate::world::{Energies, World};
+use std::path::Path;
+use xxhash_rust::xxh3::xxh3_64;
+
+/// Scalars per history row in the `history.rows.data` column.
+const ROW_WIDTH: usize = 12;
+
+fn row_data(r: &Row) -> [f64; ROW_WIDTH] {
+    let e = &r.energies;
+    [
+        r.time,
+        e.kinetic,
+        e.strain,
+        e.external_work,
+        e.damping_work,
+        r.momentum[0],
+        r.momentum[1],
+        r.momentum[2],
+        r.momentum_scale,
+        r.angular[0],
+        r.angular[1],
+        r.angular[2],
+    ]
+}
+
+fn row_from(step: u64, d: &[f64]) -> Row {
+    Row {
+        step,
+        time: d[0],
+        energies: Energies {
+            kinetic: d[1],
+            strain: d[2],
+            external_work: d[3],
+            damping_work: d[4],
+        },
+        momentum: [d[5], d[6], d[7]],
+        momentum_scale: d[8],
+        angular: [d[9], d[10], d[11]],
+    }
+}
+
+/// Writes `world` and `state` of the run of `src` to `path` (atomically); returns the bytes.
+pub fn write<D: Dim>(
+    path: &Path,
+    src: &Source,
+    world: &World<D>,
+    state: &RunState,
+) -> std::io::Result<u64> {
+    let p = &world.particles;
+    let m = &world.materials;
+    let youngs: Vec<f64> = m.iter().map(|m| m.youngs).collect();
+    let poisson: Vec<f64> = m.iter().map(|m| m.poisson).collect();
+    let density: Vec<f64> = m.iter().map(|m| m.density).collect();
+    let run = [world.work.external, world.work.damping];
+    let cadence = [state.next_history, state.next_frame, state.next_checkpoint];
+    let h = &state.history;
+    let row_steps: Vec<u64> = h.rows.iter().map(|r| r.step).collect();
+    let rows: Vec<f64> = h.rows.iter().flat_map(row_data).collect();
+    let probe_names: Vec<String> = (0..h.probes.len())
+        .map(|k| format!("history.probe.{k}"))
+        .collect();
+
+    let mut c = ColumnSet::default();
+    c.add("scenario.toml", src.text.as_bytes());
+    c.add("scenario.file", src.file.as_bytes());
+    c.add("particles.x", &p.x);
+    c.add("particles.v", &p.v);
+    c.add("particles.u", &p.u);
+    c.add("particles.mass", &p.mass);
+    c.add("particles.volume", &p.volume);
+    c.add("particles.stress", &p.stress);
+    c.add("particles.grad_v", &p.grad_v);
+    c.add("particles.material", &p.material);
+    c.add("particles.half", &p.half);
+    c.add("materials.youngs", &youngs);
+    c.add("materials.poisson", &poisson);
+    c.add("materials.density", &density);
+    c.add("run.work", &run[..]);
+    c.add("run.cadence", &cadence[..]);
+    c.add("run.centre", &state.centre[..]);
+    c.add("run.frames", &state.frames);
+    c.add("history.time", &h.time);
+    for (name, series) in probe_names.iter().zip(&h.probes) {
+        c.add(name, series);
+    }
+    c.add("history.rows.step", &row_steps);
+    c.add("history.rows.data", &rows);
+    let header = Header {
+        dimension: D::D as u8,
+        particles: p.len() as u64,
+        nodes: world.grid.geom.node_count() as u64,
+        step: world.step,
+        time: world.time,
+        dt: world.settings.dt,
+        scenario: src.name(),
+        scenario_hash: xxh3_64(src.text.as_bytes()),
+        build: env!("CARGO_PKG_VERSION").to_string(),
+        data_len: 0,
+        columns: Vec::new(),
+    };
+    let bytes = c.bytes();
+    c.write(path, header)?;
+    Ok(bytes)
+}
+
+/// A run put back together from a snapshot.
+pub struct Restored<D: Dim> {
+    /// The stored scenario.
+    pub source: Source,
+    /// The scene rebuilt from it, with the stored state in its World.
+    pub scene: Scene<D>,
+    /// The run-loop state.
+    pub state: RunState,
+}
+
+/// Rebuilds the run stored in `r` as a `D`-dimensional run.
+pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
+    let h = r.header.clone();
+    if h.dimension as usize != D::D {
+        return Err(r
+            .invalid(format!(
+                "the snapshot is from a {}D run; it cannot be resumed as {}D",
+                h.dimension,
+                D::D
+            ))
+            .into());
+    }
+    let build_version = env!("CARGO_PKG_VERSION");
+    if h.build != build_version {
+        return Err(r
+            .invalid(format!(
+                "written by fissure {}, this is {build_version}; resume with the build that wrote it \
+                 (a bit-exact continuation needs the same code)",
+                h.build
+            ))
+            .into());
+    }
+    let text = utf8(r, "scenario.toml")?;
+    if xxh3_64(text.as_bytes()) != h.scenario_hash {
+        return Err(r
+            .invalid("the stored scenario does not match its hash in the header")
+            .into());
+    }
+    let file = utf8(r, "scenario.file")?;
+    let source = Source::parse(&file, &text, &[])?;
+    let mut scene = build::<D>(&source)?;
+    let w = &mut scene.world;
+    let n = w.particles.len();
+    if n as u64 != h.particles || w.grid.geom.node_count() as u64 != h.nodes {
+        return Err(r
+            .invalid(format!(
+                "the stored scenario builds {n} particles and {} nodes, the snapshot holds {} and {}",
+                w.grid.geom.node_count(),
+                h.particles,
+                h.nodes
+            ))
+            .into());
+    }
+    if w.settings.dt.to_bits() != h.dt.to_bits() {
+        return Err(r
+            .invalid(format!(
+                "the stored scenario gives dt = {:e} s, the snapshot {:e} s",
+                w.settings.dt, h.dt
+            ))
+            .into());
+    }
+    let p = &mut w.particles;
+    p.x = r.column("particles.x", n)?;
+    p.v = r.column("particles.v", n)?;
+    p.u = r.column("particles.u", n)?;
+    p.mass = r.column("particles.mass", n)?;
+    p.volume = r.column("particles.volume", n)?;
+    p.stress = r.column("particles.stress", n)?;
+    p.grad_v = r.column("particles.grad_v", n)?;
+    p.material = r.column("particles.material", n)?;
+    p.half = r.column("particles.half", if p.half.is_empty() { 0 } else { n })?;
+    let nm = w.materials.len();
+    let youngs: Vec<f64> = r.column("materials.youngs", nm)?;
+    let poisson: Vec<f64> = r.column("materials.poisson", nm)?;
+    let density: Vec<f64> = r.column("materials.density", nm)?;
+    for (k, m) in w.materials.iter_mut().enumerate() {
+        *m = Elastic::new(&m.name, youngs[k], poisson[k], density[k]);
+    }
+    let run: Vec<f64> = r.column("run.work", 2)?;
+    w.work.external = run[0];
+    w.work.damping = run[1];
+    w.time = h.time;
+    w.step = h.step;
+    w.tiles.fresh = false;
+
+    let cadence: Vec<f64> = r.column("run.cadence", 3)?;
+    let centre: Vec<f64> = r.column("run.centre", 3)?;
+    let samples = h
+        .step
+        .checked_add(1)
+        .ok_or_else(|| r.invalid("step count overflows"))? as usize;
+    let mut history = History {
+        time: r.column("history.time", samples)?,
+        ..History::default()
+    };
+    for k in 0..scene.probes.len() {
+        history
+            .probes
+            .push(r.column(&format!("history.probe.{k}"), samples)?);
+    }
+    let steps: Vec<u64> = r.column_any("history.rows.step")?;
+    let data: Vec<f64> = r.column("history.rows.data", steps.len() * ROW_WIDTH)?;
+    history.rows = steps
+        .iter()
+        .zip(data.chunks_exact(ROW_WIDTH))
+        .map(|(&s, d)| row_from(s, d))
+        .collect();
+    let state = RunState {
+        history,
+        next_history: cadence[0],
+        next_frame: cadence[1],
+        next_checkpoint: cadence[2],
+        frames: r.column_any("run.frames")?,
+        centre: [centre[0], centre[1], centre[2]],
+    };
+    Ok(Restored {
+        source,
+        scene,
+        state,
+    })
+}
+
+fn utf8(r: &mut Reader, name: &str) -> Result<String, SnapshotError> {
+    let bytes: Vec<u8> = r.column_any(name)?;
+    String::from_utf8(bytes).map_err(|_| r.invalid(format!("column `{name}` is not UTF-8 text")))
+}

@@ -1,0 +1,381 @@
+//! Snapshots: a run stopped at step k and resumed matches the uninterrupted run bit for bit;
+//! damaged or foreign files are refused with a message naming the problem; hostile or
+//! mutated files never panic the reader.
+
+mod common;
+use common::{mixed_scene, source};
+use fissure::dim::{D2, D3};
+use fissure::run::{Outcome, RunOptions, resume, run};
+use fissure::snapshot::Reader;
+use fissure::snapshot::format::{FORMAT_VERSION, Header, MAGIC};
+use fissure::snapshot::state::restore;
+use proptest::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// A fresh, empty folder under the system temp folder.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fissure-snap-{}-{name}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The mixed scene with a probe, a history row every step, VTK frames and checkpoints.
+fn scene(dim: usize, shape: &str, update: &str) -> String {
+    let v = |a: f64, b: f64| common::v(dim, a, b);
+    format!(
+        r#"{}
+[[probe]]
+name = "box_vx"
+region = {{ min = {}, max = {} }}
+quantity = "velocity"
+component = "x"
+[output]
+history_interval = 1e-8
+interval = 2e-6
+[checkpoint]
+every_steps = 7
+keep = 3
+"#,
+        mixed_scene(dim, shape, update),
+        v(0.002, 0.002),
+        v(0.04, 0.012)
+    )
+}
+
+fn opts(out: &Path, threads: usize) -> RunOptions {
+    RunOptions {
+        out: Some(out.to_path_buf()),
+        threads,
+        ..RunOptions::default()
+    }
+}
+
+fn read(path: &Path) -> Vec<u8> {
+    std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Name of the highest-numbered VTK frame in `dir`.
+fn newest_frame(dir: &Path) -> String {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".vtu"))
+        .max()
+        .expect("the run wrote frames")
+}
+
+/// Runs `text` through, and again stopped after `k` steps then resumed with `threads`
+/// threads into a new folder; every output file and the final snapshot must match.
+fn restart_is_bit_exact(text: &str, k: u64, threads: usize, name: &str) {
+    let dir = scratch(name);
+    let src = source(text);
+    let full = run(&src, &opts(&dir.join("full"), threads)).unwrap();
+    let part = run(
+        &src,
+        &RunOptions {
+            pause_after: Some(k),
+            ..opts(&dir.join("part"), 1)
+        },
+    )
+    .unwrap();
+    assert_eq!(part.summary.status, "interrupted");
+    assert_eq!(part.summary.steps, k);
+    let snap = part.snapshot.expect("a stopped run writes a snapshot");
+    let resumed: Outcome = resume(&snap, &opts(&dir.join("resumed"), threads)).unwrap();
+    assert_eq!(resumed.summary.status, "completed");
+    let steps = full.summary.steps;
+    assert_eq!(resumed.summary.steps, steps);
+    assert!(k < steps && steps > 20, "the stop falls inside the run");
+
+    let last_frame = newest_frame(&dir.join("full"));
+    let final_snap = format!("snapshots/step_{steps:012}.fsnap");
+    for f in [
+        "energy.csv",
+        "probes.csv",
+        "particles.pvd",
+        &last_frame,
+        &final_snap,
+    ] {
+        assert!(
+            read(&dir.join("full").join(f)) == read(&dir.join("resumed").join(f)),
+            "{name}: {f} differs between the uninterrupted and the resumed run"
+        );
+    }
+    assert_eq!(full.history.rows.len(), resumed.history.rows.len());
+    let values = |o: &Outcome| -> Vec<u64> {
+        let e = &o.summary.energies;
+        vec![
+            e.kinetic.to_bits(),
+            e.strain.to_bits(),
+            e.external_work.to_bits(),
+        ]
+    };
+    assert_eq!(values(&full), values(&resumed));
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn restart_is_bit_exact_2d_one_and_two_threads() {
+    let text = scene(2, "ugimp", "usavg");
+    restart_is_bit_exact(&text, 33, 1, "2d-1");
+    restart_is_bit_exact(&text, 33, 2, "2d-2");
+}
+
+#[test]
+fn restart_is_bit_exact_3d_one_and_two_threads() {
+    let text = scene(3, "bspline", "usl").replace("duration = 1e-5", "duration = 4e-6");
+    restart_is_bit_exact(&text, 19, 1, "3d-1");
+    restart_is_bit_exact(&text, 19, 2, "3d-2");
+}
+
+/// Periodic snapshots land on multiples of `every_steps`, the last step gets one, and only
+/// the newest `keep` remain.
+#[test]
+fn checkpoint_cadence_and_keep() {
+    let dir = scratch("keep");
+    let text = scene(2, "linear", "usf");
+    let out = run(&source(&text), &opts(&dir, 1)).unwrap();
+    let steps = out.summary.steps;
+    let mut names: Vec<String> = std::fs::read_dir(dir.join("snapshots"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let k = steps / 7 * 7;
+    let want: Vec<String> = [k - 7, k, steps]
+        .iter()
+        .map(|s| format!("step_{s:012}.fsnap"))
+        .collect();
+    assert_eq!(names, want, "{steps} steps");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// A valid 2D snapshot (written once per test binary).
+fn sample() -> &'static (PathBuf, Vec<u8>) {
+    static SAMPLE: OnceLock<(PathBuf, Vec<u8>)> = OnceLock::new();
+    SAMPLE.get_or_init(|| {
+        let dir = scratch("sample");
+        let text = scene(2, "ugimp", "usavg").replace("duration = 1e-5", "duration = 1e-6");
+        let out = run(&source(&text), &opts(&dir, 1)).unwrap();
+        let path = out.snapshot.unwrap();
+        let bytes = read(&path);
+        (path, bytes)
+    })
+}
+
+/// Writes `bytes` as a snapshot file named `name` and returns the error opening and
+/// restoring it gives (as text).
+fn refusal(name: &str, bytes: &[u8]) -> String {
+    let dir = scratch(name);
+    let path = dir.join("bad.fsnap");
+    std::fs::write(&path, bytes).unwrap();
+    let err = match Reader::open(&path) {
+        Err(e) => e.to_string(),
+        Ok(mut r) => match restore::<D2>(&mut r) {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("{name}: the damaged snapshot was accepted"),
+        },
+    };
+    assert!(err.contains("bad.fsnap"), "{name}: names the file: {err}");
+    std::fs::remove_dir_all(dir).ok();
+    err
+}
+
+#[test]
+fn refuses_a_truncated_file() {
+    let bytes = &sample().1;
+    let err = refusal("truncated", &bytes[..bytes.len() - 1000]);
+    assert!(err.contains("truncated"), "{err}");
+}
+
+#[test]
+fn refuses_a_flipped_byte_naming_the_column() {
+    let (path, bytes) = sample();
+    let at = Reader::open(path)
+        .unwrap()
+        .offset_of("particles.v")
+        .unwrap() as usize
+        + 13;
+    let mut bad = bytes.clone();
+    bad[at] ^= 0x10;
+    let err = refusal("flipped", &bad);
+    assert!(
+        err.contains("`particles.v`") && err.contains("checksum"),
+        "{err}"
+    );
+}
+
+#[test]
+fn refuses_a_damaged_header() {
+    let mut bad = sample().1.clone();
+    bad[30] ^= 0x01;
+    let err = refusal("header", &bad);
+    assert!(err.contains("corrupt"), "{err}");
+}
+
+#[test]
+fn refuses_wrong_magic() {
+    let mut bad = sample().1.clone();
+    bad[0] = b'X';
+    let err = refusal("magic", &bad);
+    assert!(err.contains("wrong magic"), "{err}");
+}
+
+#[test]
+fn refuses_a_newer_format_version() {
+    let mut bad = sample().1.clone();
+    bad[8..12].copy_from_slice(&(FORMAT_VERSION + 1).to_le_bytes());
+    let err = refusal("version", &bad);
+    assert!(err.contains("newer"), "{err}");
+}
+
+#[test]
+fn refuses_a_3d_snapshot_resumed_as_2d() {
+    let dir = scratch("dims");
+    let text = scene(3, "ugimp", "usf").replace("duration = 1e-5", "duration = 3e-7");
+    let out = run(&source(&text), &opts(&dir, 1)).unwrap();
+    let mut r = Reader::open(&out.snapshot.unwrap()).unwrap();
+    let err = restore::<D2>(&mut r).err().unwrap().to_string();
+    assert!(err.contains("3D run") && err.contains("as 2D"), "{err}");
+    assert!(restore::<D3>(&mut r).is_ok());
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn refuses_a_missing_file() {
+    let err = resume(Path::new("no/such/snapshot.fsnap"), &RunOptions::default())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("no/such/snapshot.fsnap") && err.contains("cannot read"),
+        "{err}"
+    );
+}
+
+/// A header whose checksum is right but whose counts are absurd is refused before any
+/// allocation of that size.
+#[test]
+fn hostile_header_counts_are_capped_by_the_file_size() {
+    let mut header: Header = Reader::open(&sample().0).unwrap().header;
+    header.columns[2].len = 1 << 60;
+    let head = postcard::to_stdvec(&header).unwrap();
+    let mut bytes = MAGIC.to_vec();
+    bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    bytes.extend_from_slice(&(head.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(&head);
+    let sum = xxhash_rust::xxh3::xxh3_64(&bytes);
+    bytes.resize(bytes.len().div_ceil(8) * 8 + header.data_len as usize, 0);
+    bytes.extend_from_slice(&sum.to_le_bytes());
+    let err = refusal("hostile", &bytes);
+    assert!(err.contains("outside the file"), "{err}");
+}
+
+/// Reads a possibly damaged snapshot all the way; any outcome but a panic is fine.
+fn read_all(bytes: &[u8], path: &Path) {
+    std::fs::write(path, bytes).unwrap();
+    if let Ok(mut r) = Reader::open(path) {
+        let _ = r.verify();
+        let _ = restore::<D2>(&mut r);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    /// Random byte flips, a truncation and an insertion anywhere in the file.
+    #[test]
+    fn mutated_snapshots_never_panic(
+        flips in prop::collection::vec((any::<prop::sample::Index>(), 1u8..=255), 0..6),
+        cut in prop::option::of(any::<prop::sample::Index>()),
+        insert in prop::option::of((any::<prop::sample::Index>(), prop::collection::vec(any::<u8>(), 1..16))),
+    ) {
+        let mut bytes = sample().1.clone();
+        for (i, x) in &flips {
+            let at = i.index(bytes.len());
+            bytes[at] ^= x;
+        }
+        if let Some(c) = cut {
+            bytes.truncate(c.index(bytes.len()));
+        }
+        if let Some((i, ins)) = insert {
+            let at = i.index(bytes.len() + 1);
+            bytes.splice(at..at, ins);
+        }
+        read_all(&bytes, &fuzz_path());
+    }
+
+    /// Random edits of the header with its checksum recomputed, so the decoder and the
+    /// column-table checks see garbage that passes the checksum.
+    #[test]
+    fn mutated_headers_with_valid_checksums_never_panic(
+        flips in prop::collection::vec((any::<prop::sample::Index>(), 1u8..=255), 1..6),
+    ) {
+        let mut bytes = sample().1.clone();
+        let head_len = u64::from_le_bytes(bytes[12..20].try_into().unwrap()) as usize;
+        for (i, x) in &flips {
+            let at = 12 + i.index(head_len + 8);
+            bytes[at] ^= x;
+        }
+        let end = (20 + head_len).min(bytes.len() - 8);
+        let sum = xxhash_rust::xxh3::xxh3_64(&bytes[..end]);
+        let n = bytes.len();
+        bytes[n - 8..].copy_from_slice(&sum.to_le_bytes());
+        read_all(&bytes, &fuzz_path());
+    }
+}
+
+/// A scratch file for one fuzz case.
+fn fuzz_path() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fissure-snap-{}-fuzz", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(format!("{:?}.fsnap", std::thread::current().id()))
+}
+
+/// A run that goes unstable keeps its last good (finite) snapshot and names it.
+#[test]
+fn unstable_run_names_its_last_good_snapshot() {
+    let text = r#"
+[simulation]
+dimension = 2
+duration = 1e-3
+[grid]
+min = [0.0, 0.0]
+max = [0.02, 0.02]
+cell = [0.002, 0.002]
+[[material]]
+name = "m"
+E = 1e9
+nu = 0.3
+rho = 1000.0
+[[body]]
+material = "m"
+box = { min = [0.006, 0.006], max = [0.014, 0.014] }
+[[load]]
+region = { min = [0.006, 0.006], max = [0.008, 0.014] }
+force = [-1e7, 0.0]
+[output]
+history_interval = 1e-6
+vtk = false
+plot = false
+[checkpoint]
+every_steps = 2
+"#;
+    let dir = scratch("unstable");
+    let err = run(&source(text), &opts(&dir, 1))
+        .expect_err("must go unstable")
+        .to_string();
+    let named = err
+        .split("last good snapshot ")
+        .nth(1)
+        .and_then(|s| s.split(" (step").next())
+        .unwrap_or_else(|| panic!("no snapshot named: {err}"));
+    let mut r = Reader::open(Path::new(named)).unwrap();
+    let restored = restore::<D2>(&mut r).unwrap();
+    let p = &restored.scene.world.particles;
+    assert!(p.x.iter().chain(&p.v).all(|v| v.is_finite()));
+    assert_eq!(restored.scene.world.step, 4, "unstable at step 5: {err}");
+    std::fs::remove_dir_all(dir).ok();
+}
