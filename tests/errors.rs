@@ -156,3 +156,16 @@ fn launcher_exits_with_code_2_on_bad_input() {
     assert_eq!(missing.status.code(), Some(2));
     std::fs::remove_dir_all(dir).ok();
 }
+
+#[test]
+fn bad_checkpoint_settings_name_the_key() {
+    let e = error_with(&["checkpoint.keep=0"]);
+    assert_error(&e, "checkpoint.keep", None, "at least 1");
+    let e = error_with(&["checkpoint.every_time=-1e-6"]);
+    assert_error(&e, "checkpoint.every_time", None, "positive");
+    let e = error_with(&["checkpoint.every_steps=0"]);
+    assert_error(&e, "checkpoint.every_steps", None, "at least 1");
+    let e = Source::parse("bad.toml", &format!("{GOOD}[checkpoint]\nevery = 3\n"), &[])
+        .expect_err("unknown key");
+    assert!(e.to_string().contains("every") && e.line == Some(19), "{e}");
+}

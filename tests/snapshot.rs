@@ -283,8 +283,7 @@ fn read_all(bytes: &[u8], path: &Path) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
-
+    // 256 cases each by default; PROPTEST_CASES=100000 for a longer fuzzing session.
     /// Random byte flips, a truncation and an insertion anywhere in the file.
     #[test]
     fn mutated_snapshots_never_panic(
@@ -377,5 +376,72 @@ every_steps = 2
     let p = &restored.scene.world.particles;
     assert!(p.x.iter().chain(&p.v).all(|v| v.is_finite()));
     assert_eq!(restored.scene.world.step, 4, "unstable at step 5: {err}");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// `until` extends a finished run from its final snapshot, and refuses an end time that
+/// is not after the snapshot's time.
+#[test]
+fn resume_until_extends_a_finished_run() {
+    let dir = scratch("until");
+    let text = scene(2, "linear", "usf").replace("duration = 1e-5", "duration = 2e-6");
+    let first = run(&source(&text), &opts(&dir, 1)).unwrap();
+    let snap = first.snapshot.unwrap();
+    let early = RunOptions {
+        until: Some(1e-6),
+        ..opts(&dir, 1)
+    };
+    let err = resume(&snap, &early).err().unwrap().to_string();
+    assert!(err.contains("must be after the current time"), "{err}");
+    let later = RunOptions {
+        until: Some(3e-6),
+        ..opts(&dir, 1)
+    };
+    let more = resume(&snap, &later).unwrap();
+    let dt = more.summary.dt;
+    assert_eq!(more.summary.status, "completed");
+    assert_eq!(more.summary.steps, (3e-6 / dt).ceil() as u64);
+    assert!(more.summary.steps > first.summary.steps);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// `fissure inspect` verifies every column: exit 0 on a good file; on a damaged column it
+/// names it and exits 2; `fissure resume` of a missing file exits 2.
+#[test]
+fn inspect_reports_checksums_and_exit_codes() {
+    let (path, bytes) = sample();
+    let fissure = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let good = fissure(&["inspect", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&good.stdout);
+    assert_eq!(good.status.code(), Some(0), "{text}");
+    assert!(
+        text.contains("column checksums ok") && text.contains("2D"),
+        "{text}"
+    );
+
+    let dir = scratch("inspect");
+    let bad_path = dir.join("bad.fsnap");
+    let at = Reader::open(path)
+        .unwrap()
+        .offset_of("particles.stress")
+        .unwrap() as usize;
+    let mut bad = bytes.clone();
+    bad[at + 3] ^= 0x04;
+    std::fs::write(&bad_path, &bad).unwrap();
+    let out = fissure(&["inspect", bad_path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("particles.stress"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(line.ends_with("MISMATCH"), "{text}");
+    let missing = fissure(&["resume", dir.join("none.fsnap").to_str().unwrap()]);
+    assert_eq!(missing.status.code(), Some(2));
     std::fs::remove_dir_all(dir).ok();
 }

@@ -85,7 +85,10 @@ impl Checkpointer {
 
     /// Whether a snapshot is due after the step just taken; advances the time mark.
     pub fn due(&mut self, step: u64, time: f64, state: &mut RunState) -> bool {
-        let by_steps = self.plan.every_steps.is_some_and(|n| step.is_multiple_of(n));
+        let by_steps = self
+            .plan
+            .every_steps
+            .is_some_and(|n| step.is_multiple_of(n));
         let by_time = time >= state.next_checkpoint * (1.0 - 1e-9);
         if by_time && let Some(t) = self.plan.every_time {
             while state.next_checkpoint <= time * (1.0 + 1e-9) {
