@@ -63,7 +63,8 @@ pub struct Schedule {
 
 impl Schedule {
     /// The systems this scene needs, in order. USF updates stress before the internal
-    /// forces; USL after the particles move (on remapped momenta); USAVG does half of each.
+    /// forces; USL after the particles move (on momenta remapped with the start-of-step
+    /// shape functions); USAVG does half of each.
     /// Prescribed velocities add `grid_bc` after each scatter of momenta.
     pub fn for_world<D: Dim>(world: &World<D>) -> Self {
         use System::*;
@@ -82,7 +83,7 @@ impl Schedule {
         }
         s.extend([GridUpdate, G2p]);
         if update != Update::Usf {
-            s.extend([Bin, Remap]);
+            s.push(Remap);
             if bc {
                 s.push(MomentumBc { end: true });
             }

@@ -49,19 +49,28 @@ impl<'a, D: Dim> NodeWriter<'a, D> {
         unsafe { *self.force.add(n) += f };
     }
 
-    /// Adds mass and momentum only to node `n`.
+    /// Adds mass to node `n`.
     ///
     /// # Safety
     /// No other thread may access node `n` during the call.
     #[inline(always)]
-    unsafe fn add_mass(&self, n: usize, m: f64, p: D::Vec) {
+    unsafe fn add_mass(&self, n: usize, m: f64) {
         assert!(n < self.len);
         // SAFETY: n is in bounds (checked above) and the caller guarantees exclusive access
         // to node n.
-        unsafe {
-            *self.mass.add(n) += m;
-            *self.momentum.add(n) += p;
-        }
+        unsafe { *self.mass.add(n) += m };
+    }
+
+    /// Adds momentum to node `n`.
+    ///
+    /// # Safety
+    /// No other thread may access node `n` during the call.
+    #[inline(always)]
+    unsafe fn add_momentum(&self, n: usize, p: D::Vec) {
+        assert!(n < self.len);
+        // SAFETY: n is in bounds (checked above) and the caller guarantees exclusive access
+        // to node n.
+        unsafe { *self.momentum.add(n) += p };
     }
 }
 
@@ -70,32 +79,35 @@ impl<'a, D: Dim> NodeWriter<'a, D> {
 pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
     world.grid.force.par_iter_mut().for_each(|f| *f = D::zero());
     if internal {
-        scatter::<D, true, true>(world);
+        scatter::<D, true, true, true>(world);
     } else {
-        scatter::<D, true, false>(world);
+        scatter::<D, true, true, false>(world);
     }
     scatter_loads(world);
 }
 
-/// Re-scatters mass and the updated particle momenta at the new positions, so that the
-/// final stress update reads grid velocities that are mass-weighted averages of particle
-/// velocities (the modified USL of Sulsky, Zhou & Schreyer 1995). Without it, nodes with a
-/// tiny share of mass get huge velocities and linear shape functions go unstable.
+/// Re-scatters the updated particle momenta with the start-of-step shape functions, so
+/// that the final stress update reads grid velocities that are mass-weighted averages of
+/// particle velocities (the modified USL of Sulsky, Zhou & Schreyer 1995). Without it,
+/// nodes with a tiny share of mass get huge velocities and linear shape functions go
+/// unstable. The nodal masses are those of `p2g` (same particles, same weights).
 pub fn remap<D: Dim>(world: &mut World<D>) {
-    scatter::<D, true, false>(world);
+    scatter::<D, false, true, false>(world);
 }
 
 /// Scatters the internal force -V sigma . grad S alone (USF and USAVG, after the first
 /// stress update).
 pub fn internal_force<D: Dim>(world: &mut World<D>) {
-    scatter::<D, false, true>(world);
+    scatter::<D, false, false, true>(world);
 }
 
 /// One scatter pass over the tiles, colour class by colour class (Guo & Nairn 2D (2004)
-/// Eqs. 3 and 6, single velocity field): mass and momentum (zeroed first) when `MASS`, the
-/// internal force -V sigma . grad S when `FORCE`. Compile-time flags keep the hot loop
-/// free of branches.
-fn scatter<D: Dim, const MASS: bool, const FORCE: bool>(world: &mut World<D>) {
+/// Eqs. 3 and 6, single velocity field): mass when `MASS`, momentum when `MOMENTUM` (each
+/// zeroed first), the internal force -V sigma . grad S when `FORCE`. Compile-time flags
+/// keep the hot loop free of branches.
+fn scatter<D: Dim, const MASS: bool, const MOMENTUM: bool, const FORCE: bool>(
+    world: &mut World<D>,
+) {
     let Grid {
         geom,
         mass,
@@ -105,6 +117,8 @@ fn scatter<D: Dim, const MASS: bool, const FORCE: bool>(world: &mut World<D>) {
     } = &mut world.grid;
     if MASS {
         mass.par_iter_mut().for_each(|m| *m = 0.0);
+    }
+    if MOMENTUM {
         momentum.par_iter_mut().for_each(|m| *m = D::zero());
     }
     let writer = NodeWriter::<D>::new(mass, momentum, force);
@@ -128,7 +142,10 @@ fn scatter<D: Dim, const MASS: bool, const FORCE: bool>(world: &mut World<D>) {
                     // each tile is handled by one thread.
                     unsafe {
                         if MASS {
-                            writer.add_mass(row + a, mq * w, mvq * w);
+                            writer.add_mass(row + a, mq * w);
+                        }
+                        if MOMENTUM {
+                            writer.add_momentum(row + a, mvq * w);
                         }
                         if FORCE {
                             writer.add_force(row + a, sxq * dw + syz * w);

@@ -55,7 +55,7 @@ fn usf_without_boundaries_has_no_remap_and_no_grid_bc() {
 fn usl_remaps_before_its_stress_update() {
     assert_eq!(
         names("", "usl"),
-        ["bin", "p2g", "grid_update", "g2p", "bin", "remap", "stress"]
+        ["bin", "p2g", "grid_update", "g2p", "remap", "stress"]
     );
 }
 
@@ -72,7 +72,6 @@ fn boundaries_add_grid_bc_after_each_momentum_scatter() {
             "internal_force",
             "grid_update",
             "g2p",
-            "bin",
             "remap",
             "grid_bc",
             "stress"
