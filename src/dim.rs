@@ -68,6 +68,19 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     fn yz(gy: f64, gz: f64) -> Self::Vec;
     /// Gradient of the tensor-product shape function for stencil offsets (i, j, k).
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, k: usize) -> Self::Vec;
+    /// Whether the line from `p` to `q` crosses crack element `e` of vertices `v` (2D: the
+    /// segment e[0]-e[1]; 3D: the triangle e[0], e[1], e[2]): +1 if `p` is above it (left of
+    /// the segment's direction; on the side of the triangle's counterclockwise normal), -1
+    /// if below, 0 if there is no crossing. Exact orientation predicates (Shewchuk's, from
+    /// `robust`); a point exactly on the crack line or plane counts as above, so a line
+    /// through a vertex shared by two segments crosses exactly one of them.
+    fn crossing(p: Self::Vec, q: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8;
+}
+
+/// +1 for a non-negative orientation, -1 otherwise (the tie rule of [`Dim::crossing`]).
+#[inline(always)]
+fn side(o: f64) -> i8 {
+    if o >= 0.0 { 1 } else { -1 }
 }
 
 /// Two dimensions (plane strain or plane stress).
@@ -140,6 +153,19 @@ impl Dim for D2 {
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, _k: usize) -> DVec2 {
         DVec2::new(dw[0][i] * w[1][j], w[0][i] * dw[1][j])
     }
+    fn crossing(p: DVec2, q: DVec2, v: &[DVec2], e: [u32; 3]) -> i8 {
+        let c = |u: DVec2| robust::Coord { x: u.x, y: u.y };
+        let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
+        let sp = side(robust::orient2d(c(a), c(b), c(p)));
+        if sp == side(robust::orient2d(c(a), c(b), c(q))) {
+            return 0;
+        }
+        let sa = side(robust::orient2d(c(p), c(q), c(a)));
+        if sa == side(robust::orient2d(c(p), c(q), c(b))) {
+            return 0;
+        }
+        sp
+    }
 }
 
 impl Dim for D3 {
@@ -211,5 +237,22 @@ impl Dim for D3 {
             w[0][i] * dw[1][j] * w[2][k],
             w[0][i] * w[1][j] * dw[2][k],
         )
+    }
+    fn crossing(p: DVec3, q: DVec3, v: &[DVec3], e: [u32; 3]) -> i8 {
+        let c = |u: DVec3| robust::Coord3D {
+            x: u.x,
+            y: u.y,
+            z: u.z,
+        };
+        let [a, b, t] = e.map(|k| c(v[k as usize]));
+        // robust::orient3d is positive below the plane of a counterclockwise triangle.
+        let sp = side(-robust::orient3d(a, b, t, c(p)));
+        if sp == side(-robust::orient3d(a, b, t, c(q))) {
+            return 0;
+        }
+        let s1 = side(robust::orient3d(c(p), c(q), a, b));
+        let s2 = side(robust::orient3d(c(p), c(q), b, t));
+        let s3 = side(robust::orient3d(c(p), c(q), t, a));
+        if s1 == s2 && s2 == s3 { sp } else { 0 }
     }
 }

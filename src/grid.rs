@@ -110,6 +110,16 @@ impl<D: Dim> Grid<D> {
         }
     }
 
+    /// Sizes the columns for the grid nodes plus `extra` crack-field rows after them.
+    pub fn set_extra_fields(&mut self, extra: usize) {
+        let n = self.geom.node_count() + extra;
+        self.mass.resize(n, 0.0);
+        self.momentum.resize(n, D::zero());
+        self.force.resize(n, D::zero());
+        self.velocity.resize(n, D::zero());
+        self.accel.resize(n, D::zero());
+    }
+
     /// Bytes held per node by the store's columns.
     pub fn bytes_per_node() -> usize {
         std::mem::size_of::<f64>() + 4 * std::mem::size_of::<D::Vec>()

@@ -2,7 +2,7 @@
 
 use crate::dim::Dim;
 use crate::error::Unstable;
-use crate::systems::{bin, g2p, grid_update, p2g, stress};
+use crate::systems::{bin, classify, crack_advect, g2p, grid_update, p2g, stress};
 use crate::world::{Update, World};
 use std::time::Instant;
 
@@ -11,6 +11,10 @@ use std::time::Instant;
 pub enum System {
     /// Bin particles into tiles (skipped when the bins are still fresh).
     Bin,
+    /// Assign particle-node pairs near cracks to velocity fields.
+    Classify,
+    /// Move crack vertices and surfaces.
+    CrackAdvect,
     /// Scatter mass and momentum (and internal forces when `internal`) plus loads.
     P2g {
         /// Also scatter the internal force.
@@ -41,6 +45,8 @@ impl System {
     pub fn name(&self) -> &'static str {
         match self {
             System::Bin => "bin",
+            System::Classify => "classify",
+            System::CrackAdvect => "crack_advect",
             System::P2g { .. } => "p2g",
             System::MomentumBc { .. } => "grid_bc",
             System::Stress { .. } => "stress",
@@ -65,12 +71,17 @@ impl Schedule {
     /// The systems this scene needs, in order. USF updates stress before the internal
     /// forces; USL after the particles move (on momenta remapped with the start-of-step
     /// shape functions); USAVG does half of each.
-    /// Prescribed velocities add `grid_bc` after each scatter of momenta.
+    /// Prescribed velocities add `grid_bc` after each scatter of momenta; cracks add
+    /// `classify` after binning and `crack_advect` after the particles move.
     pub fn for_world<D: Dim>(world: &World<D>) -> Self {
         use System::*;
         let bc = !world.bcs.is_empty();
         let update = world.settings.update;
+        let cracks = world.cracks.is_some();
         let mut s = vec![Bin];
+        if cracks {
+            s.push(Classify);
+        }
         s.push(P2g {
             internal: update == Update::Usl,
         });
@@ -82,6 +93,9 @@ impl Schedule {
             s.extend([Stress { fraction }, InternalForce]);
         }
         s.extend([GridUpdate, G2p]);
+        if cracks {
+            s.push(CrackAdvect);
+        }
         if update != Update::Usf {
             s.push(Remap);
             if bc {
@@ -103,6 +117,8 @@ impl Schedule {
             let t0 = Instant::now();
             match *sys {
                 System::Bin => bin::run(world)?,
+                System::Classify => classify::run(world),
+                System::CrackAdvect => crack_advect::run(world),
                 System::P2g { internal } => p2g::run(world, internal),
                 System::MomentumBc { end } => grid_update::momentum_bc(world, end),
                 System::Stress { fraction } => stress::run(world, fraction),

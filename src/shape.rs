@@ -116,6 +116,22 @@ pub struct Stencil<const N: usize> {
 }
 
 impl<const N: usize> Stencil<N> {
+    /// As [`for_each`](Self::for_each), with each node replaced by its entry in `targets`
+    /// (a crack-aware particle's grid entries, in the same node order).
+    #[inline(always)]
+    pub fn for_each_target<D: Dim>(
+        &self,
+        stride: &[usize; 3],
+        targets: &[u32],
+        mut f: impl FnMut(usize, f64, D::Vec),
+    ) {
+        let mut l = 0;
+        self.for_each::<D>(stride, |_, w, g| {
+            f(targets[l] as usize, w, g);
+            l += 1;
+        });
+    }
+
     /// Calls `f(node, weight, gradient)` for every node of the stencil, in a fixed order.
     #[inline(always)]
     pub fn for_each<D: Dim>(&self, stride: &[usize; 3], mut f: impl FnMut(usize, f64, D::Vec)) {

@@ -1,5 +1,6 @@
 //! The World: every store, the materials, the scene settings, time and step. Nothing global.
 
+use crate::crack::Cracks;
 use crate::dim::Dim;
 use crate::grid::Grid;
 use crate::loads::{Load, VelocityBc};
@@ -87,6 +88,8 @@ pub struct World<D: Dim> {
     pub step: u64,
     /// Accumulated work.
     pub work: Work,
+    /// Explicit cracks and their velocity fields (None in a scene without cracks).
+    pub cracks: Option<Cracks<D>>,
 }
 
 /// Particles per chunk in parallel particle loops; fixed so reductions do not depend on

@@ -15,6 +15,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let grid = &world.grid;
     let geom = &grid.geom;
     let stencils = &world.tiles.stencils;
+    let fields = world.cracks.as_ref().map(|c| &c.fields);
     let Particles { x, v, u, .. } = &mut world.particles;
     (
         x.par_chunks_mut(CHUNK),
@@ -25,18 +26,26 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         .enumerate()
         .for_each(|(c, (x, v, u))| {
             with_nodes!(shape, N => for k in 0..x.len() {
-                let st = Stencil::<N>::cached::<D>(stencils, c * CHUNK + k);
+                let i = c * CHUNK + k;
+                let st = Stencil::<N>::cached::<D>(stencils, i);
                 let (mut dv, mut vn) = (D::zero(), D::zero());
-                st.for_each_row::<D>(&geom.stride, |row, q, _| {
-                    let (mut da, mut dn) = (D::zero(), D::zero());
-                    for a in 0..N {
-                        let w = st.w[0][a];
-                        da += grid.accel[row + a] * w;
-                        dn += grid.velocity[row + a] * w;
-                    }
-                    dv += da * q;
-                    vn += dn * q;
-                });
+                match fields.and_then(|f| f.targets_of(i)) {
+                    // Near a crack: each node's entry for this particle's field.
+                    Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, w, _| {
+                        dv += grid.accel[n] * w;
+                        vn += grid.velocity[n] * w;
+                    }),
+                    None => st.for_each_row::<D>(&geom.stride, |row, q, _| {
+                        let (mut da, mut dn) = (D::zero(), D::zero());
+                        for a in 0..N {
+                            let w = st.w[0][a];
+                            da += grid.accel[row + a] * w;
+                            dn += grid.velocity[row + a] * w;
+                        }
+                        dv += da * q;
+                        vn += dn * q;
+                    }),
+                }
                 v[k] += dv * dt;
                 x[k] += vn * dt;
                 u[k] += vn * dt;

@@ -1,6 +1,7 @@
 //! `grid_update`: nodal velocities and accelerations from momenta and forces, damping
 //! (Guo & Nairn 2D (2004) Eq. 5), gravity and prescribed velocities.
 
+use crate::crack::Fields;
 use crate::dim::Dim;
 use crate::grid::Grid;
 use crate::world::World;
@@ -14,12 +15,14 @@ const NODE_CHUNK: usize = 4096;
 pub fn momentum_bc<D: Dim>(world: &mut World<D>, end: bool) {
     let t = world.time + if end { world.settings.dt } else { 0.0 };
     let g = &mut world.grid;
+    let fields = world.cracks.as_ref().map(|c| &c.fields);
     for bc in &world.bcs {
-        for &n in &bc.nodes {
-            let n = n as usize;
-            for a in 0..D::D {
-                if bc.axes[a] {
-                    g.momentum[n][a] = g.mass[n] * bc.value(a, t);
+        for &node in &bc.nodes {
+            for n in entries(node, fields) {
+                for a in 0..D::D {
+                    if bc.axes[a] {
+                        g.momentum[n][a] = g.mass[n] * bc.value(a, t);
+                    }
                 }
             }
         }
@@ -75,19 +78,28 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     }
     let t1 = world.time + dt;
     let g = &mut world.grid;
+    let fields = world.cracks.as_ref().map(|c| &c.fields);
     for bc in &world.bcs {
-        for &n in &bc.nodes {
-            let n = n as usize;
-            if g.mass[n] <= tol {
-                continue;
-            }
-            let v0 = g.momentum[n] * (1.0 / g.mass[n]);
-            for a in 0..D::D {
-                if bc.axes[a] {
-                    g.velocity[n][a] = bc.value(a, t1);
-                    g.accel[n][a] = (g.velocity[n][a] - v0[a]) / dt;
+        for &node in &bc.nodes {
+            for n in entries(node, fields) {
+                if g.mass[n] <= tol {
+                    continue;
+                }
+                let v0 = g.momentum[n] * (1.0 / g.mass[n]);
+                for a in 0..D::D {
+                    if bc.axes[a] {
+                        g.velocity[n][a] = bc.value(a, t1);
+                        g.accel[n][a] = (g.velocity[n][a] - v0[a]) / dt;
+                    }
                 }
             }
         }
     }
+}
+
+/// Grid entries of `node`: the node and its crack fields' rows (every field obeys the
+/// node's boundary conditions).
+fn entries(node: u32, fields: Option<&Fields>) -> impl Iterator<Item = usize> {
+    let extra = fields.map_or(0..0, |f| f.rows_of(node));
+    std::iter::once(node as usize).chain(extra)
 }

@@ -1,6 +1,8 @@
 //! The systems, one file each, in pipeline order. Each is a plain function over the World.
 
 pub mod bin;
+pub mod classify;
+pub mod crack_advect;
 pub mod g2p;
 pub mod grid_update;
 pub mod p2g;

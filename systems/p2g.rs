@@ -1,9 +1,11 @@
 //! `p2g`: particle-to-grid scatter of mass, momentum and forces (Guo & Nairn 2D (2004)
 //! Eqs. 3-6, single velocity field), tile by tile in colour classes.
 
+use crate::crack::Fields;
 use crate::dim::Dim;
-use crate::grid::Grid;
-use crate::shape::Stencil;
+use crate::grid::{Grid, GridGeom};
+use crate::particles::Particles;
+use crate::shape::{ShapeKind, Stencil, StencilCache};
 use crate::with_nodes;
 use crate::world::World;
 use rayon::prelude::*;
@@ -125,9 +127,14 @@ fn scatter<D: Dim, const MASS: bool, const MOMENTUM: bool, const FORCE: bool>(
     let p = &world.particles;
     let shape = world.settings.shape;
     let geom = &*geom;
+    let fields = world.cracks.as_ref().map(|c| &c.fields);
     world.tiles.for_each_coloured(|t| {
         with_nodes!(shape, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
+            // Particles near a crack are scattered field by field afterwards.
+            if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+                continue;
+            }
             let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
             // Internal force split as in `Stencil::for_each_row`.
@@ -155,6 +162,42 @@ fn scatter<D: Dim, const MASS: bool, const MOMENTUM: bool, const FORCE: bool>(
             });
         })
     });
+    if let Some(f) = fields {
+        let stencils = &world.tiles.stencils;
+        let columns = (&mut mass[..], &mut momentum[..], &mut force[..]);
+        scatter_coded::<D, MASS, MOMENTUM, FORCE>(f, p, shape, stencils, columns, geom);
+    }
+}
+
+/// The scatter of the particles near a crack, each pair into its field's grid entry
+/// (Guo & Nairn 2D (2004) Eqs. 3 and 6), sequentially in particle order.
+fn scatter_coded<D: Dim, const MASS: bool, const MOMENTUM: bool, const FORCE: bool>(
+    fields: &Fields,
+    p: &Particles<D>,
+    shape: ShapeKind,
+    stencils: &StencilCache,
+    (mass, momentum, force): (&mut [f64], &mut [D::Vec], &mut [D::Vec]),
+    geom: &GridGeom<D>,
+) {
+    for &i in &fields.coded {
+        let i = i as usize;
+        let targets = fields.targets_of(i).expect("coded particle");
+        let (m, mv, s, vol) = (p.mass[i], p.v[i] * p.mass[i], p.stress[i], p.volume[i]);
+        with_nodes!(shape, N => {
+            let st = Stencil::<N>::cached::<D>(stencils, i);
+            st.for_each_target::<D>(&geom.stride, targets, |n, w, g| {
+                if MASS {
+                    mass[n] += m * w;
+                }
+                if MOMENTUM {
+                    momentum[n] += mv * w;
+                }
+                if FORCE {
+                    force[n] -= D::stress_dot(&s, g) * vol;
+                }
+            });
+        });
+    }
 }
 
 /// Adds external particle forces to the grid (sequential, in load order) and books the
@@ -169,9 +212,15 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
         let f = load.force * load.time.at(t);
         for &i in &load.particles {
             let i = i as usize;
+            let targets = world.cracks.as_ref().and_then(|c| c.fields.targets_of(i));
             with_nodes!(shape, N => {
                 let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
-                st.for_each::<D>(&geom.stride, |n, w, _| world.grid.force[n] += f * w);
+                match targets {
+                    Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, w, _| {
+                        world.grid.force[n] += f * w
+                    }),
+                    None => st.for_each::<D>(&geom.stride, |n, w, _| world.grid.force[n] += f * w),
+                }
             });
             work += 0.5 * dt * D::dot(f, p.v[i]);
         }

@@ -19,6 +19,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let geom = &grid.geom;
     let materials = &world.materials;
     let stencils = &world.tiles.stencils;
+    let fields = world.cracks.as_ref().map(|c| &c.fields);
     let Particles {
         grad_v,
         stress,
@@ -35,15 +36,22 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
                 let st = Stencil::<N>::cached::<D>(stencils, i);
                 // grad v = sum_rows (sum_i v_i dw_i) ⊗ q x̂ + (sum_i v_i w_i) ⊗ g_yz.
                 let mut l = D::mat_zero();
-                st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
-                    let (mut vd, mut vw) = (D::zero(), D::zero());
-                    for a in 0..N {
-                        let v = grid.velocity[row + a];
-                        vd += v * st.dw[0][a];
-                        vw += v * st.w[0][a];
-                    }
-                    l = l + D::outer(vd, D::unit_x() * q) + D::outer(vw, gyz);
-                });
+                match fields.and_then(|f| f.targets_of(i)) {
+                    // Near a crack: the velocity gradient of this particle's field (Eq. 20 of
+                    // Guo & Nairn 3D (2006)).
+                    Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, _, g| {
+                        l = l + D::outer(grid.velocity[n], g);
+                    }),
+                    None => st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
+                        let (mut vd, mut vw) = (D::zero(), D::zero());
+                        for a in 0..N {
+                            let v = grid.velocity[row + a];
+                            vd += v * st.dw[0][a];
+                            vw += v * st.w[0][a];
+                        }
+                        l = l + D::outer(vd, D::unit_x() * q) + D::outer(vw, gyz);
+                    }),
+                }
                 gv[k] = l;
                 let de = D::sym_part(&gv[k]) * dt;
                 materials[material[i] as usize].update(plane, de, &mut s[k]);

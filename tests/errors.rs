@@ -169,3 +169,34 @@ fn bad_checkpoint_settings_name_the_key() {
         .expect_err("unknown key");
     assert!(e.to_string().contains("every") && e.line == Some(19), "{e}");
 }
+
+/// Builds `GOOD` plus `extra` and returns the error it must produce.
+fn error_with_text(extra: &str) -> ScenarioError {
+    let text = format!("{GOOD}{extra}");
+    match Source::parse("bad.toml", &text, &[]) {
+        Err(e) => e,
+        Ok(src) => build::<D2>(&src).expect_err("scenario must be refused"),
+    }
+}
+
+#[test]
+fn bad_cracks_name_the_key() {
+    let e = error_with_text("[[crack]]\npoints = [[0.0001, 0.0001], [0.0001, 0.002]]\n");
+    assert_error(&e, "crack[0].points", Some(19), "outside every body");
+    let e = error_with_text("[[crack]]\npoints = [[0.01, 0.01]]\n");
+    assert_error(&e, "crack[0].points", Some(19), "at least two points");
+    let e = error_with_text(
+        "[[crack]]\npoints = [[0.006, 0.006], [0.014, 0.014], [0.014, 0.006], [0.006, 0.014]]\n",
+    );
+    assert_error(&e, "crack[0].points", Some(19), "crosses itself");
+    let e = error_with_text(
+        "[[crack]]\npoints = [[0.006, 0.01], [0.012, 0.01]]\ntips = [\"middle\"]\n",
+    );
+    assert_error(&e, "crack[0].tips", Some(20), "unknown tip");
+    let e = error_with_text("[[crack]]\npoints = [[0.006, 0.01], [0.03, 0.01]]\n");
+    assert_error(&e, "crack[0].points", Some(19), "outside the grid");
+    let e = error_with_text("[[crack]]\nline = { start = [0.006, 0.01], end = [0.006, 0.01] }\n");
+    assert_error(&e, "crack[0].line.end", None, "coincide");
+    let e = error_with_text("[[crack]]\ntips = [\"end\"]\n");
+    assert_error(&e, "crack[0]", None, "exactly one of");
+}

@@ -124,6 +124,13 @@ fn restart_is_bit_exact_2d_one_and_two_threads() {
 }
 
 #[test]
+fn restart_is_bit_exact_with_a_crack() {
+    let crack = "[[crack]]\nline = { start = [0.02, 0.0005], end = [0.02, 0.0135], spacing = 5e-4 }\ntips = []\n";
+    let text = scene(2, "ugimp", "usavg").replace("[[probe]]", &format!("{crack}[[probe]]"));
+    restart_is_bit_exact(&text, 29, 2, "crack");
+}
+
+#[test]
 fn restart_is_bit_exact_3d_one_and_two_threads() {
     let text = scene(3, "bspline", "usl").replace("duration = 1e-5", "duration = 4e-6");
     restart_is_bit_exact(&text, 19, 1, "3d-1");

@@ -68,7 +68,7 @@ pub struct Scene<D: Dim> {
 type R<T> = Result<T, ScenarioError>;
 
 /// A D-vector from a scenario list, padded to 3 (checked length and finiteness).
-fn vec3<D: Dim>(src: &Source, key: &str, v: &[f64]) -> R<[f64; 3]> {
+pub(super) fn vec3<D: Dim>(src: &Source, key: &str, v: &[f64]) -> R<[f64; 3]> {
     if v.len() != D::D {
         return Err(src.error(
             key,
@@ -88,7 +88,7 @@ fn vec3<D: Dim>(src: &Source, key: &str, v: &[f64]) -> R<[f64; 3]> {
     Ok(out)
 }
 
-fn to_vec<D: Dim>(a: [f64; 3]) -> D::Vec {
+pub(super) fn to_vec<D: Dim>(a: [f64; 3]) -> D::Vec {
     D::from_slice(&a[..D::D])
 }
 
@@ -105,7 +105,7 @@ fn axis_index<D: Dim>(src: &Source, key: &str, name: &str) -> R<usize> {
     Ok(a)
 }
 
-fn positive(src: &Source, key: &str, v: f64, unit: &str) -> R<f64> {
+pub(super) fn positive(src: &Source, key: &str, v: f64, unit: &str) -> R<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
@@ -504,6 +504,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         None => duration / 400.0,
     };
     let checkpoint = checkpoint_plan(src)?;
+    let cracks = super::cracks::build::<D>(src, &particles, &geom)?;
     let min_mass = particles.mass.iter().copied().fold(f64::INFINITY, f64::min);
     let world = World {
         tiles,
@@ -524,6 +525,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         time: 0.0,
         step: 0,
         work: Work::default(),
+        cracks,
     };
     Ok(Scene {
         name: src.name(),

@@ -2,6 +2,7 @@
 //! World from them ([`build`]).
 
 pub mod build;
+mod cracks;
 pub mod schema;
 pub mod source;
 

@@ -23,6 +23,9 @@ pub struct Scenario {
     /// Bodies filled with particles.
     #[serde(default, rename = "body")]
     pub bodies: Vec<BodySpec>,
+    /// Explicit cracks (2D polylines).
+    #[serde(default, rename = "crack")]
+    pub cracks: Vec<CrackSpec>,
     /// Prescribed grid velocities.
     #[serde(default, rename = "boundary")]
     pub boundaries: Vec<BoundarySpec>,
@@ -182,6 +185,34 @@ pub struct BodySpec {
 
 fn default_ppc() -> usize {
     2
+}
+
+/// `[[crack]]`: an explicit crack, a polyline of massless points. Exactly one of `points`
+/// and `line`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrackSpec {
+    /// Name used in reports (default `crack<k>`).
+    pub name: Option<String>,
+    /// Vertices `[[x, y], ...]` (m), at least two.
+    pub points: Option<Vec<Vec<f64>>>,
+    /// A straight crack with evenly spaced vertices.
+    pub line: Option<LineSpec>,
+    /// Which ends are crack tips: "start" and/or "end" (default `["end"]`).
+    pub tips: Option<Vec<String>>,
+}
+
+/// A straight crack from `start` to `end` (m), a vertex every `spacing` (m; default half
+/// the smallest cell).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineSpec {
+    /// First vertex (m).
+    pub start: Vec<f64>,
+    /// Last vertex (m).
+    pub end: Vec<f64>,
+    /// Largest distance between vertices (m).
+    pub spacing: Option<f64>,
 }
 
 /// A plane of nodes `axis = at` (m).

@@ -1,6 +1,7 @@
 //! A run's state as snapshot columns, and back. The scene is rebuilt from the stored scenario
-//! text (loads, boundaries, probes, grid) and the evolving state is then put back from the
-//! columns; grid scratch and particle bins are rebuilt by the first step.
+//! text (loads, boundaries, probes, grid, crack topology) and the evolving state is then put
+//! back from the columns (particles, crack vertices and surfaces, work, history); grid
+//! scratch, particle bins and crack velocity fields are rebuilt by the first step.
 
 use super::format::{ColumnSet, Header, Reader, SnapshotError};
 use crate::dim::Dim;
@@ -92,6 +93,11 @@ pub fn write<D: Dim>(
     c.add("history.time", &h.time);
     for (name, series) in probe_names.iter().zip(&h.probes) {
         c.add(name, series);
+    }
+    if let Some(cr) = &world.cracks {
+        c.add("cracks.x", &cr.x);
+        c.add("cracks.top", &cr.top);
+        c.add("cracks.bottom", &cr.bottom);
     }
     c.add("history.rows.step", &row_steps);
     c.add("history.rows.data", &rows);
@@ -194,6 +200,12 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     let run: Vec<f64> = r.column("run.work", 2)?;
     w.work.external = run[0];
     w.work.damping = run[1];
+    if let Some(cr) = &mut w.cracks {
+        let nv = cr.x.len();
+        cr.x = r.column("cracks.x", nv)?;
+        cr.top = r.column("cracks.top", nv)?;
+        cr.bottom = r.column("cracks.bottom", nv)?;
+    }
     w.time = h.time;
     w.step = h.step;
     w.tiles.fresh = false;

@@ -1,0 +1,189 @@
+//! Building the crack store from `[[crack]]` tables, with every check a crack needs.
+
+use super::build::{positive, to_vec, vec3};
+use super::schema::CrackSpec;
+use super::source::Source;
+use crate::crack::{Crack, Cracks, MAX_CRACKS};
+use crate::dim::Dim;
+use crate::error::ScenarioError;
+use crate::grid::GridGeom;
+use crate::particles::Particles;
+
+type R<T> = Result<T, ScenarioError>;
+
+/// How far (in cells, on every axis) a crack vertex may lie from the nearest particle:
+/// cracks that cut through a body must reach past its edge.
+const REACH_CELLS: f64 = 2.0;
+
+/// The scene's cracks, or None when it has none (then no crack system is scheduled).
+pub(super) fn build<D: Dim>(
+    src: &Source,
+    particles: &Particles<D>,
+    geom: &GridGeom<D>,
+) -> R<Option<Cracks<D>>> {
+    let specs = &src.scenario.cracks;
+    if specs.is_empty() {
+        return Ok(None);
+    }
+    if D::D != 2 {
+        return Err(src.error(
+            "crack[0]",
+            "cracks are 2D polylines for now; 3D crack surfaces are not implemented yet",
+        ));
+    }
+    if specs.len() > MAX_CRACKS {
+        return Err(src.error(
+            &format!("crack[{MAX_CRACKS}]"),
+            format!("at most {MAX_CRACKS} cracks per scene"),
+        ));
+    }
+    let mut store = Cracks::<D>::default();
+    for (c, spec) in specs.iter().enumerate() {
+        let key = |k: &str| format!("crack[{c}].{k}");
+        let points = vertices::<D>(src, c, spec, geom)?;
+        for (j, x) in points.iter().enumerate() {
+            if !near_particle::<D>(*x, particles, geom) {
+                let at = D::to_xyz(*x);
+                return Err(src.error(
+                    &key(if spec.points.is_some() {
+                        "points"
+                    } else {
+                        "line"
+                    }),
+                    format!(
+                        "vertex {j} at ({:e}, {:e}) m is outside every body (more than \
+                         {REACH_CELLS} cells from any particle)",
+                        at[0], at[1]
+                    ),
+                ));
+            }
+        }
+        if let Some((a, b)) = self_crossing::<D>(&points) {
+            return Err(src.error(
+                &key(if spec.points.is_some() {
+                    "points"
+                } else {
+                    "line"
+                }),
+                format!("the crack crosses itself (segments {a} and {b})"),
+            ));
+        }
+        let mut tips = [false, true];
+        if let Some(t) = &spec.tips {
+            tips = [false, false];
+            for name in t {
+                match name.as_str() {
+                    "start" => tips[0] = true,
+                    "end" => tips[1] = true,
+                    other => {
+                        return Err(
+                            src.error(&key("tips"), format!("unknown tip `{other}` (start, end)"))
+                        );
+                    }
+                }
+            }
+        }
+        let first = store.x.len();
+        for k in 0..points.len() - 1 {
+            store
+                .elems
+                .push([(first + k) as u32, (first + k + 1) as u32, 0]);
+            store.elem_crack.push(c as u16);
+        }
+        store.x.extend(&points);
+        store.cracks.push(Crack {
+            name: spec.name.clone().unwrap_or_else(|| format!("crack{c}")),
+            vertices: first..store.x.len(),
+            tips,
+        });
+    }
+    store.top = store.x.clone();
+    store.bottom = store.x.clone();
+    Ok(Some(store))
+}
+
+/// The vertices of crack `c`: its points, or its line cut at the spacing; all inside the
+/// grid, at least two, no two consecutive ones equal.
+fn vertices<D: Dim>(
+    src: &Source,
+    c: usize,
+    spec: &CrackSpec,
+    geom: &GridGeom<D>,
+) -> R<Vec<D::Vec>> {
+    let key = |k: &str| format!("crack[{c}].{k}");
+    let points: Vec<D::Vec> = match (&spec.points, &spec.line) {
+        (Some(pts), None) => {
+            if pts.len() < 2 {
+                return Err(src.error(&key("points"), "a crack needs at least two points"));
+            }
+            pts.iter()
+                .enumerate()
+                .map(|(j, p)| {
+                    vec3::<D>(src, &format!("crack[{c}].points[{j}]"), p).map(to_vec::<D>)
+                })
+                .collect::<R<_>>()?
+        }
+        (None, Some(line)) => {
+            let a = to_vec::<D>(vec3::<D>(src, &key("line.start"), &line.start)?);
+            let b = to_vec::<D>(vec3::<D>(src, &key("line.end"), &line.end)?);
+            let len = D::dot(b - a, b - a).sqrt();
+            if len == 0.0 {
+                return Err(src.error(&key("line.end"), "the line's start and end coincide"));
+            }
+            let spacing = match line.spacing {
+                Some(s) => positive(src, &key("line.spacing"), s, "m")?,
+                None => 0.5 * geom.min_cell(),
+            };
+            let n = (len / spacing).ceil().min(1e6) as usize;
+            (0..=n)
+                .map(|k| a + (b - a) * (k as f64 / n as f64))
+                .collect()
+        }
+        _ => {
+            return Err(src.error(
+                &format!("crack[{c}]"),
+                "give exactly one of `points` and `line`",
+            ));
+        }
+    };
+    for (j, w) in points.windows(2).enumerate() {
+        if w[0] == w[1] {
+            return Err(src.error(&key("points"), format!("points {j} and {} coincide", j + 1)));
+        }
+    }
+    for (j, x) in points.iter().enumerate() {
+        if !geom.fits(crate::shape::ShapeKind::Linear, *x, D::zero()) {
+            return Err(src.error(
+                &key(if spec.points.is_some() {
+                    "points"
+                } else {
+                    "line"
+                }),
+                format!("vertex {j} lies outside the grid"),
+            ));
+        }
+    }
+    Ok(points)
+}
+
+/// Whether some particle lies within `REACH_CELLS` cells of `x` on every axis.
+fn near_particle<D: Dim>(x: D::Vec, p: &Particles<D>, geom: &GridGeom<D>) -> bool {
+    p.x.iter()
+        .any(|y| (0..D::D).all(|a| ((y[a] - x[a]) * geom.inv_h[a]).abs() <= REACH_CELLS))
+}
+
+/// The first pair of non-adjacent segments of a polyline that intersect, if any.
+fn self_crossing<D: Dim>(pts: &[D::Vec]) -> Option<(usize, usize)> {
+    let e = |k: usize| [k as u32, k as u32 + 1, 0];
+    let n = pts.len() - 1;
+    for a in 0..n {
+        for b in a + 2..n {
+            let (p, q) = (pts[b], pts[b + 1]);
+            // Touching counts as crossing here: a crack must not meet itself at all.
+            if D::crossing(p, q, pts, e(a)) != 0 || D::crossing(q, p, pts, e(a)) != 0 {
+                return Some((a, b));
+            }
+        }
+    }
+    None
+}

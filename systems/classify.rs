@@ -1,0 +1,189 @@
+//! `classify`: the velocity field of every particle-node pair near a crack (Guo & Nairn 2D
+//! (2004) section 2.1; 3D (2006) Appendix A) and the extra field rows of the grid. A line
+//! from particle to node that crosses a crack an odd number of times puts the pair in the
+//! node's field for that crack side; an even number counts as none. Only particles in tiles
+//! near a crack are scanned.
+
+use crate::crack::{Cracks, side_bit};
+use crate::dim::Dim;
+use crate::shape::Stencil;
+use crate::with_nodes;
+use crate::world::World;
+
+/// Axis-aligned box (min, max).
+type Aabb<D> = (<D as Dim>::Vec, <D as Dim>::Vec);
+
+fn overlaps<D: Dim>(a: &Aabb<D>, b: &Aabb<D>) -> bool {
+    (0..D::D).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
+}
+
+fn span<D: Dim>(a: D::Vec, b: D::Vec) -> Aabb<D> {
+    let (mut lo, mut hi) = (a, a);
+    for k in 0..D::D {
+        lo[k] = a[k].min(b[k]);
+        hi[k] = a[k].max(b[k]);
+    }
+    (lo, hi)
+}
+
+/// Crack-side mask of the line from `xp` to `xn` against elements `near` (boxes `boxes`).
+fn mask_of<D: Dim>(
+    xp: D::Vec,
+    xn: D::Vec,
+    cracks: &Cracks<D>,
+    near: &[u32],
+    boxes: &[Aabb<D>],
+) -> u64 {
+    let line = span::<D>(xp, xn);
+    let (mut odd, mut above) = (0u32, 0u32);
+    for &e in near {
+        let e = e as usize;
+        if !overlaps::<D>(&line, &boxes[e]) {
+            continue;
+        }
+        let s = D::crossing(xp, xn, &cracks.x, cracks.elems[e]);
+        if s != 0 {
+            let bit = 1u32 << cracks.elem_crack[e];
+            odd ^= bit;
+            if s > 0 {
+                above |= bit;
+            } else {
+                above &= !bit;
+            }
+        }
+    }
+    let mut mask = 0;
+    while odd != 0 {
+        let c = odd.trailing_zeros() as usize;
+        odd &= odd - 1;
+        mask |= side_bit(c, if above >> c & 1 == 1 { 1 } else { -1 });
+    }
+    mask
+}
+
+/// Classifies the particles near cracks from their cached stencils and sizes the grid's
+/// extra field rows. Nothing to do in a scene without cracks.
+pub fn run<D: Dim>(world: &mut World<D>) {
+    let Some(cracks) = world.cracks.as_mut() else {
+        return;
+    };
+    let geom = &world.grid.geom;
+    let tiles = &world.tiles;
+    let p = &world.particles;
+    let shape = world.settings.shape;
+    let per = shape.nodes().pow(D::D as u32);
+    let nodes = geom.node_count();
+    let boxes: Vec<Aabb<D>> = cracks
+        .elems
+        .iter()
+        .map(|e| {
+            let v = |k: usize| cracks.x[e[k] as usize];
+            let (mut lo, mut hi) = span::<D>(v(0), v(1));
+            if D::D == 3 {
+                let (l2, h2) = span::<D>(v(2), v(2));
+                for k in 0..3 {
+                    lo[k] = lo[k].min(l2[k]);
+                    hi[k] = hi[k].max(h2[k]);
+                }
+            }
+            (lo, hi)
+        })
+        .collect();
+    // A stencil reaches at most two cells from its particle.
+    let reach = geom.h * 2.0;
+    let mut all = boxes[0];
+    for b in &boxes {
+        for k in 0..D::D {
+            all.0[k] = all.0[k].min(b.0[k]);
+            all.1[k] = all.1[k].max(b.1[k]);
+        }
+    }
+    let mut t_lo = [0usize; 3];
+    let mut t_hi = [0usize; 3];
+    for k in 0..D::D {
+        let cell = |x: f64| ((x - geom.origin[k]) * geom.inv_h[k]).max(0.0) as usize;
+        t_lo[k] = (cell(all.0[k] - reach[k]) / tiles.size).min(tiles.counts[k] - 1);
+        t_hi[k] = (cell(all.1[k] + reach[k]) / tiles.size).min(tiles.counts[k] - 1);
+    }
+
+    let mut coded: Vec<u32> = Vec::new();
+    let mut node_ids: Vec<u32> = Vec::new();
+    let mut masks: Vec<u64> = Vec::new();
+    let mut near: Vec<u32> = Vec::new();
+    let mut local = vec![(0u32, 0u64); per];
+    for tk in t_lo[2]..=t_hi[2] {
+        for tj in t_lo[1]..=t_hi[1] {
+            for ti in t_lo[0]..=t_hi[0] {
+                let t = ti + tiles.counts[0] * (tj + tiles.counts[1] * tk);
+                for &i in tiles.particles(t as u32) {
+                    let xp = p.x[i as usize];
+                    let reach_box = (xp - reach, xp + reach);
+                    near.clear();
+                    near.extend(
+                        (0..boxes.len() as u32)
+                            .filter(|&e| overlaps::<D>(&reach_box, &boxes[e as usize])),
+                    );
+                    if near.is_empty() {
+                        continue;
+                    }
+                    let mut any = false;
+                    with_nodes!(shape, N => {
+                        let st = Stencil::<N>::cached::<D>(&tiles.stencils, i as usize);
+                        let mut l = 0;
+                        st.for_each::<D>(&geom.stride, |n, w, _| {
+                            let m = if w != 0.0 {
+                                mask_of::<D>(xp, geom.node_position(n), cracks, &near, &boxes)
+                            } else {
+                                0
+                            };
+                            any |= m != 0;
+                            local[l] = (n as u32, m);
+                            l += 1;
+                        });
+                    });
+                    if any {
+                        coded.push(i);
+                        node_ids.extend(local.iter().map(|l| l.0));
+                        masks.extend(local.iter().map(|l| l.1));
+                    }
+                }
+            }
+        }
+    }
+
+    // Coded particles in index order, so every later pass is deterministic.
+    let mut order: Vec<usize> = (0..coded.len()).collect();
+    order.sort_unstable_by_key(|&k| coded[k]);
+    let mut rows: Vec<(u32, u64)> = node_ids
+        .iter()
+        .zip(&masks)
+        .filter(|(_, m)| **m != 0)
+        .map(|(n, m)| (*n, *m))
+        .collect();
+    rows.sort_unstable();
+    rows.dedup();
+    let f = &mut cracks.fields;
+    f.per = per;
+    f.nodes = nodes;
+    f.slot.clear();
+    f.slot.resize(p.len(), u32::MAX);
+    f.coded.clear();
+    f.targets.clear();
+    for (slot, &k) in order.iter().enumerate() {
+        f.coded.push(coded[k]);
+        f.slot[coded[k] as usize] = slot as u32;
+        for l in k * per..(k + 1) * per {
+            let (n, m) = (node_ids[l], masks[l]);
+            f.targets.push(if m == 0 {
+                n
+            } else {
+                let r = rows.binary_search(&(n, m)).expect("row of a recorded pair");
+                (nodes + r) as u32
+            });
+        }
+    }
+    f.node = rows.iter().map(|r| r.0).collect();
+    f.mask = rows.iter().map(|r| r.1).collect();
+    let extra = rows.len();
+    world.grid.set_extra_fields(extra);
+}

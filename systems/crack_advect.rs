@@ -1,0 +1,89 @@
+//! `crack_advect`: crack vertices move with the centre-of-mass velocity of the nodal fields,
+//! and the top and bottom crack surfaces with the fields above and below the crack (Guo &
+//! Nairn 3D (2006) Eqs. 21-23; 2D (2004) section 2.2), which gives the crack opening.
+
+use crate::crack::{Cracks, Fields, side_bit};
+use crate::dim::Dim;
+use crate::shape::{ShapeKind, Stencil};
+use crate::world::World;
+
+/// Velocities at node `n` for crack `c`: centre of mass (Eq. 23), above and below.
+fn node_velocities<D: Dim>(
+    n: usize,
+    c: usize,
+    mass: &[f64],
+    velocity: &[D::Vec],
+    fields: &Fields,
+    tol: f64,
+) -> [D::Vec; 3] {
+    let (mut m, mut mv) = (mass[n], velocity[n] * mass[n]);
+    let (mut above, mut below) = (None, None);
+    for r in fields.rows_of(n as u32) {
+        m += mass[r];
+        mv += velocity[r] * mass[r];
+        let mask = fields.mask[r - fields.nodes];
+        if mask & side_bit(c, 1) != 0 {
+            above = Some(r);
+        }
+        if mask & side_bit(c, -1) != 0 {
+            below = Some(r);
+        }
+    }
+    if m <= tol {
+        return [D::zero(); 3];
+    }
+    // The node's own field is on the side no crossing row claims.
+    let pick = |r: Option<usize>| velocity[r.unwrap_or(n)];
+    [mv * (1.0 / m), pick(above), pick(below)]
+}
+
+/// Moves every crack vertex and both surfaces over the step, interpolating the updated
+/// nodal velocities with linear shape functions (crack vertices are massless points).
+/// Vertices outside the grid do not move.
+pub fn run<D: Dim>(world: &mut World<D>) {
+    let Some(Cracks {
+        x: xs,
+        top,
+        bottom,
+        cracks,
+        fields,
+        ..
+    }) = world.cracks.as_mut()
+    else {
+        return;
+    };
+    let dt = world.settings.dt;
+    let tol = world.settings.mass_tol;
+    let g = &world.grid;
+    let geom = &g.geom;
+    for (c, crack) in cracks.iter().enumerate() {
+        for k in crack.vertices.clone() {
+            let x = xs[k];
+            if !geom.fits(ShapeKind::Linear, x, D::zero()) {
+                continue;
+            }
+            let mut st = Stencil::<2> {
+                base: [0; 3],
+                w: [[1.0, 0.0, 0.0]; 3],
+                dw: [[0.0; 3]; 3],
+            };
+            for a in 0..D::D {
+                let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
+                let (b, w, dw) = ShapeKind::Linear.axis(xi, 0.0, geom.inv_h[a]);
+                st.base[a] = b;
+                st.w[a] = w;
+                st.dw[a] = dw;
+            }
+            let mut v = [D::zero(); 3];
+            st.for_each::<D>(&geom.stride, |n, w, _| {
+                let nv = node_velocities::<D>(n, c, &g.mass, &g.velocity, fields, tol);
+                for s in 0..3 {
+                    v[s] += nv[s] * w;
+                }
+            });
+            xs[k] += v[0] * dt;
+            top[k] += v[1] * dt;
+            bottom[k] += v[2] * dt;
+        }
+    }
+}

@@ -1,0 +1,250 @@
+//! Explicit cracks: a crack through a bar decouples the halves exactly; crack vertices and
+//! surfaces move with their fields; a scene without cracks schedules no crack system.
+
+mod common;
+use common::{final_world, source};
+use fissure::dim::D2;
+use fissure::scenario::build;
+use fissure::schedule::Schedule;
+
+/// A 32 x 4 mm bar of 1 mm cells whose left half moves at -1 m/s and right half at +1 m/s,
+/// with `crack` appended (may be empty).
+fn pulled_apart(shape: &str, update: &str, crack: &str) -> String {
+    format!(
+        r#"
+[simulation]
+dimension = 2
+shape = "{shape}"
+update = "{update}"
+duration = 2e-5
+[grid]
+min = [0.0, 0.0]
+max = [0.04, 0.012]
+cell = [0.001, 0.001]
+[[material]]
+name = "m"
+E = 70e9
+nu = 0.3
+rho = 2700.0
+[[body]]
+material = "m"
+box = {{ min = [0.004, 0.004], max = [0.02, 0.008] }}
+velocity = [-1.0, 0.0]
+[[body]]
+material = "m"
+box = {{ min = [0.02, 0.004], max = [0.036, 0.008] }}
+velocity = [1.0, 0.0]
+{crack}
+"#
+    )
+}
+
+/// A crack along the grid line x = 20 mm (nodes on the crack line), through the section.
+const ON_GRID_LINE: &str = "[[crack]]\npoints = [[0.02, 0.0025], [0.02, 0.0095]]\ntips = []";
+
+/// The bar's kinetic and strain energy (J) and total momentum x (kg m/s) at the end.
+fn energies(text: &str, threads: usize) -> (f64, f64, f64, fissure::world::World<D2>) {
+    let w = final_world::<D2>(text, threads);
+    let e = w.energies();
+    let p = w.momentum();
+    (e.kinetic, e.strain, p.x, w)
+}
+
+/// With the crack the halves fly apart unstressed: no strain energy, kinetic energy and
+/// every particle velocity unchanged. Without it the same scene stretches the bar.
+#[test]
+fn a_crack_through_a_bar_lets_the_halves_separate_freely() {
+    for (shape, update) in [("ugimp", "usavg"), ("linear", "usl"), ("bspline", "usf")] {
+        let (k0, s0, _, _) = energies(&pulled_apart(shape, update, ""), 1);
+        assert!(
+            s0 > 1e-3 * k0,
+            "{shape}: without a crack the bar is stretched"
+        );
+
+        let text = pulled_apart(shape, update, ON_GRID_LINE);
+        let (k, s, px, w) = energies(&text, 1);
+        let mass: f64 = w.particles.mass.iter().sum();
+        let k_exact = 0.5 * mass * 1.0;
+        assert!(
+            s < 1e-20 * k,
+            "{shape}: strain energy {s:e} J with the crack"
+        );
+        assert!(
+            (k - k_exact).abs() < 1e-12 * k_exact,
+            "{shape}: {k} vs {k_exact}"
+        );
+        assert!(px.abs() < 1e-12 * mass, "{shape}: momentum {px:e}");
+        for (x, v) in w.particles.x.iter().zip(&w.particles.v) {
+            let want = if x.x < 0.02 { -1.0 } else { 1.0 };
+            assert!(
+                (v.x - want).abs() < 1e-12 && v.y.abs() < 1e-12,
+                "{shape}: {v}"
+            );
+        }
+    }
+}
+
+/// A crack between grid lines and inclined to them decouples the halves as well.
+#[test]
+fn an_inclined_crack_off_the_grid_lines_decouples_too() {
+    let crack = "[[crack]]\npoints = [[0.0197, 0.0025], [0.0203, 0.0095]]\ntips = []";
+    let text = pulled_apart("ugimp", "usavg", crack)
+        .replace("max = [0.02, 0.008]", "max = [0.0196, 0.008]")
+        .replace("min = [0.02, 0.004]", "min = [0.0204, 0.004]");
+    let (k, s, _, _) = energies(&text, 1);
+    assert!(s < 1e-20 * k, "strain energy {s:e} J with the crack");
+}
+
+/// The crack plane moves with the centre-of-mass field (here at rest), the top surface
+/// (left of the crack's direction) with the left half and the bottom with the right half,
+/// so the opening at mid-height is 2 v t.
+#[test]
+fn crack_surfaces_follow_their_fields() {
+    let line = "[[crack]]\nline = { start = [0.02, 0.0025], end = [0.02, 0.0095], spacing = 5e-4 }\ntips = []";
+    let text = pulled_apart("ugimp", "usavg", line);
+    let w = final_world::<D2>(&text, 2);
+    let c = w.cracks.as_ref().expect("the scene has a crack");
+    let t = w.time;
+    let k =
+        c.x.iter()
+            .position(|x| (x.y - 0.006).abs() < 1e-12)
+            .expect("a vertex at mid-height");
+    assert!((c.x[k].x - 0.02).abs() < 1e-15, "plane {}", c.x[k]);
+    assert!(
+        (c.top[k].x - (0.02 - t)).abs() < 1e-12 * 0.02,
+        "top {}",
+        c.top[k]
+    );
+    assert!(
+        (c.bottom[k].x - (0.02 + t)).abs() < 1e-12 * 0.02,
+        "bottom {}",
+        c.bottom[k]
+    );
+}
+
+/// Crack systems are scheduled only when the scene has a crack.
+#[test]
+fn crack_systems_only_in_scenes_with_cracks() {
+    let names = |text: &str| -> Vec<&'static str> {
+        let w = build::<D2>(&source(text)).unwrap().world;
+        Schedule::for_world(&w)
+            .systems
+            .iter()
+            .map(|s| s.name())
+            .collect()
+    };
+    let plain = names(&pulled_apart("ugimp", "usavg", ""));
+    assert!(!plain.contains(&"classify") && !plain.contains(&"crack_advect"));
+    let cracked = names(&pulled_apart("ugimp", "usavg", ON_GRID_LINE));
+    assert_eq!(
+        cracked,
+        [
+            "bin",
+            "classify",
+            "p2g",
+            "stress",
+            "internal_force",
+            "grid_update",
+            "g2p",
+            "crack_advect",
+            "remap",
+            "stress"
+        ]
+    );
+}
+
+/// Results with a crack are bitwise identical for 1 and 2 threads.
+#[test]
+fn cracked_scene_is_deterministic_across_threads() {
+    let text = pulled_apart("ugimp", "usavg", ON_GRID_LINE)
+        .replace("velocity = [1.0, 0.0]", "velocity = [0.3, 0.2]");
+    let bits = |w: &fissure::world::World<D2>| -> Vec<u64> {
+        let p = &w.particles;
+        p.x.iter()
+            .chain(&p.v)
+            .flat_map(|v| [v.x.to_bits(), v.y.to_bits()])
+            .chain(p.stress.iter().map(|s| s.xx.to_bits()))
+            .collect()
+    };
+    assert!(bits(&final_world::<D2>(&text, 1)) == bits(&final_world::<D2>(&text, 2)));
+}
+
+/// Two cracks one cell apart cut the bar into three pieces moving at -1, 0 and +1 m/s:
+/// nodes between them see both cracks and carry a field per crack side; every piece keeps
+/// its velocity and nothing is strained.
+#[test]
+fn two_close_cracks_cut_three_free_pieces() {
+    let text = r#"
+[simulation]
+dimension = 2
+duration = 2e-5
+[grid]
+min = [0.0, 0.0]
+max = [0.04, 0.012]
+cell = [0.001, 0.001]
+[[material]]
+name = "m"
+E = 70e9
+nu = 0.3
+rho = 2700.0
+[[body]]
+material = "m"
+box = { min = [0.004, 0.004], max = [0.0195, 0.008] }
+velocity = [-1.0, 0.0]
+[[body]]
+material = "m"
+box = { min = [0.0195, 0.004], max = [0.0205, 0.008] }
+velocity = [0.0, 0.0]
+[[body]]
+material = "m"
+box = { min = [0.0205, 0.004], max = [0.036, 0.008] }
+velocity = [1.0, 0.0]
+[[crack]]
+points = [[0.0195, 0.0025], [0.0195, 0.0095]]
+tips = []
+[[crack]]
+points = [[0.0205, 0.0025], [0.0205, 0.0095]]
+tips = []
+"#;
+    let w = final_world::<D2>(text, 2);
+    let e = w.energies();
+    assert!(
+        e.strain < 1e-20 * e.kinetic,
+        "strain energy {:e} J",
+        e.strain
+    );
+    let f = &w.cracks.as_ref().unwrap().fields;
+    assert!(
+        f.mask.iter().any(|m| m.count_ones() == 1 && m >> 2 != 0)
+            && f.mask.iter().any(|m| m & 3 != 0),
+        "fields of both cracks"
+    );
+    let nodes_with_both = f
+        .node
+        .iter()
+        .filter(|&&n| {
+            let rows = f.rows_of(n);
+            let m: u64 = f.mask[rows.start - f.nodes..rows.end - f.nodes]
+                .iter()
+                .fold(0, |a, b| a | b);
+            m & 3 != 0 && m >> 2 != 0
+        })
+        .count();
+    assert!(
+        nodes_with_both > 0,
+        "some nodes carry fields of both cracks"
+    );
+    for (x, v) in w.particles.x.iter().zip(&w.particles.v) {
+        let want = if x.x < 0.0195 {
+            -1.0
+        } else if x.x < 0.0205 {
+            0.0
+        } else {
+            1.0
+        };
+        assert!(
+            (v.x - want).abs() < 1e-12 && v.y.abs() < 1e-12,
+            "at {x}: {v}"
+        );
+    }
+}
