@@ -91,6 +91,15 @@ impl Fields {
         }
     }
 
+    /// Grid entry of node `n`'s field on `side` (+1 above, -1 below) of crack `c`: the row
+    /// whose particles crossed the crack from that side, or else the node's own field.
+    pub fn side_entry(&self, n: usize, c: usize, side: i8) -> usize {
+        let bit = side_bit(c, side);
+        self.rows_of(n as u32)
+            .find(|&r| self.mask[r - self.nodes] & bit != 0)
+            .unwrap_or(n)
+    }
+
     /// Grid entries of the extra fields of node `n`.
     pub fn rows_of(&self, n: u32) -> Range<usize> {
         let lo = self.node.partition_point(|&m| m < n);

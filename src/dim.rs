@@ -75,6 +75,9 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     /// `robust`); a point exactly on the crack line or plane counts as above, so a line
     /// through a vertex shared by two segments crosses exactly one of them.
     fn crossing(p: Self::Vec, q: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8;
+    /// Side of the line (2D) or plane (3D) of crack element `e` that `x` lies on: +1 above
+    /// or on it, -1 below; the first test of [`Dim::crossing`].
+    fn elem_side(x: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8;
 }
 
 /// +1 for a non-negative orientation, -1 otherwise (the tie rule of [`Dim::crossing`]).
@@ -153,11 +156,19 @@ impl Dim for D2 {
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, _k: usize) -> DVec2 {
         DVec2::new(dw[0][i] * w[1][j], w[0][i] * dw[1][j])
     }
+    fn elem_side(x: DVec2, v: &[DVec2], e: [u32; 3]) -> i8 {
+        let c = |u: DVec2| robust::Coord { x: u.x, y: u.y };
+        side(robust::orient2d(
+            c(v[e[0] as usize]),
+            c(v[e[1] as usize]),
+            c(x),
+        ))
+    }
     fn crossing(p: DVec2, q: DVec2, v: &[DVec2], e: [u32; 3]) -> i8 {
         let c = |u: DVec2| robust::Coord { x: u.x, y: u.y };
         let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
-        let sp = side(robust::orient2d(c(a), c(b), c(p)));
-        if sp == side(robust::orient2d(c(a), c(b), c(q))) {
+        let sp = Self::elem_side(p, v, e);
+        if sp == Self::elem_side(q, v, e) {
             return 0;
         }
         let sa = side(robust::orient2d(c(p), c(q), c(a)));
@@ -238,7 +249,7 @@ impl Dim for D3 {
             w[0][i] * w[1][j] * dw[2][k],
         )
     }
-    fn crossing(p: DVec3, q: DVec3, v: &[DVec3], e: [u32; 3]) -> i8 {
+    fn elem_side(x: DVec3, v: &[DVec3], e: [u32; 3]) -> i8 {
         let c = |u: DVec3| robust::Coord3D {
             x: u.x,
             y: u.y,
@@ -246,8 +257,17 @@ impl Dim for D3 {
         };
         let [a, b, t] = e.map(|k| c(v[k as usize]));
         // robust::orient3d is positive below the plane of a counterclockwise triangle.
-        let sp = side(-robust::orient3d(a, b, t, c(p)));
-        if sp == side(-robust::orient3d(a, b, t, c(q))) {
+        side(-robust::orient3d(a, b, t, c(x)))
+    }
+    fn crossing(p: DVec3, q: DVec3, v: &[DVec3], e: [u32; 3]) -> i8 {
+        let c = |u: DVec3| robust::Coord3D {
+            x: u.x,
+            y: u.y,
+            z: u.z,
+        };
+        let [a, b, t] = e.map(|k| c(v[k as usize]));
+        let sp = Self::elem_side(p, v, e);
+        if sp == Self::elem_side(q, v, e) {
             return 0;
         }
         let s1 = side(robust::orient3d(c(p), c(q), a, b));

@@ -9,6 +9,7 @@ pub mod bodies;
 pub mod crack;
 pub mod dim;
 pub mod error;
+pub mod fracture;
 pub mod grid;
 pub mod loads;
 pub mod material;

@@ -1,6 +1,7 @@
 //! Probes (particle averages recorded every step) and `[[expect]]` evaluation.
 
 use crate::dim::Dim;
+use crate::fracture::TipResult;
 use crate::material::Elastic;
 use crate::particles::Particles;
 use crate::world::Energies;
@@ -82,6 +83,8 @@ pub struct History {
     pub probes: Vec<Vec<f64>>,
     /// Rows at the energy cadence.
     pub rows: Vec<Row>,
+    /// J and K at every crack tip, at the energy cadence.
+    pub fracture: Vec<TipResult>,
 }
 
 /// What an expect measures.
@@ -105,6 +108,15 @@ pub enum Measure {
     EnergyDrift,
     /// |L(end) - L(0)| / |L(0)| about the initial centre of mass (relative).
     AngularMomentumDrift,
+    /// The last value at a crack tip: `qty` 0..4 = K_I, K_II, J_x, J_y (Pa sqrt(m), J/m^2).
+    Tip {
+        /// Crack index.
+        crack: u32,
+        /// 0 start, 1 end.
+        tip: u32,
+        /// Which value.
+        qty: usize,
+    },
 }
 
 /// A checked expectation.
@@ -173,6 +185,13 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
     let finite = |v: f64| v.is_finite().then_some(v);
     match *m {
         Measure::Final(p) => h.probes[p].last().copied().and_then(finite),
+        Measure::Tip { crack, tip, qty } => {
+            let r = h
+                .fracture
+                .iter()
+                .rfind(|r| r.crack == crack && r.tip == tip)?;
+            finite([r.k[0], r.k[1], r.j[0], r.j[1]][qty])
+        }
         Measure::Max(p) => h.probes[p].iter().copied().reduce(f64::max),
         Measure::Min(p) => h.probes[p].iter().copied().reduce(f64::min),
         Measure::Frequency(p) => frequency(&h.time, &h.probes[p]),

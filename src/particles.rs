@@ -24,6 +24,9 @@ pub struct Particles<D: Dim> {
     pub material: Vec<u16>,
     /// Particle half-width per axis (m); only allocated for uGIMP.
     pub half: Vec<D::Vec>,
+    /// Displacement gradient du_i/dx_j, accumulated from grad v; only allocated when
+    /// J-integrals are measured (Guo & Nairn 2D (2004) section 3 tracks it on particles).
+    pub grad_u: Vec<D::Mat>,
 }
 
 impl<D: Dim> Default for Particles<D> {
@@ -38,6 +41,7 @@ impl<D: Dim> Default for Particles<D> {
             grad_v: Vec::new(),
             material: Vec::new(),
             half: Vec::new(),
+            grad_u: Vec::new(),
         }
     }
 }
@@ -73,7 +77,9 @@ impl<D: Dim> Particles<D> {
             + std::mem::size_of::<Sym3>()
             + std::mem::size_of::<D::Mat>()
             + std::mem::size_of::<u16>();
+        let mat = std::mem::size_of::<D::Mat>();
         base + if self.half.is_empty() { 0 } else { vec }
+            + if self.grad_u.is_empty() { 0 } else { mat }
     }
 
     /// Reorders every column so that new particle `k` is old particle `order[k]`.
@@ -92,6 +98,7 @@ impl<D: Dim> Particles<D> {
         apply(&mut self.grad_v, order);
         apply(&mut self.material, order);
         apply(&mut self.half, order);
+        apply(&mut self.grad_u, order);
     }
 
     /// Half-width of particle `p` (zero when the scene's shape function does not use one).

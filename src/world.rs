@@ -41,6 +41,8 @@ pub struct Settings<D: Dim> {
     pub dt: f64,
     /// Nodes lighter than this carry no velocity (kg).
     pub mass_tol: f64,
+    /// Out-of-plane thickness (m) in 2D, 1 in 3D: particle volume over particle area.
+    pub thickness: f64,
 }
 
 /// Work accumulated since t = 0 (J).

@@ -110,17 +110,44 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let mut node_ids: Vec<u32> = Vec::new();
     let mut masks: Vec<u64> = Vec::new();
     let mut near: Vec<u32> = Vec::new();
+    let mut tile_near: Vec<u32> = Vec::new();
     let mut local = vec![(0u32, 0u64); per];
     for tk in t_lo[2]..=t_hi[2] {
         for tj in t_lo[1]..=t_hi[1] {
             for ti in t_lo[0]..=t_hi[0] {
                 let t = ti + tiles.counts[0] * (tj + tiles.counts[1] * tk);
+                // Elements within reach of the tile, then of each of its particles.
+                let (mut lo, mut hi) = (geom.origin, geom.origin);
+                for (k, c) in [ti, tj, tk].into_iter().enumerate().take(D::D) {
+                    lo[k] += (c * tiles.size) as f64 * geom.h[k] - reach[k];
+                    hi[k] += ((c + 1) * tiles.size) as f64 * geom.h[k] + reach[k];
+                }
+                tile_near.clear();
+                tile_near.extend(
+                    (0..boxes.len() as u32)
+                        .filter(|&e| overlaps::<D>(&(lo, hi), &boxes[e as usize])),
+                );
+                if tile_near.is_empty() {
+                    continue;
+                }
+                let mut union = boxes[tile_near[0] as usize];
+                for &e in &tile_near {
+                    for k in 0..D::D {
+                        union.0[k] = union.0[k].min(boxes[e as usize].0[k]);
+                        union.1[k] = union.1[k].max(boxes[e as usize].1[k]);
+                    }
+                }
                 for &i in tiles.particles(t as u32) {
                     let xp = p.x[i as usize];
                     let reach_box = (xp - reach, xp + reach);
+                    if !overlaps::<D>(&reach_box, &union) {
+                        continue;
+                    }
                     near.clear();
                     near.extend(
-                        (0..boxes.len() as u32)
+                        tile_near
+                            .iter()
+                            .copied()
                             .filter(|&e| overlaps::<D>(&reach_box, &boxes[e as usize])),
                     );
                     if near.is_empty() {
@@ -129,6 +156,26 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                     let mut any = false;
                     with_nodes!(shape, N => {
                         let st = Stencil::<N>::cached::<D>(&tiles.stencils, i as usize);
+                        // Drop elements whose line or plane has the particle and every
+                        // corner of its stencil's node box on one side: no line from the
+                        // particle to a node can cross them.
+                        let mut corners = [D::zero(); 8];
+                        for (k, c) in corners.iter_mut().enumerate().take(1 << D::D) {
+                            *c = geom.origin;
+                            for a in 0..D::D {
+                                let i = st.base[a] + (N - 1) * (k >> a & 1);
+                                c[a] += i as f64 * geom.h[a];
+                            }
+                        }
+                        let corners = &corners[..1 << D::D];
+                        near.retain(|&e| {
+                            let el = cracks.elems[e as usize];
+                            let sp = D::elem_side(xp, &cracks.x, el);
+                            corners.iter().any(|&c| D::elem_side(c, &cracks.x, el) != sp)
+                        });
+                        if near.is_empty() {
+                            continue;
+                        }
                         let mut l = 0;
                         st.for_each::<D>(&geom.stride, |n, w, _| {
                             let m = if w != 0.0 {

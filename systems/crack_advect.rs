@@ -2,7 +2,7 @@
 //! and the top and bottom crack surfaces with the fields above and below the crack (Guo &
 //! Nairn 3D (2006) Eqs. 21-23; 2D (2004) section 2.2), which gives the crack opening.
 
-use crate::crack::{Cracks, Fields, side_bit};
+use crate::crack::{Cracks, Fields};
 use crate::dim::Dim;
 use crate::shape::{ShapeKind, Stencil};
 use crate::world::World;
@@ -17,24 +17,18 @@ fn node_velocities<D: Dim>(
     tol: f64,
 ) -> [D::Vec; 3] {
     let (mut m, mut mv) = (mass[n], velocity[n] * mass[n]);
-    let (mut above, mut below) = (None, None);
     for r in fields.rows_of(n as u32) {
         m += mass[r];
         mv += velocity[r] * mass[r];
-        let mask = fields.mask[r - fields.nodes];
-        if mask & side_bit(c, 1) != 0 {
-            above = Some(r);
-        }
-        if mask & side_bit(c, -1) != 0 {
-            below = Some(r);
-        }
     }
     if m <= tol {
         return [D::zero(); 3];
     }
-    // The node's own field is on the side no crossing row claims.
-    let pick = |r: Option<usize>| velocity[r.unwrap_or(n)];
-    [mv * (1.0 / m), pick(above), pick(below)]
+    [
+        mv * (1.0 / m),
+        velocity[fields.side_entry(n, c, 1)],
+        velocity[fields.side_entry(n, c, -1)],
+    ]
 }
 
 /// Moves every crack vertex and both surfaces over the step, interpolating the updated

@@ -3,6 +3,7 @@
 pub mod bin;
 pub mod classify;
 pub mod crack_advect;
+pub mod fracture;
 pub mod g2p;
 pub mod grid_update;
 pub mod p2g;

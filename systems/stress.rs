@@ -57,6 +57,19 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
                 materials[material[i] as usize].update(plane, de, &mut s[k]);
             })
         });
+    displacement_gradient(&mut world.particles, dt);
+}
+
+/// Accumulates the displacement gradient, when it is tracked: grad u += grad v dt.
+fn displacement_gradient<D: Dim>(p: &mut Particles<D>, dt: f64) {
+    if p.grad_u.is_empty() {
+        return;
+    }
+    let Particles { grad_u, grad_v, .. } = p;
+    grad_u
+        .par_iter_mut()
+        .zip(grad_v.par_iter())
+        .for_each(|(u, l)| *u = *u + *l * dt);
 }
 
 /// Sets the grid velocity column to p/m (zero on nodes lighter than the mass tolerance).

@@ -200,3 +200,18 @@ fn bad_cracks_name_the_key() {
     let e = error_with_text("[[crack]]\ntips = [\"end\"]\n");
     assert_error(&e, "crack[0]", None, "exactly one of");
 }
+
+#[test]
+fn bad_fracture_requests_name_the_key() {
+    let crack = "[[crack]]\npoints = [[0.003, 0.01], [0.01, 0.01]]\n";
+    let e = error_with_text("[fracture]\ncontour = 2\n");
+    assert_error(&e, "fracture", None, "at least one [[crack]]");
+    let e = error_with_text(&format!("{crack}tips = []\n[fracture]\n"));
+    assert_error(&e, "fracture", None, "no crack has one");
+    let e = error_with_text(&format!("{crack}[fracture]\ncontour = 6\n"));
+    assert_error(&e, "fracture.contour", None, "leaves the grid");
+    let e = error_with_text(&format!(
+        "{crack}[fracture]\n[[expect]]\nquantity = \"KI\"\ncrack = \"crack0\"\ntip = \"start\"\nreference = 1.0\nsource = \"s\"\ntolerance = 0.1\n"
+    ));
+    assert_error(&e, "expect[0].tip", None, "not a tip");
+}

@@ -14,7 +14,7 @@ use crate::scenario::{Scene, Source, build};
 use crate::schedule::Schedule;
 use crate::snapshot::Reader;
 use crate::snapshot::state::restore;
-use crate::systems::bin;
+use crate::systems::{bin, classify, fracture};
 use crate::world::{Energies, World};
 use anyhow::Context;
 use checkpoint::Checkpointer;
@@ -139,6 +139,7 @@ fn drive<D: Dim>(
         output,
         dt_limit,
         checkpoint,
+        fracture,
     } = scene;
     let mut schedule = Schedule::for_world(&world);
     let dt = world.settings.dt;
@@ -163,9 +164,32 @@ fn drive<D: Dim>(
             checkpoint.every_time,
         ),
     };
+    let crack_names: Option<Vec<String>> = fracture
+        .as_ref()
+        .and(world.cracks.as_ref())
+        .map(|c| c.cracks.iter().map(|c| c.name.clone()).collect());
     let mut writers = match &opts.out {
-        Some(dir) => Some(Writers::open(dir, &names, &state.history)?),
+        Some(dir) => Some(Writers::open(
+            dir,
+            &names,
+            crack_names.as_deref(),
+            &state.history,
+        )?),
         None => None,
+    };
+    let mut fracture_seconds = 0.0;
+    let mut measure = |world: &World<D>, state: &mut RunState, w: &mut Option<Writers>| {
+        let Some(plan) = &fracture else {
+            return Ok::<(), anyhow::Error>(());
+        };
+        let t0 = Instant::now();
+        let tips = fracture::run(world, plan);
+        fracture_seconds += t0.elapsed().as_secs_f64();
+        if let Some(w) = w {
+            w.fracture(&tips)?;
+        }
+        state.history.fracture.extend(tips);
+        Ok(())
     };
     let mut checkpoints = match &opts.out {
         Some(dir) => Some(Checkpointer::new(
@@ -179,6 +203,13 @@ fn drive<D: Dim>(
     if resumed_from.is_none() {
         state.sample(&world, &probes);
         let row = *state.record(&world, world.energies());
+        if fracture.is_some() {
+            // J at t = 0 reads the particles' stencils and fields, which the first step
+            // would build anyway.
+            bin::run(&mut world)?;
+            classify::run(&mut world);
+        }
+        measure(&world, &mut state, &mut writers)?;
         if let Some(w) = &mut writers {
             w.row(&row, &state.history)?;
             if vtk {
@@ -216,6 +247,7 @@ fn drive<D: Dim>(
                 break;
             }
             let row = *state.record(&world, energies);
+            measure(&world, &mut state, &mut writers)?;
             if let Some(w) = &mut writers {
                 w.row(&row, &state.history)?;
             }
@@ -312,6 +344,11 @@ fn drive<D: Dim>(
             .seconds_by_name()
             .into_iter()
             .map(|(n, s)| (n.to_string(), s))
+            .chain(
+                fracture
+                    .is_some()
+                    .then(|| ("fracture".to_string(), fracture_seconds)),
+            )
             .collect(),
         bytes_per_particle: world.bytes_per_particle(),
         bytes_per_node: crate::grid::Grid::<D>::bytes_per_node(),

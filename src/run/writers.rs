@@ -4,6 +4,7 @@
 
 use super::state::RunState;
 use crate::dim::Dim;
+use crate::fracture::TipResult;
 use crate::measure::{History, Row};
 use crate::output::vtk;
 use crate::world::World;
@@ -18,12 +19,19 @@ pub struct Writers {
     pub dir: PathBuf,
     energy: BufWriter<File>,
     probes: BufWriter<File>,
+    fracture: Option<(BufWriter<File>, Vec<String>)>,
 }
 
 impl Writers {
     /// Creates the output folder and the CSV files, holding the header and every row
     /// already recorded in `history` (none for a fresh run).
-    pub fn open(dir: &Path, probe_names: &[String], history: &History) -> anyhow::Result<Self> {
+    /// `cracks` names the cracks when J and K are measured (then fracture.csv is written).
+    pub fn open(
+        dir: &Path,
+        probe_names: &[String],
+        cracks: Option<&[String]>,
+        history: &History,
+    ) -> anyhow::Result<Self> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output folder {}", dir.display()))?;
         let create = |name: &str| -> anyhow::Result<_> {
@@ -40,14 +48,24 @@ impl Writers {
         let mut probes = create("probes.csv")?;
         let names: String = probe_names.iter().map(|n| format!(",{n}")).collect();
         writeln!(probes, "step,time{names}")?;
+        let fracture = match cracks {
+            Some(names) => {
+                let mut f = create("fracture.csv")?;
+                writeln!(f, "step,time,crack,tip,x,y,z,J1,J2,KI,KII,KIII")?;
+                Some((f, names.to_vec()))
+            }
+            None => None,
+        };
         let mut w = Writers {
             dir: dir.to_path_buf(),
             energy,
             probes,
+            fracture,
         };
         for row in &history.rows {
             w.row(row, history)?;
         }
+        w.fracture(&history.fracture)?;
         Ok(w)
     }
 
@@ -66,6 +84,32 @@ impl Writers {
             write!(self.probes, ",{:.9e}", s[k])?;
         }
         writeln!(self.probes)?;
+        Ok(())
+    }
+
+    /// Appends J and K at crack tips to fracture.csv (SI: J/m^2, Pa sqrt(m)).
+    pub fn fracture(&mut self, tips: &[TipResult]) -> anyhow::Result<()> {
+        let Some((f, names)) = &mut self.fracture else {
+            return Ok(());
+        };
+        for t in tips {
+            writeln!(
+                f,
+                "{},{:.9e},{},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
+                t.step,
+                t.time,
+                names[t.crack as usize],
+                ["start", "end"][t.tip as usize],
+                t.x[0],
+                t.x[1],
+                t.x[2],
+                t.j[0],
+                t.j[1],
+                t.k[0],
+                t.k[1],
+                t.k[2]
+            )?;
+        }
         Ok(())
     }
 
@@ -88,6 +132,9 @@ impl Writers {
     pub fn flush(&mut self) -> anyhow::Result<()> {
         self.energy.flush()?;
         self.probes.flush()?;
+        if let Some((f, _)) = &mut self.fracture {
+            f.flush()?;
+        }
         Ok(())
     }
 }

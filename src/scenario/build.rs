@@ -5,6 +5,7 @@ use super::source::Source;
 use crate::bodies::{Geometry, fill};
 use crate::dim::Dim;
 use crate::error::ScenarioError;
+use crate::fracture::FracturePlan;
 use crate::grid::{Grid, GridGeom};
 use crate::loads::{Load, VelocityBc};
 use crate::material::{Elastic, Plane};
@@ -63,6 +64,8 @@ pub struct Scene<D: Dim> {
     pub dt_limit: f64,
     /// Snapshot cadence.
     pub checkpoint: CheckpointPlan,
+    /// J and K measurement, when the scenario asks for it.
+    pub fracture: Option<FracturePlan>,
 }
 
 type R<T> = Result<T, ScenarioError>;
@@ -441,6 +444,22 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 .ok_or_else(|| src.error(&key("probes"), format!("no probe named `{name}`")))?;
             ids.push(id);
         }
+        if let Some(qty) = ["KI", "KII", "J1", "J2"]
+            .iter()
+            .position(|q| *q == e.quantity)
+        {
+            let measure = super::cracks::tip_measure(src, i, e, qty)?;
+            positive(src, &key("tolerance"), e.tolerance, "relative")?;
+            expects.push(Expect {
+                quantity: e.quantity.clone(),
+                probes: e.crack.iter().cloned().collect(),
+                measure,
+                reference: e.reference,
+                source: e.source.clone(),
+                tolerance: e.tolerance,
+            });
+            continue;
+        }
         let need = match e.quantity.as_str() {
             "wave_speed" => 2,
             "final" | "max" | "min" | "frequency" => 1,
@@ -450,7 +469,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     &key("quantity"),
                     format!(
                         "unknown quantity `{other}` (final, max, min, frequency, wave_speed, \
-                         momentum_drift, energy_drift, angular_momentum_drift)"
+                         momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2)"
                     ),
                 ));
             }
@@ -505,6 +524,10 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     };
     let checkpoint = checkpoint_plan(src)?;
     let cracks = super::cracks::build::<D>(src, &particles, &geom)?;
+    let fracture = super::cracks::fracture_plan(src, cracks.as_ref(), &geom)?;
+    if fracture.is_some() {
+        particles.grad_u = vec![D::mat_zero(); particles.len()];
+    }
     let min_mass = particles.mass.iter().copied().fold(f64::INFINITY, f64::min);
     let world = World {
         tiles,
@@ -519,6 +542,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             gravity: to_vec::<D>(gravity),
             dt,
             mass_tol: 1e-12 * min_mass,
+            thickness,
         },
         loads,
         bcs,
@@ -541,6 +565,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         },
         dt_limit,
         checkpoint,
+        fracture,
     })
 }
 

@@ -1,12 +1,14 @@
 //! Building the crack store from `[[crack]]` tables, with every check a crack needs.
 
 use super::build::{positive, to_vec, vec3};
-use super::schema::CrackSpec;
+use super::schema::{CrackSpec, ExpectSpec};
 use super::source::Source;
 use crate::crack::{Crack, Cracks, MAX_CRACKS};
 use crate::dim::Dim;
 use crate::error::ScenarioError;
+use crate::fracture::FracturePlan;
 use crate::grid::GridGeom;
+use crate::measure::Measure;
 use crate::particles::Particles;
 
 type R<T> = Result<T, ScenarioError>;
@@ -186,4 +188,97 @@ fn self_crossing<D: Dim>(pts: &[D::Vec]) -> Option<(usize, usize)> {
         }
     }
     None
+}
+
+/// The `[fracture]` table, checked against the cracks: they must exist and have tips, and
+/// the contour around each tip must fit inside the grid.
+pub(super) fn fracture_plan<D: Dim>(
+    src: &Source,
+    cracks: Option<&Cracks<D>>,
+    geom: &GridGeom<D>,
+) -> R<Option<FracturePlan>> {
+    let Some(f) = &src.scenario.fracture else {
+        return Ok(None);
+    };
+    let Some(cracks) = cracks else {
+        return Err(src.error("fracture", "J and K need at least one [[crack]]"));
+    };
+    if !cracks.cracks.iter().any(|c| c.tips[0] || c.tips[1]) {
+        return Err(src.error(
+            "fracture",
+            "J and K are measured at crack tips, and no crack has one (see `tips`)",
+        ));
+    }
+    let n = f.contour.unwrap_or(2);
+    if n == 0 {
+        return Err(src.error("fracture.contour", "must be at least 1 cell"));
+    }
+    for c in &cracks.cracks {
+        for (end, k) in [(0, c.vertices.start), (1, c.vertices.end - 1)] {
+            if !c.tips[end] {
+                continue;
+            }
+            let x = cracks.x[k];
+            let fits = (0..D::D).all(|a| {
+                let i = ((x[a] - geom.origin[a]) * geom.inv_h[a]).round();
+                i >= n as f64 && i + n as f64 <= geom.cells[a] as f64
+            });
+            if !fits {
+                return Err(src.error(
+                    "fracture.contour",
+                    format!(
+                        "a {n} x {n} cell contour around the {} tip of `{}` leaves the grid",
+                        ["start", "end"][end],
+                        c.name
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(Some(FracturePlan {
+        contour: n,
+        area_term: f.area_term.unwrap_or(true),
+    }))
+}
+
+/// The measure of an expect on a crack tip (`qty` 0..4 = KI, KII, J1, J2).
+pub(super) fn tip_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) -> R<Measure> {
+    let key = |k: &str| format!("expect[{i}].{k}");
+    let sc = &src.scenario;
+    if sc.fracture.is_none() {
+        return Err(src.error(
+            &key("quantity"),
+            format!("`{}` needs a [fracture] table", e.quantity),
+        ));
+    }
+    let name = e
+        .crack
+        .as_deref()
+        .ok_or_else(|| src.error(&key("quantity"), "name the crack with `crack = ...`"))?;
+    let c = sc
+        .cracks
+        .iter()
+        .enumerate()
+        .position(|(k, c)| c.name.clone().unwrap_or_else(|| format!("crack{k}")) == name)
+        .ok_or_else(|| src.error(&key("crack"), format!("no crack named `{name}`")))?;
+    let tip = match e.tip.as_deref().unwrap_or("end") {
+        "start" => 0,
+        "end" => 1,
+        other => return Err(src.error(&key("tip"), format!("unknown tip `{other}` (start, end)"))),
+    };
+    let tips = sc.cracks[c]
+        .tips
+        .clone()
+        .unwrap_or_else(|| vec!["end".into()]);
+    if !tips.iter().any(|t| t == ["start", "end"][tip]) {
+        return Err(src.error(
+            &key("tip"),
+            format!("the {} of `{name}` is not a tip", ["start", "end"][tip]),
+        ));
+    }
+    Ok(Measure::Tip {
+        crack: c as u32,
+        tip: tip as u32,
+        qty,
+    })
 }

@@ -41,6 +41,8 @@ pub struct Scenario {
     /// Snapshot cadence for checkpoint and restart.
     #[serde(default)]
     pub checkpoint: CheckpointSpec,
+    /// J-integral and K at crack tips (needs cracks).
+    pub fracture: Option<FractureSpec>,
     /// Self-checks against reference values.
     #[serde(default, rename = "expect")]
     pub expects: Vec<ExpectSpec>,
@@ -283,6 +285,16 @@ pub struct OutputSpec {
     pub plot: Option<bool>,
 }
 
+/// `[fracture]`: J and K at every crack tip, at the history cadence (fracture.csv).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FractureSpec {
+    /// Half-size n of the n x n square contour, in cells (default 2).
+    pub contour: Option<usize>,
+    /// Include the area term of Guo & Nairn 2D (2004) Eq. 8 (default true).
+    pub area_term: Option<bool>,
+}
+
 /// `[checkpoint]`: when to write snapshots into `<out>/snapshots/` (any combination; none
 /// set means snapshots only on a clean stop).
 #[derive(Debug, Clone, Deserialize, Default)]
@@ -303,11 +315,15 @@ pub struct CheckpointSpec {
 #[serde(deny_unknown_fields)]
 pub struct ExpectSpec {
     /// One of: final, max, min, frequency, wave_speed, momentum_drift, energy_drift,
-    /// angular_momentum_drift.
+    /// angular_momentum_drift; KI, KII, J1, J2 (last value at a crack tip).
     pub quantity: String,
     /// Probe(s) the quantity is measured on (wave_speed takes two).
     #[serde(default)]
     pub probes: Vec<String>,
+    /// Crack name, for KI, KII, J1, J2.
+    pub crack: Option<String>,
+    /// Tip of that crack: "start" or "end" (default "end").
+    pub tip: Option<String>,
     /// Reference value (SI).
     pub reference: f64,
     /// Where the reference comes from.

@@ -5,6 +5,7 @@
 
 use super::format::{ColumnSet, Header, Reader, SnapshotError};
 use crate::dim::Dim;
+use crate::fracture::TipResult;
 use crate::material::Elastic;
 use crate::measure::{History, Row};
 use crate::run::state::RunState;
@@ -31,6 +32,15 @@ fn row_data(r: &Row) -> [f64; ROW_WIDTH] {
         r.angular[0],
         r.angular[1],
         r.angular[2],
+    ]
+}
+
+/// Scalars per crack-tip result in the `history.fracture.data` column.
+const TIP_WIDTH: usize = 9;
+
+fn tip_data(t: &TipResult) -> [f64; TIP_WIDTH] {
+    [
+        t.time, t.x[0], t.x[1], t.x[2], t.j[0], t.j[1], t.k[0], t.k[1], t.k[2],
     ]
 }
 
@@ -67,6 +77,13 @@ pub fn write<D: Dim>(
     let h = &state.history;
     let row_steps: Vec<u64> = h.rows.iter().map(|r| r.step).collect();
     let rows: Vec<f64> = h.rows.iter().flat_map(row_data).collect();
+    let tip_steps: Vec<u64> = h.fracture.iter().map(|t| t.step).collect();
+    let tip_ids: Vec<u64> = h
+        .fracture
+        .iter()
+        .map(|t| 2 * u64::from(t.crack) + u64::from(t.tip))
+        .collect();
+    let tip_data: Vec<f64> = h.fracture.iter().flat_map(tip_data).collect();
     let probe_names: Vec<String> = (0..h.probes.len())
         .map(|k| format!("history.probe.{k}"))
         .collect();
@@ -83,6 +100,7 @@ pub fn write<D: Dim>(
     c.add("particles.grad_v", &p.grad_v);
     c.add("particles.material", &p.material);
     c.add("particles.half", &p.half);
+    c.add("particles.grad_u", &p.grad_u);
     c.add("materials.youngs", &youngs);
     c.add("materials.poisson", &poisson);
     c.add("materials.density", &density);
@@ -99,6 +117,9 @@ pub fn write<D: Dim>(
         c.add("cracks.top", &cr.top);
         c.add("cracks.bottom", &cr.bottom);
     }
+    c.add("history.fracture.step", &tip_steps);
+    c.add("history.fracture.tip", &tip_ids);
+    c.add("history.fracture.data", &tip_data);
     c.add("history.rows.step", &row_steps);
     c.add("history.rows.data", &rows);
     let header = Header {
@@ -190,6 +211,7 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     p.grad_v = r.column("particles.grad_v", n)?;
     p.material = r.column("particles.material", n)?;
     p.half = r.column("particles.half", if p.half.is_empty() { 0 } else { n })?;
+    p.grad_u = r.column("particles.grad_u", if p.grad_u.is_empty() { 0 } else { n })?;
     let nm = w.materials.len();
     let youngs: Vec<f64> = r.column("materials.youngs", nm)?;
     let poisson: Vec<f64> = r.column("materials.poisson", nm)?;
@@ -231,6 +253,23 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
         .iter()
         .zip(data.chunks_exact(ROW_WIDTH))
         .map(|(&s, d)| row_from(s, d))
+        .collect();
+    let tip_steps: Vec<u64> = r.column_any("history.fracture.step")?;
+    let tip_ids: Vec<u64> = r.column("history.fracture.tip", tip_steps.len())?;
+    let data: Vec<f64> = r.column("history.fracture.data", tip_steps.len() * TIP_WIDTH)?;
+    history.fracture = tip_steps
+        .iter()
+        .zip(&tip_ids)
+        .zip(data.chunks_exact(TIP_WIDTH))
+        .map(|((&step, &id), d)| TipResult {
+            step,
+            time: d[0],
+            crack: (id / 2) as u32,
+            tip: (id % 2) as u32,
+            x: [d[1], d[2], d[3]],
+            j: [d[4], d[5]],
+            k: [d[6], d[7], d[8]],
+        })
         .collect();
     let state = RunState {
         history,

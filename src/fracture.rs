@@ -1,0 +1,115 @@
+//! Fracture measurement results and the conversion of the energy release rate into stress
+//! intensity factors from the crack opening (Guo & Nairn 2D (2004) Eqs. 10, 14-22).
+
+use crate::material::{Elastic, Plane};
+
+/// What to measure at crack tips, from the scenario's `[fracture]` table.
+#[derive(Clone, Debug)]
+pub struct FracturePlan {
+    /// Half-size of the square J contour in cells (n for an n x n contour).
+    pub contour: usize,
+    /// Add the area integral of Guo & Nairn 2D (2004) Eq. 8 (path independence in dynamics).
+    pub area_term: bool,
+}
+
+/// J and K at one crack tip at one time (SI: J/m^2, Pa sqrt(m)).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TipResult {
+    /// Step.
+    pub step: u64,
+    /// Time (s).
+    pub time: f64,
+    /// Crack index.
+    pub crack: u32,
+    /// 0 for the crack's start vertex, 1 for its end vertex.
+    pub tip: u32,
+    /// Tip position (m).
+    pub x: [f64; 3],
+    /// J components in global x and y (Eq. 7 or 8).
+    pub j: [f64; 2],
+    /// Mode I, II and III stress intensity factors (KIII = 0 in 2D).
+    pub k: [f64; 3],
+}
+
+/// Crack-speed factors for a tip running at speed `c` (Nishioka 1995, as quoted in Guo &
+/// Nairn 2D (2004) Eqs. 16-18): (beta_d, beta_s, A_I, A_II) with beta_d = sqrt(1 - c^2/cd^2)
+/// and beta_s = sqrt(1 - c^2/cs^2). At c = 0 the A's take their limit (kappa + 1)/4 (Eq. 20).
+pub fn speed_factors(c: f64, cs: f64, cd: f64, kappa: f64) -> (f64, f64, f64, f64) {
+    if c == 0.0 {
+        let a = (kappa + 1.0) / 4.0;
+        return (1.0, 1.0, a, a);
+    }
+    let bd = (1.0 - (c / cd).powi(2)).sqrt();
+    let bs = (1.0 - (c / cs).powi(2)).sqrt();
+    let d = 4.0 * bd * bs - (1.0 + bs * bs).powi(2);
+    (bd, bs, bd * (1.0 - bs * bs) / d, bs * (1.0 - bs * bs) / d)
+}
+
+/// kappa: 3 - 4 nu in plane strain (and 3D), (3 - nu)/(1 + nu) in plane stress.
+pub fn kappa(m: &Elastic, plane: Plane) -> f64 {
+    match plane {
+        Plane::Stress => (3.0 - m.poisson) / (1.0 + m.poisson),
+        Plane::Strain | Plane::None => 3.0 - 4.0 * m.poisson,
+    }
+}
+
+/// K_I and K_II from the energy release rate `g` and the opening `d_i` and sliding `d_ii`
+/// displacements behind a tip running at speed `c` (Guo & Nairn 2D (2004) Eqs. 14-15; at
+/// c = 0 these reduce to Eqs. 21-22). NaN when the crack is closed (no opening to split by).
+pub fn k_from_g(m: &Elastic, plane: Plane, g: f64, d_i: f64, d_ii: f64, c: f64) -> [f64; 2] {
+    let kap = kappa(m, plane);
+    let cs = (m.mu / m.density).sqrt();
+    let cd = cs * ((kap + 1.0) / (kap - 1.0)).sqrt();
+    let (bd, bs, a1, a2) = speed_factors(c, cs, cd, kap);
+    let den = d_i * d_i * bs + d_ii * d_ii * bd;
+    if den == 0.0 {
+        return [f64::NAN; 2];
+    }
+    let g = g.max(0.0);
+    [
+        d_i * (2.0 * m.mu * g * bs / (a1 * den)).sqrt(),
+        d_ii * (2.0 * m.mu * g * bd / (a2 * den)).sqrt(),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// At c = 0, Eqs. 14-15 are K = (delta/|delta|) sqrt(G E') (Eqs. 21-22).
+    #[test]
+    fn stationary_limit_is_sqrt_g_e() {
+        let m = Elastic::new("m", 2.3e9, 0.33, 1500.0);
+        let g = 10.0;
+        for (plane, e) in [
+            (Plane::Stress, 2.3e9),
+            (Plane::Strain, 2.3e9 / (1.0 - 0.33 * 0.33)),
+        ] {
+            let [k1, k2] = k_from_g(&m, plane, g, 3.0, 4.0, 0.0);
+            let k = (g * e).sqrt();
+            assert!(
+                (k1 - 0.6 * k).abs() < 1e-12 * k,
+                "{plane:?}: {k1} vs {}",
+                0.6 * k
+            );
+            assert!((k2 - 0.8 * k).abs() < 1e-12 * k);
+        }
+    }
+
+    /// The speed factors tend to their c = 0 limit (kappa + 1)/4 (Eq. 20) and grow as the
+    /// speed approaches the Rayleigh speed, where D = 0.
+    #[test]
+    fn speed_factors_are_continuous_at_rest() {
+        let (cs, nu): (f64, f64) = (1000.0, 0.3);
+        let kap: f64 = 3.0 - 4.0 * nu;
+        let cd = cs * ((kap + 1.0) / (kap - 1.0)).sqrt();
+        let (_, _, a1, a2) = speed_factors(1e-3 * cs, cs, cd, kap);
+        let limit = (kap + 1.0) / 4.0;
+        assert!(
+            (a1 - limit).abs() < 1e-5 && (a2 - limit).abs() < 1e-5,
+            "{a1} {a2}"
+        );
+        let (_, _, fast, _) = speed_factors(0.5 * cs, cs, cd, kap);
+        assert!(fast > 1.1 * limit);
+    }
+}

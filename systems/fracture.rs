@@ -1,0 +1,310 @@
+//! `fracture`: the dynamic J-integral around each crack tip on a square contour along grid
+//! lines, split where the crack crosses it (Guo & Nairn 2D (2004) Eqs. 7, 11-13), with the
+//! optional area term (Eq. 8), then G (Eq. 10) and K_I, K_II from the crack opening
+//! (Eqs. 14-22). Runs on output steps only; it reads the world and changes nothing.
+
+use crate::crack::{Crack, Cracks};
+use crate::dim::Dim;
+use crate::fracture::{FracturePlan, TipResult, k_from_g};
+use crate::shape::Stencil;
+use crate::with_nodes;
+use crate::world::World;
+use std::collections::HashMap;
+
+/// Mass-weighted nodal values of one field (Eq. 11): stress xx, yy, xy; displacement
+/// gradient du_i/dx_j as [00, 01, 10, 11]; strain and kinetic energy densities.
+#[derive(Clone, Copy, Debug, Default)]
+struct Nodal {
+    s: [f64; 3],
+    gu: [f64; 4],
+    w: f64,
+    k: f64,
+}
+
+impl Nodal {
+    fn lerp(a: &Nodal, b: &Nodal, t: f64) -> Nodal {
+        let l = |x: f64, y: f64| x + (y - x) * t;
+        Nodal {
+            s: [0, 1, 2].map(|i| l(a.s[i], b.s[i])),
+            gu: [0, 1, 2, 3].map(|i| l(a.gu[i], b.gu[i])),
+            w: l(a.w, b.w),
+            k: l(a.k, b.k),
+        }
+    }
+
+    /// The integrand F_m of Eq. 13 for outward normal `n`, m = x and y.
+    fn integrand(&self, n: [f64; 2]) -> [f64; 2] {
+        let [sxx, syy, sxy] = self.s;
+        let t = [sxx * n[0] + sxy * n[1], sxy * n[0] + syy * n[1]];
+        let e = self.w + self.k;
+        [
+            e * n[0] - (t[0] * self.gu[0] + t[1] * self.gu[2]),
+            e * n[1] - (t[0] * self.gu[1] + t[1] * self.gu[3]),
+        ]
+    }
+}
+
+/// J and K at every tip of every crack.
+pub fn run<D: Dim>(world: &World<D>, plan: &FracturePlan) -> Vec<TipResult> {
+    let Some(cracks) = &world.cracks else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (c, crack) in cracks.cracks.iter().enumerate() {
+        for end in 0..2 {
+            if crack.tips[end] {
+                out.push(tip::<D>(world, cracks, c, crack, end, plan));
+            }
+        }
+    }
+    out
+}
+
+/// The square contour of half-size `n` cells around node (i0, j0), counterclockwise, as
+/// node indices (closed: the first node is repeated at the end).
+fn contour(i0: usize, j0: usize, n: usize) -> Vec<[usize; 2]> {
+    let (lo_i, hi_i, lo_j, hi_j) = (i0 - n, i0 + n, j0 - n, j0 + n);
+    let mut p = Vec::with_capacity(8 * n + 1);
+    p.extend((lo_i..hi_i).map(|i| [i, lo_j]));
+    p.extend((lo_j..hi_j).map(|j| [hi_i, j]));
+    p.extend((lo_i + 1..=hi_i).rev().map(|i| [i, hi_j]));
+    p.extend((lo_j + 1..=hi_j).rev().map(|j| [lo_i, j]));
+    p.push([lo_i, lo_j]);
+    p
+}
+
+/// Where segment a-b meets segment c-d: the parameter along a-b, if they properly cross.
+fn intersect(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> Option<f64> {
+    let r = [b[0] - a[0], b[1] - a[1]];
+    let s = [d[0] - c[0], d[1] - c[1]];
+    let den = r[0] * s[1] - r[1] * s[0];
+    if den == 0.0 {
+        return None;
+    }
+    let q = [c[0] - a[0], c[1] - a[1]];
+    let t = (q[0] * s[1] - q[1] * s[0]) / den;
+    let u = (q[0] * r[1] - q[1] * r[0]) / den;
+    ((0.0..1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
+}
+
+fn tip<D: Dim>(
+    world: &World<D>,
+    cracks: &Cracks<D>,
+    c: usize,
+    crack: &Crack,
+    end: usize,
+    plan: &FracturePlan,
+) -> TipResult {
+    let g = &world.grid;
+    let geom = &g.geom;
+    let xy = |v: D::Vec| [v[0], v[1]];
+    let verts = crack.vertices.clone();
+    let (kt, kp) = if end == 1 {
+        (verts.end - 1, verts.end - 2)
+    } else {
+        (verts.start, verts.start + 1)
+    };
+    let xt = xy(cracks.x[kt]);
+    let mut res = TipResult {
+        step: world.step,
+        time: world.time,
+        crack: c as u32,
+        tip: end as u32,
+        x: D::to_xyz(cracks.x[kt]),
+        j: [f64::NAN; 2],
+        k: [f64::NAN, f64::NAN, 0.0],
+    };
+
+    // The contour around the node nearest the tip, shrunk to fit inside the grid.
+    let node = |a: usize| ((xt[a] - geom.origin[a]) * geom.inv_h[a]).round().max(0.0) as usize;
+    let (i0, j0) = (node(0), node(1));
+    let room = i0
+        .min(j0)
+        .min(geom.cells[0] - i0.min(geom.cells[0]))
+        .min(geom.cells[1] - j0.min(geom.cells[1]));
+    let n = plan.contour.min(room);
+    if n == 0 {
+        return res;
+    }
+    let ring = contour(i0, j0, n);
+    let pos = |q: [usize; 2]| {
+        [
+            geom.origin[0] + q[0] as f64 * geom.h[0],
+            geom.origin[1] + q[1] as f64 * geom.h[1],
+        ]
+    };
+    let index = |q: [usize; 2]| q[0] + geom.stride[1] * q[1];
+
+    // Where the crack leaves the contour: edge e at parameter s, crossing crack segment k.
+    let mut cut = None;
+    'find: for e in 0..ring.len() - 1 {
+        let (a, b) = (pos(ring[e]), pos(ring[e + 1]));
+        for k in verts.start..verts.end - 1 {
+            if let Some(s) = intersect(a, b, xy(cracks.x[k]), xy(cracks.x[k + 1])) {
+                cut = Some((e, s, k));
+                break 'find;
+            }
+        }
+    }
+    let Some((e, s, k)) = cut else {
+        return res;
+    };
+    // The path starts on the side of the crack that ring[e + 1] is on and ends on the other.
+    let (ca, cb) = (xy(cracks.x[k]), xy(cracks.x[k + 1]));
+    let after = pos(ring[e + 1]);
+    let orient = (cb[0] - ca[0]) * (after[1] - ca[1]) - (cb[1] - ca[1]) * (after[0] - ca[0]);
+    let first: i8 = if orient >= 0.0 { 1 } else { -1 };
+    let fields = &cracks.fields;
+
+    // Nodal values of every field at the contour nodes (Eq. 11).
+    let mut acc: HashMap<usize, [f64; 10]> = HashMap::new();
+    for q in &ring {
+        let nidx = index(*q);
+        acc.insert(nidx, [0.0; 10]);
+        for r in fields.rows_of(nidx as u32) {
+            acc.insert(r, [0.0; 10]);
+        }
+    }
+    let p = &world.particles;
+    let shape = world.settings.shape;
+    let (lo, hi) = (pos([i0 - n, j0 - n]), pos([i0 + n, j0 + n]));
+    let reach = 2.0 * geom.h[0].max(geom.h[1]);
+    let mut area = [0.0; 2];
+    let mut nearest = (f64::INFINITY, 0usize);
+    for i in 0..p.len() {
+        let x = xy(p.x[i]);
+        if x[0] < lo[0] - reach
+            || x[0] > hi[0] + reach
+            || x[1] < lo[1] - reach
+            || x[1] > hi[1] + reach
+        {
+            continue;
+        }
+        let d2 = (x[0] - xt[0]).powi(2) + (x[1] - xt[1]).powi(2);
+        if d2 < nearest.0 {
+            nearest = (d2, i);
+        }
+        let m = p.mass[i];
+        let mat = &world.materials[p.material[i] as usize];
+        let st = p.stress[i];
+        let gu = p.grad_u[i];
+        let gu = [
+            D::entry(&gu, 0, 0),
+            D::entry(&gu, 0, 1),
+            D::entry(&gu, 1, 0),
+            D::entry(&gu, 1, 1),
+        ];
+        let v = xy(p.v[i]);
+        let f = [
+            m,
+            m * st.xx,
+            m * st.yy,
+            m * st.xy,
+            m * gu[0],
+            m * gu[1],
+            m * gu[2],
+            m * gu[3],
+            m * mat.energy_density(&st),
+            m * 0.5 * (m / p.volume[i]) * (v[0] * v[0] + v[1] * v[1]),
+        ];
+        let targets = fields.targets_of(i);
+        let inside = x[0] > lo[0] && x[0] < hi[0] && x[1] > lo[1] && x[1] < hi[1];
+        let mut accel = [0.0; 2];
+        with_nodes!(shape, N => {
+            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
+            let mut visit = |entry: usize, w: f64| {
+                if let Some(a) = acc.get_mut(&entry) {
+                    for (a, f) in a.iter_mut().zip(&f) {
+                        *a += f * w;
+                    }
+                }
+                if inside {
+                    accel[0] += g.accel[entry][0] * w;
+                    accel[1] += g.accel[entry][1] * w;
+                }
+            };
+            match targets {
+                Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, w, _| visit(n, w)),
+                None => st.for_each::<D>(&geom.stride, |n, w, _| visit(n, w)),
+            }
+        });
+        if inside && plan.area_term {
+            // Eq. 8's area term: rho [a . du/dx_m - v . dv/dx_m] over the particle's area
+            // V / thickness, with rho V = m.
+            let gv = p.grad_v[i];
+            let scale = m / world.settings.thickness;
+            for (mm, a) in area.iter_mut().enumerate() {
+                let du = [D::entry(&p.grad_u[i], 0, mm), D::entry(&p.grad_u[i], 1, mm)];
+                let dv = [D::entry(&gv, 0, mm), D::entry(&gv, 1, mm)];
+                *a += scale * (accel[0] * du[0] + accel[1] * du[1] - v[0] * dv[0] - v[1] * dv[1]);
+            }
+        }
+    }
+    let value = |entry: usize| -> Nodal {
+        let a = acc.get(&entry).copied().unwrap_or([0.0; 10]);
+        if a[0] <= world.settings.mass_tol {
+            return Nodal::default();
+        }
+        let m = a[0];
+        Nodal {
+            s: [a[1] / m, a[2] / m, a[3] / m],
+            gu: [a[4] / m, a[5] / m, a[6] / m, a[7] / m],
+            w: a[8] / m,
+            k: a[9] / m,
+        }
+    };
+
+    // The split path: crossing point, ring[e + 1], ..., ring[e], crossing point (Eq. 12).
+    let m = ring.len() - 1;
+    let order: Vec<usize> = (1..=m).map(|q| (e + q) % m).collect();
+    let at = |q: usize, side: i8| value(fields.side_entry(index(ring[q]), c, side));
+    let cross = {
+        let (a, b) = (pos(ring[e]), pos(ring[e + 1]));
+        [a[0] + (b[0] - a[0]) * s, a[1] + (b[1] - a[1]) * s]
+    };
+    let mut pts = vec![cross];
+    let mut vals = vec![Nodal::lerp(&at(e, first), &at(e + 1, first), s)];
+    for (q, &r) in order.iter().enumerate() {
+        let side = if 2 * q < order.len() { first } else { -first };
+        pts.push(pos(ring[r]));
+        vals.push(at(r, side));
+    }
+    pts.push(cross);
+    vals.push(Nodal::lerp(&at(e, -first), &at(e + 1, -first), s));
+    let mut j = area;
+    if !plan.area_term {
+        j = [0.0; 2];
+    }
+    for q in 0..pts.len() - 1 {
+        let (a, b) = (pts[q], pts[q + 1]);
+        let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+        if len == 0.0 {
+            continue;
+        }
+        let normal = [(b[1] - a[1]) / len, -(b[0] - a[0]) / len];
+        let (fa, fb) = (vals[q].integrand(normal), vals[q + 1].integrand(normal));
+        for (mm, jm) in j.iter_mut().enumerate() {
+            *jm += 0.5 * (fa[mm] + fb[mm]) * len;
+        }
+    }
+    res.j = j;
+
+    // G along the tip direction (Eq. 10), split by the opening behind the tip (Eqs. 14-22).
+    let xp = xy(cracks.x[kp]);
+    let len = ((xt[0] - xp[0]).powi(2) + (xt[1] - xp[1]).powi(2)).sqrt();
+    let dir = [(xt[0] - xp[0]) / len, (xt[1] - xp[1]) / len];
+    let gr = j[0] * dir[0] + j[1] * dir[1];
+    // The surface left of the tip direction: the top one at an end tip, the bottom at a start.
+    let (upper, lower) = if end == 1 {
+        (cracks.top[kp], cracks.bottom[kp])
+    } else {
+        (cracks.bottom[kp], cracks.top[kp])
+    };
+    let d = xy(upper - lower);
+    let d_i = -d[0] * dir[1] + d[1] * dir[0];
+    let d_ii = d[0] * dir[0] + d[1] * dir[1];
+    let mat = &world.materials[p.material[nearest.1] as usize];
+    let [k1, k2] = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
+    res.k = [k1, k2, 0.0];
+    res
+}
