@@ -1,0 +1,35 @@
+//! Crack systems on the DCB scene (`scenarios/dcb_2d.toml`, 9,600 particles, a 50 mm crack
+//! with 104 segments): `classify` per step and the J-integral at the tip per output step.
+//!
+//! `cargo bench --bench cracks`.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use fissure::dim::D2;
+use fissure::scenario::{Source, build};
+use fissure::schedule::Schedule;
+use fissure::systems::{classify, fracture};
+use std::time::Duration;
+
+fn cracks(c: &mut Criterion) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/dcb_2d.toml");
+    let src = Source::load(std::path::Path::new(path), &[]).expect("the DCB scenario loads");
+    let scene = build::<D2>(&src).expect("the DCB scenario builds");
+    let plan = scene.fracture.clone().expect("the DCB measures J");
+    let mut world = scene.world;
+    let mut schedule = Schedule::for_world(&world);
+    for _ in 0..50 {
+        schedule.step(&mut world).expect("stable");
+    }
+    let mut g = c.benchmark_group("cracks-dcb");
+    g.sample_size(20)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3));
+    g.throughput(Throughput::Elements(world.particles.len() as u64));
+    g.bench_function("classify", |b| b.iter(|| classify::run(&mut world)));
+    g.throughput(Throughput::Elements(1));
+    g.bench_function("j_integral", |b| b.iter(|| fracture::run(&world, &plan)));
+    g.finish();
+}
+
+criterion_group!(benches, cracks);
+criterion_main!(benches);
