@@ -10,6 +10,9 @@ pub struct FracturePlan {
     pub contour: usize,
     /// Add the area integral of Guo & Nairn 2D (2004) Eq. 8 (path independence in dynamics).
     pub area_term: bool,
+    /// Distance behind the tip, in cells, where the crack opening that splits G into K_I
+    /// and K_II is read.
+    pub opening: f64,
 }
 
 /// J and K at one crack tip at one time (SI: J/m^2, Pa sqrt(m)).

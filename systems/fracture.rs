@@ -73,6 +73,10 @@ fn contour(i0: usize, j0: usize, n: usize) -> Vec<[usize; 2]> {
     p
 }
 
+fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+}
+
 /// Where segment a-b meets segment c-d: the parameter along a-b, if they properly cross.
 fn intersect(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> Option<f64> {
     let r = [b[0] - a[0], b[1] - a[1]];
@@ -295,10 +299,26 @@ fn tip<D: Dim>(
     let dir = [(xt[0] - xp[0]) / len, (xt[1] - xp[1]) / len];
     let gr = j[0] * dir[0] + j[1] * dir[1];
     // The surface left of the tip direction: the top one at an end tip, the bottom at a start.
+    // The opening is read at the first vertex at least `opening` cells behind the tip (the
+    // paper's next-to-last crack point, for points spaced that far apart): closer vertices
+    // sit in the few cells where the grid cannot resolve the sqrt(r) opening.
+    let want = plan.opening * geom.h[0].max(geom.h[1]);
+    let mut kc = kp;
+    while dist(xy(cracks.x[kc]), xt) < want {
+        let next = if end == 1 {
+            kc.checked_sub(1)
+        } else {
+            Some(kc + 1)
+        };
+        match next {
+            Some(k) if verts.contains(&k) => kc = k,
+            _ => break,
+        }
+    }
     let (upper, lower) = if end == 1 {
-        (cracks.top[kp], cracks.bottom[kp])
+        (cracks.top[kc], cracks.bottom[kc])
     } else {
-        (cracks.bottom[kp], cracks.top[kp])
+        (cracks.bottom[kc], cracks.top[kc])
     };
     let d = xy(upper - lower);
     let d_i = -d[0] * dir[1] + d[1] * dir[0];

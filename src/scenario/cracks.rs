@@ -235,9 +235,14 @@ pub(super) fn fracture_plan<D: Dim>(
             }
         }
     }
+    let opening = match f.opening {
+        Some(c) => positive(src, "fracture.opening", c, "cells")?,
+        None => 2.0,
+    };
     Ok(Some(FracturePlan {
         contour: n,
         area_term: f.area_term.unwrap_or(true),
+        opening,
     }))
 }
 

@@ -293,6 +293,9 @@ pub struct FractureSpec {
     pub contour: Option<usize>,
     /// Include the area term of Guo & Nairn 2D (2004) Eq. 8 (default true).
     pub area_term: Option<bool>,
+    /// Cells behind the tip where the crack opening is read to split G into K_I and K_II
+    /// (default 2).
+    pub opening: Option<f64>,
 }
 
 /// `[checkpoint]`: when to write snapshots into `<out>/snapshots/` (any combination; none
