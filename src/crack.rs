@@ -3,6 +3,7 @@
 //! opening; and the table of extra velocity fields on the nodes that see a crack.
 
 use crate::dim::Dim;
+use std::collections::HashMap;
 use std::ops::Range;
 
 /// Most cracks a scene may hold (each takes two bits of a node field's side mask).
@@ -17,6 +18,68 @@ pub struct Crack {
     pub vertices: Range<usize>,
     /// Whether the first and the last vertex are crack tips.
     pub tips: [bool; 2],
+    /// How the crack faces interact where they touch.
+    pub contact: Contact,
+}
+
+/// Contact law on a crack's faces (Guo & Nairn 3D (2006) Appendix B).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Law {
+    /// Faces pass through each other (open crack).
+    None,
+    /// Touching faces move together (Eqs. 71-72).
+    Stick,
+    /// Touching faces cannot interpenetrate but slide freely.
+    Frictionless,
+    /// Coulomb friction with this coefficient: stick while |f_t| <= mu |f_n|, else slide
+    /// with |f_t| = mu |f_n|.
+    Coulomb(f64),
+}
+
+/// A crack's contact settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// The law.
+    pub law: Law,
+    /// Also require the faces to approach (Eq. 70) before the displacement test (Eq. 69).
+    pub approach_check: bool,
+}
+
+impl Law {
+    /// The momentum change of the field above the crack (the field below gets its
+    /// negative, so momentum is conserved exactly) for masses `ma`, `mb`, velocities `va`,
+    /// `vb` and unit normal `n` pointing into the material above. Stick moves both to their
+    /// centre-of-mass velocity (Eqs. 71-72 times dt); frictionless keeps only the normal
+    /// part; Coulomb caps the tangential part at mu times the normal one. Faces that are
+    /// separating get no normal push (no tension across a contact) unless they stick.
+    pub fn momentum_change<D: Dim>(
+        self,
+        ma: f64,
+        va: D::Vec,
+        mb: f64,
+        vb: D::Vec,
+        n: D::Vec,
+    ) -> D::Vec {
+        let vcm = (va * ma + vb * mb) * (1.0 / (ma + mb));
+        let stick = (vcm - va) * ma;
+        let dn = D::dot(stick, n);
+        let normal = n * dn;
+        let tangential = stick - normal;
+        match self {
+            Law::None => D::zero(),
+            Law::Stick => stick,
+            _ if dn <= 0.0 => D::zero(),
+            Law::Frictionless => normal,
+            Law::Coulomb(mu) => {
+                let t = D::dot(tangential, tangential).sqrt();
+                if t <= mu * dn {
+                    stick
+                } else {
+                    normal + tangential * (mu * dn / t)
+                }
+            }
+        }
+    }
 }
 
 /// The crack store: vertices (struct of arrays), elements and cracks, and the field table.
@@ -36,6 +99,12 @@ pub struct Cracks<D: Dim> {
     pub cracks: Vec<Crack>,
     /// Extra velocity fields this step.
     pub fields: Fields,
+    /// Mass-weighted nodal displacements m u of the crack fields' entries this step (for
+    /// contact detection).
+    pub disp: HashMap<usize, D::Vec>,
+    /// Momentum changes made by contact on the scattered momenta this step (entry, change),
+    /// which the particles' velocity update must also see.
+    pub contact_dp: Vec<(usize, D::Vec)>,
 }
 
 /// Which grid entry each particle-node pair of a particle near a crack uses, and the extra
@@ -74,6 +143,8 @@ impl<D: Dim> Default for Cracks<D> {
             elem_crack: Vec::new(),
             cracks: Vec::new(),
             fields: Fields::default(),
+            disp: HashMap::new(),
+            contact_dp: Vec::new(),
         }
     }
 }

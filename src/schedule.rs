@@ -2,7 +2,7 @@
 
 use crate::dim::Dim;
 use crate::error::Unstable;
-use crate::systems::{bin, classify, crack_advect, g2p, grid_update, p2g, stress};
+use crate::systems::{bin, classify, contact, crack_advect, g2p, grid_update, p2g, stress};
 use crate::world::{Update, World};
 use std::time::Instant;
 
@@ -15,6 +15,11 @@ pub enum System {
     Classify,
     /// Move crack vertices and surfaces.
     CrackAdvect,
+    /// Crack-face contact on momenta (`update` false) or on updated velocities.
+    Contact {
+        /// After the grid update.
+        update: bool,
+    },
     /// Scatter mass and momentum (and internal forces when `internal`) plus loads.
     P2g {
         /// Also scatter the internal force.
@@ -47,6 +52,7 @@ impl System {
             System::Bin => "bin",
             System::Classify => "classify",
             System::CrackAdvect => "crack_advect",
+            System::Contact { .. } => "contact",
             System::P2g { .. } => "p2g",
             System::MomentumBc { .. } => "grid_bc",
             System::Stress { .. } => "stress",
@@ -78,6 +84,11 @@ impl Schedule {
         let bc = !world.bcs.is_empty();
         let update = world.settings.update;
         let cracks = world.cracks.is_some();
+        let contact = world.cracks.as_ref().is_some_and(|c| {
+            c.cracks
+                .iter()
+                .any(|c| c.contact.law != crate::crack::Law::None)
+        });
         let mut s = vec![Bin];
         if cracks {
             s.push(Classify);
@@ -88,11 +99,18 @@ impl Schedule {
         if bc {
             s.push(MomentumBc { end: false });
         }
+        if contact {
+            s.push(Contact { update: false });
+        }
         if update != Update::Usl {
             let fraction = if update == Update::Usf { 1.0 } else { 0.5 };
             s.extend([Stress { fraction }, InternalForce]);
         }
-        s.extend([GridUpdate, G2p]);
+        s.push(GridUpdate);
+        if contact {
+            s.push(Contact { update: true });
+        }
+        s.push(G2p);
         if cracks {
             s.push(CrackAdvect);
         }
@@ -119,6 +137,7 @@ impl Schedule {
                 System::Bin => bin::run(world)?,
                 System::Classify => classify::run(world),
                 System::CrackAdvect => crack_advect::run(world),
+                System::Contact { update } => contact::run(world, update),
                 System::P2g { internal } => p2g::run(world, internal),
                 System::MomentumBc { end } => grid_update::momentum_bc(world, end),
                 System::Stress { fraction } => stress::run(world, fraction),

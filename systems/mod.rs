@@ -2,6 +2,7 @@
 
 pub mod bin;
 pub mod classify;
+pub mod contact;
 pub mod crack_advect;
 pub mod fracture;
 pub mod g2p;

@@ -215,3 +215,25 @@ fn bad_fracture_requests_name_the_key() {
     ));
     assert_error(&e, "expect[0].tip", None, "not a tip");
 }
+
+#[test]
+fn bad_contact_settings_name_the_key() {
+    let crack = "[[crack]]\npoints = [[0.006, 0.01], [0.012, 0.01]]\n";
+    let e = error_with_text(&format!("{crack}contact = {{ law = \"glue\" }}\n"));
+    assert_error(&e, "crack[0].contact.law", None, "unknown contact law");
+    let e = error_with_text(&format!("{crack}contact = {{ law = \"friction\" }}\n"));
+    assert_error(&e, "crack[0].contact.friction", None, "coefficient");
+    let e = error_with_text(&format!(
+        "{crack}contact = {{ law = \"friction\", friction = -0.1 }}\n"
+    ));
+    assert_error(&e, "crack[0].contact.friction", None, ">= 0");
+    let e = error_with_text(&format!(
+        "{crack}contact = {{ law = \"stick\", friction = 0.1 }}\n"
+    ));
+    assert_error(
+        &e,
+        "crack[0].contact.friction",
+        None,
+        "only the `friction` law",
+    );
+}

@@ -3,7 +3,7 @@
 use super::build::{positive, to_vec, vec3};
 use super::schema::{CrackSpec, ExpectSpec};
 use super::source::Source;
-use crate::crack::{Crack, Cracks, MAX_CRACKS};
+use crate::crack::{Contact, Crack, Cracks, Law, MAX_CRACKS};
 use crate::dim::Dim;
 use crate::error::ScenarioError;
 use crate::fracture::FracturePlan;
@@ -85,6 +85,7 @@ pub(super) fn build<D: Dim>(
                 }
             }
         }
+        let contact = contact(src, c, spec)?;
         let first = store.x.len();
         for k in 0..points.len() - 1 {
             store
@@ -97,11 +98,53 @@ pub(super) fn build<D: Dim>(
             name: spec.name.clone().unwrap_or_else(|| format!("crack{c}")),
             vertices: first..store.x.len(),
             tips,
+            contact,
         });
     }
     store.top = store.x.clone();
     store.bottom = store.x.clone();
     Ok(Some(store))
+}
+
+/// The contact settings of crack `c`.
+fn contact(src: &Source, c: usize, spec: &CrackSpec) -> R<Contact> {
+    let key = |k: &str| format!("crack[{c}].contact.{k}");
+    let Some(cs) = &spec.contact else {
+        return Ok(Contact {
+            law: Law::None,
+            approach_check: false,
+        });
+    };
+    let law = match cs.law.as_str() {
+        "none" => Law::None,
+        "stick" => Law::Stick,
+        "frictionless" => Law::Frictionless,
+        "friction" => {
+            let mu = cs
+                .friction
+                .ok_or_else(|| src.error(&key("friction"), "give the friction coefficient"))?;
+            if !(mu.is_finite() && mu >= 0.0) {
+                return Err(src.error(&key("friction"), "must be a number >= 0"));
+            }
+            Law::Coulomb(mu)
+        }
+        other => {
+            return Err(src.error(
+                &key("law"),
+                format!("unknown contact law `{other}` (none, stick, frictionless, friction)"),
+            ));
+        }
+    };
+    if cs.friction.is_some() && !matches!(law, Law::Coulomb(_)) {
+        return Err(src.error(
+            &key("friction"),
+            "only the `friction` law takes a coefficient",
+        ));
+    }
+    Ok(Contact {
+        law,
+        approach_check: cs.approach_check.unwrap_or(false),
+    })
 }
 
 /// The vertices of crack `c`: its points, or its line cut at the spacing; all inside the

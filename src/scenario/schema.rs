@@ -202,6 +202,20 @@ pub struct CrackSpec {
     pub line: Option<LineSpec>,
     /// Which ends are crack tips: "start" and/or "end" (default `["end"]`).
     pub tips: Option<Vec<String>>,
+    /// Contact between the crack faces (default: none, an open crack).
+    pub contact: Option<ContactSpec>,
+}
+
+/// `contact = { law = "frictionless" }` on a crack.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// "none", "stick", "frictionless" or "friction".
+    pub law: String,
+    /// Coulomb coefficient for "friction".
+    pub friction: Option<f64>,
+    /// Check that the faces approach before testing their overlap (default false).
+    pub approach_check: Option<bool>,
 }
 
 /// A straight crack from `start` to `end` (m), a vertex every `spacing` (m; default half
