@@ -92,3 +92,75 @@ fn vtu_offsets_and_pvd_are_consistent() {
     assert_eq!(&data[expected_offset..], b"\n</AppendedData>\n</VTKFile>\n");
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// Crack files: the crack-plane vertices as points, the segments as line cells, packed
+/// arrays, and a collection listing one file per frame.
+#[test]
+fn crack_vtu_holds_the_segments() {
+    let text = r#"
+[simulation]
+dimension = 2
+duration = 2e-6
+[grid]
+min = [0.0, 0.0]
+max = [0.02, 0.02]
+cell = [0.002, 0.002]
+[[material]]
+name = "m"
+E = 1e9
+nu = 0.3
+rho = 1000.0
+[[body]]
+material = "m"
+box = { min = [0.004, 0.004], max = [0.016, 0.016] }
+[[crack]]
+line = { start = [0.003, 0.01], end = [0.01, 0.01], spacing = 1e-3 }
+[output]
+interval = 1e-6
+"#;
+    let dir = std::env::temp_dir().join(format!("fissure-vtk-crack-{}", std::process::id()));
+    let opts = RunOptions {
+        out: Some(dir.clone()),
+        ..RunOptions::default()
+    };
+    run(&source(text), &opts).unwrap();
+    let pvd = std::fs::read_to_string(dir.join("cracks.pvd")).unwrap();
+    let doc = roxmltree::Document::parse(&pvd).expect("pvd is well-formed XML");
+    let files = doc
+        .descendants()
+        .filter(|e| e.has_tag_name("DataSet"))
+        .count();
+    assert!(files >= 3, "a crack file per frame");
+    let bytes = std::fs::read(dir.join("cracks_00000.vtu")).unwrap();
+    let marker = b"<AppendedData encoding=\"raw\">\n_";
+    let at = bytes
+        .windows(marker.len())
+        .position(|w| w == marker)
+        .unwrap();
+    let header = std::str::from_utf8(&bytes[..at + marker.len() - 1]).unwrap();
+    let xml = format!("{header}</AppendedData>\n</VTKFile>\n");
+    let doc = roxmltree::Document::parse(&xml).expect("vtu header is well-formed XML");
+    let piece = doc.descendants().find(|e| e.has_tag_name("Piece")).unwrap();
+    // 7 mm at 1 mm spacing: 8 vertices, 7 segments.
+    assert_eq!(piece.attribute("NumberOfPoints"), Some("8"));
+    assert_eq!(piece.attribute("NumberOfCells"), Some("7"));
+    let data = &bytes[at + marker.len()..];
+    let mut next = 0;
+    for array in doc.descendants().filter(|e| e.has_tag_name("DataArray")) {
+        let offset: usize = array.attribute("offset").unwrap().parse().unwrap();
+        assert_eq!(offset, next, "arrays are packed back to back");
+        let len = u64::from_le_bytes(data[offset..offset + 8].try_into().unwrap()) as usize;
+        let want = match array.attribute("Name").unwrap() {
+            "opening" | "Points" => 8 * 3 * 8,
+            "crack" => 8 * 4,
+            "connectivity" => 7 * 2 * 8,
+            "offsets" => 7 * 8,
+            "types" => 7,
+            other => panic!("unexpected array {other}"),
+        };
+        assert_eq!(len, want, "{:?}", array.attribute("Name"));
+        next = offset + 8 + len;
+    }
+    assert_eq!(&data[next..], b"\n</AppendedData>\n</VTKFile>\n");
+    std::fs::remove_dir_all(dir).ok();
+}

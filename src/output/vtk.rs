@@ -1,6 +1,7 @@
-//! VTK XML output for ParaView: particle `.vtu` files (appended raw binary) and a `.pvd`
-//! collection indexing them by time.
+//! VTK XML output for ParaView: particle and crack `.vtu` files (appended raw binary) and
+//! `.pvd` collections indexing them by time.
 
+use crate::crack::Cracks;
 use crate::dim::Dim;
 use crate::particles::Particles;
 use std::io::Write;
@@ -55,18 +56,89 @@ pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result
         attrs: r#"type="Float64" Name="Points" NumberOfComponents="3""#.into(),
         bytes: vec3(&p.x),
     };
-    let cells = vec![
+    let cells = [
+        (0..n as i64).flat_map(i64::to_le_bytes).collect(),
+        (1..=n as i64).flat_map(i64::to_le_bytes).collect(),
+        vec![1u8; n],
+    ];
+    write_unstructured(
+        path,
+        (n, n),
+        r#"Vectors="velocity" Tensors="stress""#,
+        &point_data,
+        points,
+        cells,
+    )
+}
+
+/// Writes the cracks of `c` as line cells: the crack-plane vertices joined by the crack
+/// segments, with the opening (top minus bottom surface, m) and the crack index.
+pub fn write_cracks<D: Dim>(path: &Path, c: &Cracks<D>) -> std::io::Result<()> {
+    let n = c.x.len();
+    let m = c.elems.len();
+    let opening = f64s((0..n).flat_map(|k| D::to_xyz(c.top[k] - c.bottom[k])));
+    let mut crack = vec![0i32; n];
+    for (k, cr) in c.cracks.iter().enumerate() {
+        crack[cr.vertices.clone()]
+            .iter_mut()
+            .for_each(|x| *x = k as i32);
+    }
+    let point_data = vec![
+        Array {
+            attrs: r#"type="Float64" Name="opening" NumberOfComponents="3""#.into(),
+            bytes: opening,
+        },
+        Array {
+            attrs: r#"type="Int32" Name="crack" NumberOfComponents="1""#.into(),
+            bytes: crack.iter().flat_map(|k| k.to_le_bytes()).collect(),
+        },
+    ];
+    let points = Array {
+        attrs: r#"type="Float64" Name="Points" NumberOfComponents="3""#.into(),
+        bytes: f64s(c.x.iter().flat_map(|v| D::to_xyz(*v))),
+    };
+    let cells = [
+        c.elems
+            .iter()
+            .flat_map(|e| [e[0] as i64, e[1] as i64])
+            .flat_map(i64::to_le_bytes)
+            .collect(),
+        (1..=m as i64).flat_map(|k| (2 * k).to_le_bytes()).collect(),
+        vec![3u8; m],
+    ];
+    write_unstructured(
+        path,
+        (n, m),
+        r#"Vectors="opening""#,
+        &point_data,
+        points,
+        cells,
+    )
+}
+
+/// Writes an unstructured grid of `counts` = (points, cells) with appended raw arrays:
+/// point data, the points, and the cells' connectivity (Int64), offsets (Int64) and
+/// types (UInt8).
+fn write_unstructured(
+    path: &Path,
+    (points_n, cells_n): (usize, usize),
+    active: &str,
+    point_data: &[Array],
+    points: Array,
+    [connectivity, offsets, types]: [Vec<u8>; 3],
+) -> std::io::Result<()> {
+    let cells = [
         Array {
             attrs: r#"type="Int64" Name="connectivity""#.into(),
-            bytes: (0..n as i64).flat_map(i64::to_le_bytes).collect(),
+            bytes: connectivity,
         },
         Array {
             attrs: r#"type="Int64" Name="offsets""#.into(),
-            bytes: (1..=n as i64).flat_map(i64::to_le_bytes).collect(),
+            bytes: offsets,
         },
         Array {
             attrs: r#"type="UInt8" Name="types""#.into(),
-            bytes: vec![1u8; n],
+            bytes: types,
         },
     ];
     let mut offset = 0usize;
@@ -83,9 +155,9 @@ pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result
     xml.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
     xml.push_str("<UnstructuredGrid>\n");
     xml.push_str(&format!(
-        "<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">\n<PointData Vectors=\"velocity\" Tensors=\"stress\">\n"
+        "<Piece NumberOfPoints=\"{points_n}\" NumberOfCells=\"{cells_n}\">\n<PointData {active}>\n"
     ));
-    for a in &point_data {
+    for a in point_data {
         xml.push_str(&tag(a));
         xml.push('\n');
     }

@@ -7,7 +7,7 @@ pub mod writers;
 
 use crate::dim::{D2, D3, Dim};
 use crate::error::Unstable;
-use crate::measure::{History, Row};
+use crate::measure::{Expect, History, Measure, Row};
 use crate::output::plot::{self, Series};
 use crate::output::summary::Summary;
 use crate::scenario::{Scene, Source, build};
@@ -366,6 +366,11 @@ fn drive<D: Dim>(
         if output.plot {
             plot_energies(&w.dir.join("energy.png"), &name, &state.history)
                 .map_err(|e| anyhow::anyhow!("cannot draw energy.png: {e}"))?;
+            if let Some(cracks) = &crack_names {
+                let path = w.dir.join("fracture.png");
+                plot_fracture(&path, &name, &state.history, &expects, cracks)
+                    .map_err(|e| anyhow::anyhow!("cannot draw fracture.png: {e}"))?;
+            }
         }
     }
     if let Stop::Unstable(_) = stop {
@@ -384,6 +389,59 @@ fn drive<D: Dim>(
         history: state.history,
         snapshot: snapshot.map(|s| s.0),
     })
+}
+
+/// K_I and K_II over time at every tip, with each K expect's reference as a flat line.
+fn plot_fracture(
+    path: &Path,
+    name: &str,
+    h: &History,
+    expects: &[Expect],
+    cracks: &[String],
+) -> Result<(), String> {
+    let mut tips: Vec<(u32, u32)> = h.fracture.iter().map(|t| (t.crack, t.tip)).collect();
+    tips.sort_unstable();
+    tips.dedup();
+    let t_end = h.fracture.last().map_or(0.0, |t| t.time);
+    let label =
+        |c: u32, tip: u32| format!("{} {}", cracks[c as usize], ["start", "end"][tip as usize]);
+    let mut labels = Vec::new();
+    let mut points = Vec::new();
+    for &(c, tip) in &tips {
+        for (k, mode) in ["KI", "KII"].iter().enumerate() {
+            labels.push(format!("{mode} {}", label(c, tip)));
+            points.push(
+                h.fracture
+                    .iter()
+                    .filter(|t| (t.crack, t.tip) == (c, tip))
+                    .map(|t| (t.time, t.k[k]))
+                    .collect::<Vec<_>>(),
+            );
+        }
+    }
+    for e in expects {
+        if let Measure::Tip { crack, tip, qty } = e.measure
+            && qty < 2
+        {
+            labels.push(format!("{} reference {}", e.quantity, label(crack, tip)));
+            points.push(vec![(0.0, e.reference), (t_end, e.reference)]);
+        }
+    }
+    let series: Vec<Series> = labels
+        .iter()
+        .zip(points)
+        .map(|(l, p)| Series {
+            label: l,
+            points: p,
+        })
+        .collect();
+    plot::lines(
+        path,
+        &format!("{name}: stress intensity factors"),
+        "time (s)",
+        "K (Pa sqrt(m))",
+        &series,
+    )
 }
 
 fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {

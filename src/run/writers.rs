@@ -125,6 +125,17 @@ impl Writers {
             .map(|(k, &t)| (t, frame_name(k)))
             .collect();
         vtk::write_collection(&self.dir.join("particles.pvd"), &list)?;
+        if let Some(c) = &world.cracks {
+            let crack_name = |k: usize| format!("cracks_{k:05}.vtu");
+            vtk::write_cracks(&self.dir.join(crack_name(state.frames.len() - 1)), c)?;
+            let list: Vec<(f64, String)> = state
+                .frames
+                .iter()
+                .enumerate()
+                .map(|(k, &t)| (t, crack_name(k)))
+                .collect();
+            vtk::write_collection(&self.dir.join("cracks.pvd"), &list)?;
+        }
         Ok(())
     }
 
