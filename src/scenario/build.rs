@@ -452,7 +452,12 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             positive(src, &key("tolerance"), e.tolerance, "relative")?;
             expects.push(Expect {
                 quantity: e.quantity.clone(),
-                probes: e.crack.iter().cloned().collect(),
+                probes: e
+                    .crack
+                    .iter()
+                    .cloned()
+                    .chain([e.tip.clone().unwrap_or_else(|| "end".into())])
+                    .collect(),
                 measure,
                 reference: e.reference,
                 source: e.source.clone(),
