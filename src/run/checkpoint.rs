@@ -36,16 +36,15 @@ fn step_of(name: &str) -> Option<u64> {
 }
 
 impl Checkpointer {
-    /// Snapshots for a run writing to `out`. A fresh run removes the snapshots a previous
-    /// run left there; a resumed run keeps them (and counts `resumed` as its newest).
+    /// Snapshots for a run writing to `out` (the folder `out/snapshots` is made on the first
+    /// write). A fresh run removes the snapshots a previous run left there; a resumed run
+    /// keeps them (and counts `resumed` as its newest).
     pub fn new(
         out: &Path,
         plan: CheckpointPlan,
         resumed: Option<(PathBuf, u64)>,
     ) -> anyhow::Result<Self> {
         let dir = out.join("snapshots");
-        std::fs::create_dir_all(&dir)
-            .with_context(|| format!("cannot create {}", dir.display()))?;
         let c = Checkpointer {
             dir,
             plan,
@@ -63,8 +62,11 @@ impl Checkpointer {
         Ok(c)
     }
 
-    /// Snapshot files in the folder, by step.
+    /// Snapshot files in the folder, by step (none while the folder does not exist).
     fn existing(&self) -> anyhow::Result<Vec<(u64, PathBuf)>> {
+        if !self.dir.exists() {
+            return Ok(Vec::new());
+        }
         let mut found: Vec<(u64, PathBuf)> = std::fs::read_dir(&self.dir)
             .with_context(|| format!("cannot list {}", self.dir.display()))?
             .filter_map(|e| {
@@ -112,6 +114,8 @@ impl Checkpointer {
         state: &RunState,
     ) -> anyhow::Result<PathBuf> {
         let t0 = Instant::now();
+        std::fs::create_dir_all(&self.dir)
+            .with_context(|| format!("cannot create {}", self.dir.display()))?;
         let path = self.dir.join(file_name(world.step));
         self.bytes += write(&path, src, world, state)
             .with_context(|| format!("cannot write snapshot {}", path.display()))?;
