@@ -212,7 +212,8 @@ fn tip<D: Dim>(
             m * 0.5 * (m / p.volume[i]) * (v[0] * v[0] + v[1] * v[1]),
         ];
         let targets = fields.targets_of(i);
-        let inside = x[0] > lo[0] && x[0] < hi[0] && x[1] > lo[1] && x[1] < hi[1];
+        // Only the area term needs the particles inside the contour.
+        let inside = plan.area_term && x[0] > lo[0] && x[0] < hi[0] && x[1] > lo[1] && x[1] < hi[1];
         let mut accel = [0.0; 2];
         with_nodes!(shape, N => {
             let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
@@ -232,7 +233,7 @@ fn tip<D: Dim>(
                 None => st.for_each::<D>(&geom.stride, |n, w, _| visit(n, w)),
             }
         });
-        if inside && plan.area_term {
+        if inside {
             // Eq. 8's area term: rho [a . du/dx_m - v . dv/dx_m] over the particle's area
             // V / thickness, with rho V = m.
             let gv = p.grad_v[i];
@@ -276,9 +277,6 @@ fn tip<D: Dim>(
     pts.push(cross);
     vals.push(Nodal::lerp(&at(e, -first), &at(e + 1, -first), s));
     let mut j = area;
-    if !plan.area_term {
-        j = [0.0; 2];
-    }
     for q in 0..pts.len() - 1 {
         let (a, b) = (pts[q], pts[q + 1]);
         let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
