@@ -60,9 +60,9 @@ fn load_work_end<D: Dim>(world: &mut World<D>) {
     let (t, dt) = (world.time, world.settings.dt);
     let mut work = 0.0;
     for load in &world.loads {
-        let f = load.force * load.time.at(t);
-        for &i in &load.particles {
-            work += 0.5 * dt * D::dot(f, world.particles.v[i as usize]);
+        let scale = load.time.at(t);
+        for (&i, &f) in load.particles.iter().zip(&load.forces) {
+            work += 0.5 * dt * scale * D::dot(f, world.particles.v[i as usize]);
         }
     }
     world.work.external += work;

@@ -209,9 +209,9 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
     let shape = world.settings.shape;
     let mut work = 0.0;
     for load in &world.loads {
-        let f = load.force * load.time.at(t);
-        for &i in &load.particles {
-            let i = i as usize;
+        let scale = load.time.at(t);
+        for (&i, &f) in load.particles.iter().zip(&load.forces) {
+            let (i, f) = (i as usize, f * scale);
             let targets = world.cracks.as_ref().and_then(|c| c.fields.targets_of(i));
             with_nodes!(shape, N => {
                 let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);

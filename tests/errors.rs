@@ -237,3 +237,25 @@ fn bad_contact_settings_name_the_key() {
         "only the `friction` law",
     );
 }
+
+#[test]
+fn bad_loads_name_the_key() {
+    let region = "region = { min = [0.015, 0.004], max = [0.016, 0.016] }\n";
+    let field = "williams = { KI = 1e6, KII = 0.0, tip = [0.01, 0.01] }\n";
+    let e = error_with_text(&format!("[[load]]\n{region}"));
+    assert_error(&e, "load[0]", None, "give `force`");
+    let e = error_with_text(&format!("[[load]]\n{region}force = [1.0, 0.0]\n{field}"));
+    assert_error(&e, "load[0].williams", None, "not both");
+    let e = error_with_text(&format!("[[load]]\n{region}{field}"));
+    assert_error(&e, "load[0].normal", None, "outward normal");
+    let e = error_with_text(&format!("[[load]]\n{region}{field}normal = [0.6, 0.8]\n"));
+    assert_error(&e, "load[0].normal", None, "axis direction");
+    let e = error_with_text(&format!(
+        "[[load]]\n{region}normal = [1.0, 0.0]\nwilliams = {{ KI = 1e6, KII = 0.0, tip = [0.016, 0.0095] }}\n"
+    ));
+    assert_error(&e, "load[0].williams.tip", None, "on the loaded face");
+    let e = error_with_text(&format!(
+        "[[load]]\n{region}force = [1.0, 0.0]\nnormal = [1.0, 0.0]\n"
+    ));
+    assert_error(&e, "load[0].normal", None, "traction field");
+}

@@ -258,17 +258,39 @@ pub struct BoundarySpec {
     pub time: TimeFn,
 }
 
-/// `[[load]]`: a total force spread over the particles initially inside a region.
+/// `[[load]]`: on the particles initially inside a region, either a total force spread
+/// equally (`force`) or the traction of a stress field on a face (`williams` + `normal`).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSpec {
     /// Particles initially inside this box are loaded.
     pub region: BoxSpec,
     /// Total force (N).
-    pub force: Vec<f64>,
+    pub force: Option<Vec<f64>>,
+    /// Traction of the near-tip (Williams) stress field, 2D only.
+    pub williams: Option<WilliamsSpec>,
+    /// Outward unit normal of the face a traction acts on (an axis direction, e.g. [1, 0]).
+    pub normal: Option<Vec<f64>>,
     /// Time multiplier.
     #[serde(default)]
     pub time: TimeFn,
+}
+
+/// The leading (Williams / Irwin) term of the stress field around a crack tip.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WilliamsSpec {
+    /// Mode I stress intensity factor (Pa sqrt(m)).
+    #[serde(rename = "KI")]
+    pub k1: f64,
+    /// Mode II stress intensity factor (Pa sqrt(m)).
+    #[serde(rename = "KII")]
+    pub k2: f64,
+    /// Tip position (m).
+    pub tip: Vec<f64>,
+    /// Direction the crack points (from its faces to its tip), degrees from +x; default 0.
+    #[serde(default)]
+    pub direction: f64,
 }
 
 /// `[[probe]]`: a particle average recorded at every step.
