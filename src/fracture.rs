@@ -10,8 +10,8 @@ pub struct FracturePlan {
     pub contour: usize,
     /// Add the area integral of Guo & Nairn 2D (2004) Eq. 8 (path independence in dynamics).
     pub area_term: bool,
-    /// Distance behind the tip, in cells, where the crack opening that splits G into K_I
-    /// and K_II is read.
+    /// End of the window behind the tip, in cells, over which the crack opening that splits
+    /// G into K_I and K_II is fitted (it starts one cell behind the tip).
     pub opening: f64,
 }
 

@@ -7,28 +7,29 @@ use crate::dim::Dim;
 use crate::shape::{ShapeKind, Stencil};
 use crate::world::World;
 
-/// Velocities at node `n` for crack `c`: centre of mass (Eq. 23), above and below.
-fn node_velocities<D: Dim>(
+/// Centre-of-mass velocity at node `n` (Eq. 23), and the momenta and masses of its fields
+/// above and below crack `c`.
+fn node_fields<D: Dim>(
     n: usize,
     c: usize,
     mass: &[f64],
     velocity: &[D::Vec],
     fields: &Fields,
     tol: f64,
-) -> [D::Vec; 3] {
+) -> (D::Vec, [(D::Vec, f64); 2]) {
     let (mut m, mut mv) = (mass[n], velocity[n] * mass[n]);
     for r in fields.rows_of(n as u32) {
         m += mass[r];
         mv += velocity[r] * mass[r];
     }
     if m <= tol {
-        return [D::zero(); 3];
+        return (D::zero(), [(D::zero(), 0.0); 2]);
     }
-    [
-        mv * (1.0 / m),
-        velocity[fields.side_entry(n, c, 1)],
-        velocity[fields.side_entry(n, c, -1)],
-    ]
+    let side = |s: i8| {
+        let e = fields.side_entry(n, c, s);
+        (velocity[e] * mass[e], mass[e])
+    };
+    (mv * (1.0 / m), [side(1), side(-1)])
 }
 
 /// Moves every crack vertex and both surfaces over the step, interpolating the updated
@@ -68,16 +69,22 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 st.w[a] = w;
                 st.dw[a] = dw;
             }
-            let mut v = [D::zero(); 3];
+            let mut cm = D::zero();
+            let mut sides = [(D::zero(), 0.0); 2];
             st.for_each::<D>(&geom.stride, |n, w, _| {
-                let nv = node_velocities::<D>(n, c, &g.mass, &g.velocity, fields, tol);
-                for s in 0..3 {
-                    v[s] += nv[s] * w;
+                let (v, f) = node_fields::<D>(n, c, &g.mass, &g.velocity, fields, tol);
+                cm += v * w;
+                for (s, (p, m)) in sides.iter_mut().zip(f) {
+                    s.0 += p * w;
+                    s.1 += m * w;
                 }
             });
-            xs[k] += v[0] * dt;
-            top[k] += v[1] * dt;
-            bottom[k] += v[2] * dt;
+            // Each surface moves with the mass-weighted velocity of its side's fields, so a
+            // field holding a sliver of mass (and a meaningless velocity) cannot drag it.
+            let surface = |(p, m): (D::Vec, f64)| if m > tol { p * (1.0 / m) } else { cm };
+            xs[k] += cm * dt;
+            top[k] += surface(sides[0]) * dt;
+            bottom[k] += surface(sides[1]) * dt;
         }
     }
 }

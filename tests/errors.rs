@@ -210,6 +210,8 @@ fn bad_fracture_requests_name_the_key() {
     assert_error(&e, "fracture", None, "no crack has one");
     let e = error_with_text(&format!("{crack}[fracture]\ncontour = 6\n"));
     assert_error(&e, "fracture.contour", None, "leaves the grid");
+    let e = error_with_text(&format!("{crack}[fracture]\nopening = 1.0\n"));
+    assert_error(&e, "fracture.opening", None, "at least 2");
     let e = error_with_text(&format!(
         "{crack}[fracture]\n[[expect]]\nquantity = \"KI\"\ncrack = \"crack0\"\ntip = \"start\"\nreference = 1.0\nsource = \"s\"\ntolerance = 0.1\n"
     ));
@@ -245,7 +247,7 @@ fn bad_loads_name_the_key() {
     let e = error_with_text(&format!("[[load]]\n{region}"));
     assert_error(&e, "load[0]", None, "give `force`");
     let e = error_with_text(&format!("[[load]]\n{region}force = [1.0, 0.0]\n{field}"));
-    assert_error(&e, "load[0].williams", None, "not both");
+    assert_error(&e, "load[0].force", None, "not both");
     let e = error_with_text(&format!("[[load]]\n{region}{field}"));
     assert_error(&e, "load[0].normal", None, "outward normal");
     let e = error_with_text(&format!("[[load]]\n{region}{field}normal = [0.6, 0.8]\n"));
@@ -253,7 +255,7 @@ fn bad_loads_name_the_key() {
     let e = error_with_text(&format!(
         "[[load]]\n{region}normal = [1.0, 0.0]\nwilliams = {{ KI = 1e6, KII = 0.0, tip = [0.016, 0.0095] }}\n"
     ));
-    assert_error(&e, "load[0].williams.tip", None, "on the loaded face");
+    assert_error(&e, "load[0].region", None, "singular");
     let e = error_with_text(&format!(
         "[[load]]\n{region}force = [1.0, 0.0]\nnormal = [1.0, 0.0]\n"
     ));

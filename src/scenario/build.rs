@@ -1,13 +1,14 @@
 //! Building a World from a parsed scenario, validating every value on the way.
 
-use super::schema::{BodySpec, BoxSpec, WilliamsSpec};
+use super::schema::{BodySpec, BoxSpec};
 use super::source::Source;
+use super::traction::{Face, Field, tractions};
 use crate::bodies::{Geometry, fill};
 use crate::dim::Dim;
 use crate::error::ScenarioError;
 use crate::fracture::FracturePlan;
 use crate::grid::{Grid, GridGeom};
-use crate::loads::{Load, VelocityBc, williams_stress};
+use crate::loads::{Load, VelocityBc};
 use crate::material::{Elastic, Plane};
 use crate::measure::{Expect, Measure, Probe, ProbeQty};
 use crate::particles::Particles;
@@ -376,7 +377,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         if let Some(msg) = l.time.check() {
             return Err(src.error(&key("time"), msg));
         }
-        let forces = match (&l.force, &l.williams) {
+        let forces = match (&l.force, Field::of(src, &key, l)?) {
             (Some(f), None) => {
                 if l.normal.is_some() {
                     return Err(src.error(&key("normal"), "`normal` goes with a traction field"));
@@ -384,21 +385,17 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 let f = vec3::<D>(src, &key("force"), f)?;
                 vec![to_vec::<D>(f.map(|c| c / sel.len() as f64)); sel.len()]
             }
-            (None, Some(w)) => {
-                let face = Face {
-                    key: &key,
-                    normal: l.normal.as_deref(),
-                    h: D::to_xyz(geom.h),
-                };
-                williams_forces(src, &face, w, &sel, &particles, &ppc)?
+            (None, Some(field)) => {
+                let face = Face::new::<D>(src, &key, l.normal.as_deref(), geom.h)?;
+                tractions(src, &face, &field, &sel, &particles, &ppc)?
             }
             (Some(_), Some(_)) => {
-                return Err(src.error(&key("williams"), "give `force` or `williams`, not both"));
+                return Err(src.error(&key("force"), "give a force or a traction field, not both"));
             }
             (None, None) => {
                 return Err(src.error(
                     &format!("load[{i}]"),
-                    "give `force` (total N) or `williams` (a near-tip traction field)",
+                    "give `force` (total N), or a traction field: `williams` or `centre_crack`",
                 ));
             }
         };
@@ -707,71 +704,6 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
         (Some(_), _) => return Err(src.error(&key("polygon.z"), "z must be [z0, z1] with z1 > z0")),
     };
     Ok(Geometry::Polygon { points, z })
-}
-
-/// The face a traction load acts on.
-struct Face<'a> {
-    /// Scenario key of the load, for errors.
-    key: &'a dyn Fn(&str) -> String,
-    /// Outward normal as written in the scenario.
-    normal: Option<&'a [f64]>,
-    /// Cell size (m).
-    h: [f64; 3],
-}
-
-/// Forces on face particles from the Williams near-tip stress field: the traction s . n at
-/// the particle's face point times the face area it carries (volume over its size along n).
-fn williams_forces<D: Dim>(
-    src: &Source,
-    face: &Face,
-    w: &WilliamsSpec,
-    sel: &[u32],
-    particles: &Particles<D>,
-    ppc: &[f64],
-) -> R<Vec<D::Vec>> {
-    if D::D != 2 {
-        return Err(src.error(&(face.key)("williams"), "the Williams field is 2D only"));
-    }
-    let n = face.normal.ok_or_else(|| {
-        src.error(
-            &(face.key)("normal"),
-            "a traction needs the outward normal of its face, e.g. normal = [1.0, 0.0]",
-        )
-    })?;
-    let n = vec3::<D>(src, &(face.key)("normal"), n)?;
-    let axis = (0..2)
-        .find(|&a| n[a].abs() == 1.0 && n[1 - a] == 0.0)
-        .ok_or_else(|| {
-            src.error(
-                &(face.key)("normal"),
-                "the normal must be an axis direction: [1, 0], [-1, 0], [0, 1] or [0, -1]",
-            )
-        })?;
-    let tip = vec3::<D>(src, &(face.key)("williams.tip"), &w.tip)?;
-    let (sn, cs) = w.direction.to_radians().sin_cos();
-    let mut forces = Vec::with_capacity(sel.len());
-    for &p in sel {
-        let p = p as usize;
-        let x = D::to_xyz(particles.x[p]);
-        let size = face.h[axis] / ppc[p];
-        let d = [0, 1].map(|a| x[a] + 0.5 * size * n[a] - tip[a]);
-        let (xl, yl) = (cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]);
-        let r = xl.hypot(yl);
-        if r < 1e-12 * size {
-            return Err(src.error(
-                &(face.key)("williams.tip"),
-                "the tip lies on the loaded face; move it inside the body",
-            ));
-        }
-        let [lxx, lyy, lxy] = williams_stress(w.k1, w.k2, r, yl.atan2(xl));
-        let sxx = cs * cs * lxx + sn * sn * lyy - 2.0 * cs * sn * lxy;
-        let syy = sn * sn * lxx + cs * cs * lyy + 2.0 * cs * sn * lxy;
-        let sxy = cs * sn * (lxx - lyy) + (cs * cs - sn * sn) * lxy;
-        let area = particles.volume[p] / size;
-        let t = [sxx * n[0] + sxy * n[1], sxy * n[0] + syy * n[1], 0.0];
-        forces.push(to_vec::<D>(t.map(|c| c * area)));
-    }
-    Ok(forces)
 }
 
 /// Fills body `b` with particles and appends them to the store.

@@ -278,10 +278,13 @@ pub(super) fn fracture_plan<D: Dim>(
             }
         }
     }
-    let opening = match f.opening {
-        Some(c) => positive(src, "fracture.opening", c, "cells")?,
-        None => 2.0,
-    };
+    let opening = f.opening.unwrap_or(8.0);
+    if opening.is_nan() || opening < 2.0 {
+        return Err(src.error(
+            "fracture.opening",
+            "the opening is fitted from 1 cell to `opening` cells behind the tip: give at least 2",
+        ));
+    }
     Ok(Some(FracturePlan {
         contour: n,
         area_term: f.area_term.unwrap_or(true),

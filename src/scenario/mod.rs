@@ -5,6 +5,7 @@ pub mod build;
 mod cracks;
 pub mod schema;
 pub mod source;
+mod traction;
 
 pub use build::{CheckpointPlan, OutputPlan, Scene, build};
 pub use source::Source;

@@ -269,6 +269,8 @@ pub struct LoadSpec {
     pub force: Option<Vec<f64>>,
     /// Traction of the near-tip (Williams) stress field, 2D only.
     pub williams: Option<WilliamsSpec>,
+    /// Traction of the exact field of a centre crack in an infinite plate, 2D only.
+    pub centre_crack: Option<CentreCrackSpec>,
     /// Outward unit normal of the face a traction acts on (an axis direction, e.g. [1, 0]).
     pub normal: Option<Vec<f64>>,
     /// Time multiplier.
@@ -307,6 +309,21 @@ pub struct ProbeSpec {
     pub component: String,
 }
 
+/// A straight crack in an infinite plate under a uniform remote stress.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CentreCrackSpec {
+    /// Remote stress (xx, yy, xy) in global axes (Pa).
+    pub stress: Vec<f64>,
+    /// Crack centre (m).
+    pub center: Vec<f64>,
+    /// Half-length a (m).
+    pub half_length: f64,
+    /// Angle of the crack line, degrees from +x; default 0.
+    #[serde(default)]
+    pub angle: f64,
+}
+
 /// `[output]`.
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -329,8 +346,8 @@ pub struct FractureSpec {
     pub contour: Option<usize>,
     /// Include the area term of Guo & Nairn 2D (2004) Eq. 8 (default true).
     pub area_term: Option<bool>,
-    /// Cells behind the tip where the crack opening is read to split G into K_I and K_II
-    /// (default 2).
+    /// The crack opening that splits G into K_I and K_II is fitted over the crack from 1 to
+    /// `opening` cells behind the tip (default 8).
     pub opening: Option<f64>,
 }
 
