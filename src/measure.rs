@@ -108,7 +108,8 @@ pub enum Measure {
     EnergyDrift,
     /// |L(end) - L(0)| / |L(0)| about the initial centre of mass (relative).
     AngularMomentumDrift,
-    /// The last value at a crack tip: `qty` 0..4 = K_I, K_II, J_x, J_y (Pa sqrt(m), J/m^2).
+    /// A value at a crack tip, the last one or at a time: `qty` 0..4 = K_I, K_II, J_x, J_y
+    /// (Pa sqrt(m), J/m^2).
     Tip {
         /// Crack index.
         crack: u32,
@@ -116,6 +117,8 @@ pub enum Measure {
         tip: u32,
         /// Which value.
         qty: usize,
+        /// Time (s): interpolated linearly between the rows around it; None for the last row.
+        at: Option<f64>,
     },
 }
 
@@ -185,12 +188,28 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
     let finite = |v: f64| v.is_finite().then_some(v);
     match *m {
         Measure::Final(p) => h.probes[p].last().copied().and_then(finite),
-        Measure::Tip { crack, tip, qty } => {
-            let r = h
+        Measure::Tip {
+            crack,
+            tip,
+            qty,
+            at,
+        } => {
+            let value = |r: &TipResult| [r.k[0], r.k[1], r.j[0], r.j[1]][qty];
+            let rows = h
                 .fracture
                 .iter()
-                .rfind(|r| r.crack == crack && r.tip == tip)?;
-            finite([r.k[0], r.k[1], r.j[0], r.j[1]][qty])
+                .filter(|r| r.crack == crack && r.tip == tip);
+            let Some(t) = at else {
+                return finite(value(rows.last()?));
+            };
+            let rows: Vec<&TipResult> = rows.collect();
+            let k = rows.iter().position(|r| r.time >= t)?;
+            if k == 0 {
+                return (rows[0].time == t).then(|| value(rows[0])).and_then(finite);
+            }
+            let (a, b) = (rows[k - 1], rows[k]);
+            let w = (t - a.time) / (b.time - a.time);
+            finite(value(a) + w * (value(b) - value(a)))
         }
         Measure::Max(p) => h.probes[p].iter().copied().reduce(f64::max),
         Measure::Min(p) => h.probes[p].iter().copied().reduce(f64::min),

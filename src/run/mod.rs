@@ -419,12 +419,34 @@ fn plot_fracture(
             );
         }
     }
+    // A reference for the last value is a level line; references at times join up into a
+    // curve, one per crack tip and quantity.
     for e in expects {
-        if let Measure::Tip { crack, tip, qty } = e.measure
-            && qty < 2
-        {
-            labels.push(format!("{} reference {}", e.quantity, label(crack, tip)));
-            points.push(vec![(0.0, e.reference), (t_end, e.reference)]);
+        let Measure::Tip {
+            crack,
+            tip,
+            qty,
+            at,
+        } = e.measure
+        else {
+            continue;
+        };
+        if qty >= 2 {
+            continue;
+        }
+        let name = format!("{} reference {}", e.quantity, label(crack, tip));
+        match at {
+            None => {
+                labels.push(name);
+                points.push(vec![(0.0, e.reference), (t_end, e.reference)]);
+            }
+            Some(t) => match labels.iter().position(|l| *l == name) {
+                Some(k) => points[k].push((t, e.reference)),
+                None => {
+                    labels.push(name);
+                    points.push(vec![(t, e.reference)]);
+                }
+            },
         }
     }
     let series: Vec<Series> = labels

@@ -483,6 +483,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     .iter()
                     .cloned()
                     .chain([e.tip.clone().unwrap_or_else(|| "end".into())])
+                    .chain(e.at.map(|t| format!("t={t:.3e}")))
                     .collect(),
                 measure,
                 reference: e.reference,
@@ -490,6 +491,9 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 tolerance: e.tolerance,
             });
             continue;
+        }
+        if e.at.is_some() {
+            return Err(src.error(&key("at"), "`at` applies to KI, KII, J1 and J2"));
         }
         let need = match e.quantity.as_str() {
             "wave_speed" => 2,

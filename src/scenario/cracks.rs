@@ -327,9 +327,19 @@ pub(super) fn tip_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) ->
             format!("the {} of `{name}` is not a tip", ["start", "end"][tip]),
         ));
     }
+    if let Some(t) = e.at {
+        let end = src.scenario.simulation.duration;
+        if !(0.0..=end).contains(&t) {
+            return Err(src.error(
+                &key("at"),
+                format!("the time must lie in the run, 0 to {end:.4e} s"),
+            ));
+        }
+    }
     Ok(Measure::Tip {
         crack: c as u32,
         tip: tip as u32,
         qty,
+        at: e.at,
     })
 }

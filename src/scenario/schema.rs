@@ -371,7 +371,7 @@ pub struct CheckpointSpec {
 #[serde(deny_unknown_fields)]
 pub struct ExpectSpec {
     /// One of: final, max, min, frequency, wave_speed, momentum_drift, energy_drift,
-    /// angular_momentum_drift; KI, KII, J1, J2 (last value at a crack tip).
+    /// angular_momentum_drift; KI, KII, J1, J2 (at a crack tip: the last value, or at `at`).
     pub quantity: String,
     /// Probe(s) the quantity is measured on (wave_speed takes two).
     #[serde(default)]
@@ -380,6 +380,8 @@ pub struct ExpectSpec {
     pub crack: Option<String>,
     /// Tip of that crack: "start" or "end" (default "end").
     pub tip: Option<String>,
+    /// For KI, KII, J1, J2: the value at this time (s) instead of the last one.
+    pub at: Option<f64>,
     /// Reference value (SI).
     pub reference: f64,
     /// Where the reference comes from.
