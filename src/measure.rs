@@ -195,12 +195,12 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             at,
         } => {
             let value = |r: &TipResult| [r.k[0], r.k[1], r.j[0], r.j[1]][qty];
-            let rows = h
+            let mut rows = h
                 .fracture
                 .iter()
                 .filter(|r| r.crack == crack && r.tip == tip);
             let Some(t) = at else {
-                return finite(value(rows.last()?));
+                return finite(value(rows.next_back()?));
             };
             let rows: Vec<&TipResult> = rows.collect();
             let k = rows.iter().position(|r| r.time >= t)?;
