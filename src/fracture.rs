@@ -13,6 +13,30 @@ pub struct FracturePlan {
     /// End of the window behind the tip, in cells, over which the crack opening that splits
     /// G into K_I and K_II is fitted (it starts one cell behind the tip).
     pub opening: f64,
+    /// Further contour sizes (cells) on which J is also measured, for paths.csv.
+    pub compare: Vec<usize>,
+    /// Start of the window over which the contours are compared (s).
+    pub compare_from: f64,
+}
+
+/// J on one contour at one tip and time, its line and area parts apart (J/m^2): the
+/// path-independence record (paths.csv).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PathResult {
+    /// Step.
+    pub step: u64,
+    /// Time (s).
+    pub time: f64,
+    /// Crack index.
+    pub crack: u32,
+    /// 0 for the crack's start vertex, 1 for its end vertex.
+    pub tip: u32,
+    /// Contour size n (cells) of the n x n contour.
+    pub contour: u32,
+    /// Line integral (Eq. 7), global x and y.
+    pub line: [f64; 2],
+    /// Area term (Eq. 8), global x and y.
+    pub area: [f64; 2],
 }
 
 /// J and K at one crack tip at one time (SI: J/m^2, Pa sqrt(m)).

@@ -1,7 +1,7 @@
 //! Probes (particle averages recorded every step) and `[[expect]]` evaluation.
 
 use crate::dim::Dim;
-use crate::fracture::TipResult;
+use crate::fracture::{PathResult, TipResult};
 use crate::material::Elastic;
 use crate::particles::Particles;
 use crate::world::Energies;
@@ -85,6 +85,8 @@ pub struct History {
     pub rows: Vec<Row>,
     /// J and K at every crack tip, at the energy cadence.
     pub fracture: Vec<TipResult>,
+    /// J on the compared contours, at the energy cadence.
+    pub paths: Vec<PathResult>,
 }
 
 /// What an expect measures.
@@ -119,6 +121,20 @@ pub enum Measure {
         qty: usize,
         /// Time (s): interpolated linearly between the rows around it; None for the last row.
         at: Option<f64>,
+    },
+    /// Path dependence of J with the area term at a crack tip: the largest
+    /// [`path_difference`] of the compared contours against the main one.
+    PathDifference {
+        /// Crack index.
+        crack: u32,
+        /// 0 start, 1 end.
+        tip: u32,
+        /// Main contour size (cells).
+        main: u32,
+        /// Compared contour sizes (cells).
+        compare: Vec<u32>,
+        /// Start of the window (s).
+        from: f64,
     },
 }
 
@@ -211,6 +227,17 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             let w = (t - a.time) / (b.time - a.time);
             finite(value(a) + w * (value(b) - value(a)))
         }
+        Measure::PathDifference {
+            crack,
+            tip,
+            main,
+            ref compare,
+            from,
+        } => compare
+            .iter()
+            .map(|&n| path_difference(h, crack, tip, main, n, from, true))
+            .try_fold(0.0, |worst: f64, d| d.map(|d| worst.max(d)))
+            .and_then(finite),
         Measure::Max(p) => h.probes[p].iter().copied().reduce(f64::max),
         Measure::Min(p) => h.probes[p].iter().copied().reduce(f64::min),
         Measure::Frequency(p) => frequency(&h.time, &h.probes[p]),
@@ -315,4 +342,38 @@ mod tests {
             .collect();
         assert!((arrival(&t, &s).unwrap() - 45.0).abs() < 1e-12);
     }
+}
+
+/// How far J on contour `n` is from J on contour `main` at a crack tip, over the rows from
+/// time `from` on: max |J_n - J_main| / max |J_main| (J as a vector), with or without the
+/// area term. None without rows for both contours.
+pub fn path_difference(
+    h: &History,
+    crack: u32,
+    tip: u32,
+    main: u32,
+    n: u32,
+    from: f64,
+    area: bool,
+) -> Option<f64> {
+    let j = |p: &PathResult| {
+        let a = if area { p.area } else { [0.0; 2] };
+        [p.line[0] + a[0], p.line[1] + a[1]]
+    };
+    let rows: Vec<&PathResult> = h
+        .paths
+        .iter()
+        .filter(|p| p.crack == crack && p.tip == tip && p.time >= from)
+        .collect();
+    let (mut diff, mut size, mut pairs) = (0.0f64, 0.0f64, 0);
+    for m in rows.iter().filter(|p| p.contour == main) {
+        let Some(o) = rows.iter().find(|p| p.contour == n && p.step == m.step) else {
+            continue;
+        };
+        let (a, b) = (j(m), j(o));
+        diff = diff.max((b[0] - a[0]).hypot(b[1] - a[1]));
+        size = size.max(a[0].hypot(a[1]));
+        pairs += 1;
+    }
+    (pairs > 0 && size > 0.0).then(|| diff / size)
 }

@@ -5,7 +5,7 @@
 
 use crate::crack::{Crack, Cracks};
 use crate::dim::Dim;
-use crate::fracture::{FracturePlan, TipResult, k_from_g};
+use crate::fracture::{FracturePlan, PathResult, TipResult, k_from_g};
 use crate::shape::Stencil;
 use crate::with_nodes;
 use crate::world::World;
@@ -44,20 +44,22 @@ impl Nodal {
     }
 }
 
-/// J and K at every tip of every crack.
-pub fn run<D: Dim>(world: &World<D>, plan: &FracturePlan) -> Vec<TipResult> {
+/// J and K at every tip of every crack, and J on the compared contours.
+pub fn run<D: Dim>(world: &World<D>, plan: &FracturePlan) -> (Vec<TipResult>, Vec<PathResult>) {
+    let (mut tips, mut paths) = (Vec::new(), Vec::new());
     let Some(cracks) = &world.cracks else {
-        return Vec::new();
+        return (tips, paths);
     };
-    let mut out = Vec::new();
     for (c, crack) in cracks.cracks.iter().enumerate() {
         for end in 0..2 {
             if crack.tips[end] {
-                out.push(tip::<D>(world, cracks, c, crack, end, plan));
+                let (t, p) = tip::<D>(world, cracks, c, crack, end, plan);
+                tips.push(t);
+                paths.extend(p);
             }
         }
     }
-    out
+    (tips, paths)
 }
 
 /// The square contour of half-size `n` cells around node (i0, j0), counterclockwise, as
@@ -98,9 +100,8 @@ fn tip<D: Dim>(
     crack: &Crack,
     end: usize,
     plan: &FracturePlan,
-) -> TipResult {
-    let g = &world.grid;
-    let geom = &g.geom;
+) -> (TipResult, Vec<PathResult>) {
+    let geom = &world.grid.geom;
     let xy = |v: D::Vec| [v[0], v[1]];
     let verts = crack.vertices.clone();
     let (kt, kp) = if end == 1 {
@@ -119,6 +120,71 @@ fn tip<D: Dim>(
         k: [f64::NAN, f64::NAN, 0.0],
     };
 
+    let Some(main) = contour_j(world, cracks, c, &verts, xt, plan.contour, plan.area_term) else {
+        return (res, Vec::new());
+    };
+    let j = [main.line[0] + main.area[0], main.line[1] + main.area[1]];
+    res.j = j;
+    // Path independence: J on the main and compared contours, line and area parts apart.
+    let paths = if plan.compare.is_empty() {
+        Vec::new()
+    } else {
+        std::iter::once(plan.contour)
+            .chain(plan.compare.iter().copied())
+            .filter_map(|n| {
+                let cj = contour_j(world, cracks, c, &verts, xt, n, true)?;
+                Some(PathResult {
+                    step: world.step,
+                    time: world.time,
+                    crack: c as u32,
+                    tip: end as u32,
+                    contour: n as u32,
+                    line: cj.line,
+                    area: cj.area,
+                })
+            })
+            .collect()
+    };
+
+    // G along the tip direction (Eq. 10), split by the opening behind the tip (Eqs. 14-22).
+    let xp = xy(cracks.x[kp]);
+    let len = ((xt[0] - xp[0]).powi(2) + (xt[1] - xp[1]).powi(2)).sqrt();
+    let dir = [(xt[0] - xp[0]) / len, (xt[1] - xp[1]) / len];
+    let gr = j[0] * dir[0] + j[1] * dir[1];
+    let h = geom.h[0].max(geom.h[1]);
+    let [d_i, d_ii] = opening_amplitudes(cracks, &verts, end, xt, dir, h, plan.opening * h);
+    let mat = &world.materials[world.particles.material[main.nearest] as usize];
+    let [k1, k2] = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
+    res.k = [k1, k2, 0.0];
+    (res, paths)
+}
+
+/// J on one contour around a tip: the line integral (Eqs. 11-13) and the area term (Eq. 8;
+/// zero unless asked for), with the particle nearest the tip (whose material converts G to
+/// K).
+struct ContourJ {
+    /// Line integral, global x and y (J/m^2).
+    line: [f64; 2],
+    /// Area integral over the particles inside the contour (J/m^2).
+    area: [f64; 2],
+    /// Particle nearest the tip.
+    nearest: usize,
+}
+
+/// J on the square contour `n` cells from the node nearest the tip `xt` of crack `c` (shrunk
+/// to fit the grid), or None when no contour fits or the crack does not leave it.
+fn contour_j<D: Dim>(
+    world: &World<D>,
+    cracks: &Cracks<D>,
+    c: usize,
+    verts: &std::ops::Range<usize>,
+    xt: [f64; 2],
+    n: usize,
+    area_term: bool,
+) -> Option<ContourJ> {
+    let g = &world.grid;
+    let geom = &g.geom;
+    let xy = |v: D::Vec| [v[0], v[1]];
     // The contour around the node nearest the tip, shrunk to fit inside the grid.
     let node = |a: usize| ((xt[a] - geom.origin[a]) * geom.inv_h[a]).round().max(0.0) as usize;
     let (i0, j0) = (node(0), node(1));
@@ -126,9 +192,9 @@ fn tip<D: Dim>(
         .min(j0)
         .min(geom.cells[0] - i0.min(geom.cells[0]))
         .min(geom.cells[1] - j0.min(geom.cells[1]));
-    let n = plan.contour.min(room);
+    let n = n.min(room);
     if n == 0 {
-        return res;
+        return None;
     }
     let ring = contour(i0, j0, n);
     let pos = |q: [usize; 2]| {
@@ -150,9 +216,7 @@ fn tip<D: Dim>(
             }
         }
     }
-    let Some((e, s, k)) = cut else {
-        return res;
-    };
+    let (e, s, k) = cut?;
     // The path starts on the side of the crack that ring[e + 1] is on and ends on the other.
     let (ca, cb) = (xy(cracks.x[k]), xy(cracks.x[k + 1]));
     let after = pos(ring[e + 1]);
@@ -213,7 +277,7 @@ fn tip<D: Dim>(
         ];
         let targets = fields.targets_of(i);
         // Only the area term needs the particles inside the contour.
-        let inside = plan.area_term && x[0] > lo[0] && x[0] < hi[0] && x[1] > lo[1] && x[1] < hi[1];
+        let inside = area_term && x[0] > lo[0] && x[0] < hi[0] && x[1] > lo[1] && x[1] < hi[1];
         let mut accel = [0.0; 2];
         with_nodes!(shape, N => {
             let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
@@ -276,7 +340,7 @@ fn tip<D: Dim>(
     }
     pts.push(cross);
     vals.push(Nodal::lerp(&at(e, -first), &at(e + 1, -first), s));
-    let mut j = area;
+    let mut j = [0.0; 2];
     for q in 0..pts.len() - 1 {
         let (a, b) = (pts[q], pts[q + 1]);
         let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
@@ -289,19 +353,11 @@ fn tip<D: Dim>(
             *jm += 0.5 * (fa[mm] + fb[mm]) * len;
         }
     }
-    res.j = j;
-
-    // G along the tip direction (Eq. 10), split by the opening behind the tip (Eqs. 14-22).
-    let xp = xy(cracks.x[kp]);
-    let len = ((xt[0] - xp[0]).powi(2) + (xt[1] - xp[1]).powi(2)).sqrt();
-    let dir = [(xt[0] - xp[0]) / len, (xt[1] - xp[1]) / len];
-    let gr = j[0] * dir[0] + j[1] * dir[1];
-    let h = geom.h[0].max(geom.h[1]);
-    let [d_i, d_ii] = opening_amplitudes(cracks, &verts, end, xt, dir, h, plan.opening * h);
-    let mat = &world.materials[p.material[nearest.1] as usize];
-    let [k1, k2] = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
-    res.k = [k1, k2, 0.0];
-    res
+    Some(ContourJ {
+        line: j,
+        area,
+        nearest: nearest.1,
+    })
 }
 
 /// Opening and sliding amplitudes behind a tip, for splitting G (Eqs. 14-22). The paper reads

@@ -212,6 +212,21 @@ fn bad_fracture_requests_name_the_key() {
     assert_error(&e, "fracture.contour", None, "leaves the grid");
     let e = error_with_text(&format!("{crack}[fracture]\nopening = 1.0\n"));
     assert_error(&e, "fracture.opening", None, "at least 2");
+    let e = error_with_text(&format!("{crack}[fracture]\ncompare = [8]\n"));
+    assert_error(&e, "fracture.compare", None, "leaves the grid");
+    let e = error_with_text(&format!("{crack}[fracture]\ncompare_from = -1.0\n"));
+    assert_error(&e, "fracture.compare_from", None, ">= 0");
+    let expect = |body: &str| {
+        format!(
+            "{crack}[fracture]\n[[expect]]\ncrack = \"crack0\"\nreference = 0.0\nsource = \"s\"\ntolerance = 0.1\n{body}"
+        )
+    };
+    let e = error_with_text(&expect("quantity = \"J_path\"\n"));
+    assert_error(&e, "expect[0].quantity", None, "[fracture] compare");
+    let e = error_with_text(&expect("quantity = \"KI\"\nat = 1.0\n"));
+    assert_error(&e, "expect[0].at", None, "must lie in the run");
+    let e = error_with_text(&expect("quantity = \"max\"\nat = 1e-5\n"));
+    assert_error(&e, "expect[0].at", None, "applies to KI");
     let e = error_with_text(&format!(
         "{crack}[fracture]\n[[expect]]\nquantity = \"KI\"\ncrack = \"crack0\"\ntip = \"start\"\nreference = 1.0\nsource = \"s\"\ntolerance = 0.1\n"
     ));

@@ -91,13 +91,19 @@ fn restart_is_bit_exact(text: &str, k: u64, threads: usize, name: &str) {
 
     let last_frame = newest_frame(&dir.join("full"));
     let final_snap = format!("snapshots/step_{steps:012}.fsnap");
+    let measured = ["fracture.csv", "paths.csv"]
+        .into_iter()
+        .filter(|f| dir.join("full").join(f).exists());
     for f in [
         "energy.csv",
         "probes.csv",
         "particles.pvd",
         &last_frame,
         &final_snap,
-    ] {
+    ]
+    .into_iter()
+    .chain(measured)
+    {
         assert!(
             read(&dir.join("full").join(f)) == read(&dir.join("resumed").join(f)),
             "{name}: {f} differs between the uninterrupted and the resumed run"
@@ -128,6 +134,18 @@ fn restart_is_bit_exact_with_a_crack() {
     let crack = "[[crack]]\nline = { start = [0.02, 0.0005], end = [0.02, 0.0135], spacing = 5e-4 }\ntips = []\n";
     let text = scene(2, "ugimp", "usavg").replace("[[probe]]", &format!("{crack}[[probe]]"));
     restart_is_bit_exact(&text, 29, 2, "crack");
+}
+
+#[test]
+fn restart_is_bit_exact_with_j_on_two_contours() {
+    let crack = "[[crack]]\nline = { start = [0.02, 0.0005], end = [0.02, 0.0071], spacing = 5e-4 }\n\
+                 tips = [\"end\"]\n[fracture]\ncontour = 2\ncompare = [3]\n";
+    let text = scene(2, "ugimp", "usavg").replace("[[probe]]", &format!("{crack}[[probe]]"));
+    let dir = scratch("paths-exist");
+    let out = run(&source(&text), &opts(&dir, 1)).unwrap();
+    assert!(!out.history.paths.is_empty() && dir.join("paths.csv").exists());
+    std::fs::remove_dir_all(dir).ok();
+    restart_is_bit_exact(&text, 29, 2, "paths");
 }
 
 #[test]

@@ -46,6 +46,8 @@ pub struct Summary {
     pub energies: Energies,
     /// Results of the scenario's [[expect]] blocks (only for a completed run).
     pub expects: Vec<ExpectResult>,
+    /// Path dependence of J per crack tip and compared contour (`[fracture] compare`).
+    pub paths: Vec<PathReport>,
     /// Snapshot this run continued from.
     pub resumed_from: Option<String>,
     /// Newest snapshot written (or resumed from).
@@ -54,4 +56,24 @@ pub struct Summary {
     pub snapshot_seconds: f64,
     /// Bytes of snapshot columns written.
     pub snapshot_bytes: u64,
+}
+
+/// How far J on one compared contour is from J on the main contour at a crack tip, over the
+/// window from `from` on: max |J_n - J_main| / max |J_main|, with and without the area term.
+#[derive(Clone, Debug, Serialize)]
+pub struct PathReport {
+    /// Crack name.
+    pub crack: String,
+    /// "start" or "end".
+    pub tip: String,
+    /// Main contour size (cells).
+    pub main: u32,
+    /// Compared contour size (cells).
+    pub contour: u32,
+    /// Start of the window (s).
+    pub from: f64,
+    /// Relative difference with the area term (Eq. 8).
+    pub with_area: Option<f64>,
+    /// Relative difference without it.
+    pub without_area: Option<f64>,
 }

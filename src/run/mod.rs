@@ -7,9 +7,10 @@ pub mod writers;
 
 use crate::dim::{D2, D3, Dim};
 use crate::error::Unstable;
-use crate::measure::{Expect, History, Measure, Row};
+use crate::fracture::FracturePlan;
+use crate::measure::{Expect, History, Measure, Row, path_difference};
 use crate::output::plot::{self, Series};
-use crate::output::summary::Summary;
+use crate::output::summary::{PathReport, Summary};
 use crate::scenario::{Scene, Source, build};
 use crate::schedule::Schedule;
 use crate::snapshot::Reader;
@@ -173,6 +174,7 @@ fn drive<D: Dim>(
             dir,
             &names,
             crack_names.as_deref(),
+            fracture.as_ref().is_some_and(|f| !f.compare.is_empty()),
             &state.history,
         )?),
         None => None,
@@ -183,12 +185,13 @@ fn drive<D: Dim>(
             return Ok::<(), anyhow::Error>(());
         };
         let t0 = Instant::now();
-        let tips = fracture::run(world, plan);
+        let (tips, paths) = fracture::run(world, plan);
         fracture_seconds += t0.elapsed().as_secs_f64();
         if let Some(w) = w {
-            w.fracture(&tips)?;
+            w.fracture(&tips, &paths)?;
         }
         state.history.fracture.extend(tips);
+        state.history.paths.extend(paths);
         Ok(())
     };
     let mut checkpoints = match &opts.out {
@@ -354,6 +357,7 @@ fn drive<D: Dim>(
         bytes_per_node: crate::grid::Grid::<D>::bytes_per_node(),
         energies: world.energies(),
         expects: results,
+        paths: path_reports(&world, fracture.as_ref(), &state.history),
         resumed_from: resumed_from.map(|p| p.display().to_string()),
         snapshot: snapshot.as_ref().map(|s| s.0.display().to_string()),
         snapshot_seconds: checkpoints.as_ref().map_or(0.0, |c| c.seconds),
@@ -500,4 +504,44 @@ fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
         "energy (J)",
         &series,
     )
+}
+
+/// The path-dependence report of summary.json: every crack tip against every compared
+/// contour.
+fn path_reports<D: Dim>(
+    world: &World<D>,
+    plan: Option<&FracturePlan>,
+    history: &History,
+) -> Vec<PathReport> {
+    let (Some(plan), Some(cracks)) = (plan, &world.cracks) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (c, crack) in cracks.cracks.iter().enumerate() {
+        for tip in (0..2).filter(|&t| crack.tips[t]) {
+            for &n in &plan.compare {
+                let diff = |area| {
+                    path_difference(
+                        history,
+                        c as u32,
+                        tip as u32,
+                        plan.contour as u32,
+                        n as u32,
+                        plan.compare_from,
+                        area,
+                    )
+                };
+                out.push(PathReport {
+                    crack: crack.name.clone(),
+                    tip: ["start", "end"][tip].into(),
+                    main: plan.contour as u32,
+                    contour: n as u32,
+                    from: plan.compare_from,
+                    with_area: diff(true),
+                    without_area: diff(false),
+                });
+            }
+        }
+    }
+    out
 }

@@ -4,7 +4,7 @@
 
 use super::state::RunState;
 use crate::dim::Dim;
-use crate::fracture::TipResult;
+use crate::fracture::{PathResult, TipResult};
 use crate::measure::{History, Row};
 use crate::output::vtk;
 use crate::world::World;
@@ -20,16 +20,19 @@ pub struct Writers {
     energy: BufWriter<File>,
     probes: BufWriter<File>,
     fracture: Option<(BufWriter<File>, Vec<String>)>,
+    paths: Option<BufWriter<File>>,
 }
 
 impl Writers {
     /// Creates the output folder and the CSV files, holding the header and every row
     /// already recorded in `history` (none for a fresh run).
-    /// `cracks` names the cracks when J and K are measured (then fracture.csv is written).
+    /// `cracks` names the cracks when J and K are measured (then fracture.csv is written);
+    /// `paths` asks for paths.csv (J on compared contours).
     pub fn open(
         dir: &Path,
         probe_names: &[String],
         cracks: Option<&[String]>,
+        paths: bool,
         history: &History,
     ) -> anyhow::Result<Self> {
         std::fs::create_dir_all(dir)
@@ -56,16 +59,25 @@ impl Writers {
             }
             None => None,
         };
+        let paths = match (paths, &fracture) {
+            (true, Some(_)) => {
+                let mut f = create("paths.csv")?;
+                writeln!(f, "step,time,crack,tip,contour,J1,J2,J1_area,J2_area")?;
+                Some(f)
+            }
+            _ => None,
+        };
         let mut w = Writers {
             dir: dir.to_path_buf(),
             energy,
             probes,
             fracture,
+            paths,
         };
         for row in &history.rows {
             w.row(row, history)?;
         }
-        w.fracture(&history.fracture)?;
+        w.fracture(&history.fracture, &history.paths)?;
         Ok(w)
     }
 
@@ -87,11 +99,29 @@ impl Writers {
         Ok(())
     }
 
-    /// Appends J and K at crack tips to fracture.csv (SI: J/m^2, Pa sqrt(m)).
-    pub fn fracture(&mut self, tips: &[TipResult]) -> anyhow::Result<()> {
+    /// Appends J and K at crack tips to fracture.csv, and J on the compared contours (with
+    /// the area term, and the area term alone) to paths.csv (SI: J/m^2, Pa sqrt(m)).
+    pub fn fracture(&mut self, tips: &[TipResult], paths: &[PathResult]) -> anyhow::Result<()> {
         let Some((f, names)) = &mut self.fracture else {
             return Ok(());
         };
+        if let Some(pf) = &mut self.paths {
+            for p in paths {
+                writeln!(
+                    pf,
+                    "{},{:.9e},{},{},{},{:.9e},{:.9e},{:.9e},{:.9e}",
+                    p.step,
+                    p.time,
+                    names[p.crack as usize],
+                    ["start", "end"][p.tip as usize],
+                    p.contour,
+                    p.line[0] + p.area[0],
+                    p.line[1] + p.area[1],
+                    p.area[0],
+                    p.area[1]
+                )?;
+            }
+        }
         for t in tips {
             writeln!(
                 f,
@@ -144,6 +174,9 @@ impl Writers {
         self.energy.flush()?;
         self.probes.flush()?;
         if let Some((f, _)) = &mut self.fracture {
+            f.flush()?;
+        }
+        if let Some(f) = &mut self.paths {
             f.flush()?;
         }
         Ok(())

@@ -492,6 +492,24 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             });
             continue;
         }
+        if e.quantity == "J_path" {
+            let measure = super::cracks::path_measure(src, i, e)?;
+            positive(src, &key("tolerance"), e.tolerance, "relative")?;
+            expects.push(Expect {
+                quantity: e.quantity.clone(),
+                probes: e
+                    .crack
+                    .iter()
+                    .cloned()
+                    .chain([e.tip.clone().unwrap_or_else(|| "end".into())])
+                    .collect(),
+                measure,
+                reference: e.reference,
+                source: e.source.clone(),
+                tolerance: e.tolerance,
+            });
+            continue;
+        }
         if e.at.is_some() {
             return Err(src.error(&key("at"), "`at` applies to KI, KII, J1 and J2"));
         }

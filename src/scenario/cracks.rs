@@ -252,31 +252,43 @@ pub(super) fn fracture_plan<D: Dim>(
             "J and K are measured at crack tips, and no crack has one (see `tips`)",
         ));
     }
-    let n = f.contour.unwrap_or(2);
-    if n == 0 {
-        return Err(src.error("fracture.contour", "must be at least 1 cell"));
-    }
-    for c in &cracks.cracks {
-        for (end, k) in [(0, c.vertices.start), (1, c.vertices.end - 1)] {
-            if !c.tips[end] {
-                continue;
-            }
-            let x = cracks.x[k];
-            let fits = (0..D::D).all(|a| {
-                let i = ((x[a] - geom.origin[a]) * geom.inv_h[a]).round();
-                i >= n as f64 && i + n as f64 <= geom.cells[a] as f64
-            });
-            if !fits {
-                return Err(src.error(
-                    "fracture.contour",
-                    format!(
-                        "a {n} x {n} cell contour around the {} tip of `{}` leaves the grid",
-                        ["start", "end"][end],
-                        c.name
-                    ),
-                ));
+    let fits = |key: &str, n: usize| -> R<()> {
+        if n == 0 {
+            return Err(src.error(key, "must be at least 1 cell"));
+        }
+        for c in &cracks.cracks {
+            for (end, k) in [(0, c.vertices.start), (1, c.vertices.end - 1)] {
+                if !c.tips[end] {
+                    continue;
+                }
+                let x = cracks.x[k];
+                let inside = (0..D::D).all(|a| {
+                    let i = ((x[a] - geom.origin[a]) * geom.inv_h[a]).round();
+                    i >= n as f64 && i + n as f64 <= geom.cells[a] as f64
+                });
+                if !inside {
+                    return Err(src.error(
+                        key,
+                        format!(
+                            "a {n} x {n} cell contour around the {} tip of `{}` leaves the grid",
+                            ["start", "end"][end],
+                            c.name
+                        ),
+                    ));
+                }
             }
         }
+        Ok(())
+    };
+    let n = f.contour.unwrap_or(2);
+    fits("fracture.contour", n)?;
+    let compare = f.compare.clone().unwrap_or_default();
+    for &m in &compare {
+        fits("fracture.compare", m)?;
+    }
+    let compare_from = f.compare_from.unwrap_or(0.0);
+    if !(compare_from >= 0.0) {
+        return Err(src.error("fracture.compare_from", "give a time >= 0 (s)"));
     }
     let opening = f.opening.unwrap_or(8.0);
     if opening.is_nan() || opening < 2.0 {
@@ -289,11 +301,13 @@ pub(super) fn fracture_plan<D: Dim>(
         contour: n,
         area_term: f.area_term.unwrap_or(true),
         opening,
+        compare,
+        compare_from,
     }))
 }
 
-/// The measure of an expect on a crack tip (`qty` 0..4 = KI, KII, J1, J2).
-pub(super) fn tip_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) -> R<Measure> {
+/// The crack and tip (0 start, 1 end) an expect names, checked.
+fn expect_tip(src: &Source, i: usize, e: &ExpectSpec) -> R<(u32, u32)> {
     let key = |k: &str| format!("expect[{i}].{k}");
     let sc = &src.scenario;
     if sc.fracture.is_none() {
@@ -327,6 +341,13 @@ pub(super) fn tip_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) ->
             format!("the {} of `{name}` is not a tip", ["start", "end"][tip]),
         ));
     }
+    Ok((c as u32, tip as u32))
+}
+
+/// The measure of an expect on a crack tip (`qty` 0..4 = KI, KII, J1, J2).
+pub(super) fn tip_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) -> R<Measure> {
+    let key = |k: &str| format!("expect[{i}].{k}");
+    let (crack, tip) = expect_tip(src, i, e)?;
     if let Some(t) = e.at {
         let end = src.scenario.simulation.duration;
         if !(0.0..=end).contains(&t) {
@@ -337,9 +358,39 @@ pub(super) fn tip_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) ->
         }
     }
     Ok(Measure::Tip {
-        crack: c as u32,
-        tip: tip as u32,
+        crack,
+        tip,
         qty,
         at: e.at,
+    })
+}
+
+/// The measure of a `J_path` expect: J with the area term on the compared contours against
+/// the main one at a crack tip, from `[fracture] compare_from` on.
+pub(super) fn path_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure> {
+    let (crack, tip) = expect_tip(src, i, e)?;
+    if e.at.is_some() {
+        return Err(src.error(
+            &format!("expect[{i}].at"),
+            "`J_path` runs over a window: set its start with `[fracture] compare_from`",
+        ));
+    }
+    let f = src.scenario.fracture.as_ref();
+    let compare: Vec<u32> = f
+        .and_then(|f| f.compare.as_ref())
+        .map(|c| c.iter().map(|&n| n as u32).collect())
+        .unwrap_or_default();
+    if compare.is_empty() {
+        return Err(src.error(
+            &format!("expect[{i}].quantity"),
+            "`J_path` compares contours: list them in `[fracture] compare`",
+        ));
+    }
+    Ok(Measure::PathDifference {
+        crack,
+        tip,
+        main: f.and_then(|f| f.contour).unwrap_or(2) as u32,
+        compare,
+        from: f.and_then(|f| f.compare_from).unwrap_or(0.0),
     })
 }

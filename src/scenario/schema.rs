@@ -346,6 +346,12 @@ pub struct FractureSpec {
     pub contour: Option<usize>,
     /// Include the area term of Guo & Nairn 2D (2004) Eq. 8 (default true).
     pub area_term: Option<bool>,
+    /// Further contour sizes (cells) on which J is also measured, its line and area parts
+    /// apart, for the path-independence record paths.csv.
+    pub compare: Option<Vec<usize>>,
+    /// Start of the window (s) over which summary.json and `J_path` expects compare the
+    /// contours (default 0), e.g. once the first stress wave has passed the tip.
+    pub compare_from: Option<f64>,
     /// The crack opening that splits G into K_I and K_II is fitted over the crack from 1 to
     /// `opening` cells behind the tip (default 8).
     pub opening: Option<f64>,
@@ -371,7 +377,9 @@ pub struct CheckpointSpec {
 #[serde(deny_unknown_fields)]
 pub struct ExpectSpec {
     /// One of: final, max, min, frequency, wave_speed, momentum_drift, energy_drift,
-    /// angular_momentum_drift; KI, KII, J1, J2 (at a crack tip: the last value, or at `at`).
+    /// angular_momentum_drift; KI, KII, J1, J2 (at a crack tip: the last value, or at `at`);
+    /// J_path (largest difference of J on the `[fracture] compare` contours from the main
+    /// one, relative to the main one's largest |J|).
     pub quantity: String,
     /// Probe(s) the quantity is measured on (wave_speed takes two).
     #[serde(default)]

@@ -5,7 +5,7 @@
 
 use super::format::{ColumnSet, Header, Reader, SnapshotError};
 use crate::dim::Dim;
-use crate::fracture::TipResult;
+use crate::fracture::{PathResult, TipResult};
 use crate::material::Elastic;
 use crate::measure::{History, Row};
 use crate::run::state::RunState;
@@ -42,6 +42,13 @@ fn tip_data(t: &TipResult) -> [f64; TIP_WIDTH] {
     [
         t.time, t.x[0], t.x[1], t.x[2], t.j[0], t.j[1], t.k[0], t.k[1], t.k[2],
     ]
+}
+
+/// Scalars per path result in the `history.paths.data` column.
+const PATH_WIDTH: usize = 5;
+
+fn path_data(p: &PathResult) -> [f64; PATH_WIDTH] {
+    [p.time, p.line[0], p.line[1], p.area[0], p.area[1]]
 }
 
 fn row_from(step: u64, d: &[f64]) -> Row {
@@ -84,6 +91,18 @@ pub fn write<D: Dim>(
         .map(|t| 2 * u64::from(t.crack) + u64::from(t.tip))
         .collect();
     let tip_data: Vec<f64> = h.fracture.iter().flat_map(tip_data).collect();
+    let path_steps: Vec<u64> = h.paths.iter().map(|p| p.step).collect();
+    let path_ids: Vec<u64> = h
+        .paths
+        .iter()
+        .flat_map(|p| {
+            [
+                2 * u64::from(p.crack) + u64::from(p.tip),
+                u64::from(p.contour),
+            ]
+        })
+        .collect();
+    let path_data: Vec<f64> = h.paths.iter().flat_map(path_data).collect();
     let probe_names: Vec<String> = (0..h.probes.len())
         .map(|k| format!("history.probe.{k}"))
         .collect();
@@ -120,6 +139,9 @@ pub fn write<D: Dim>(
     c.add("history.fracture.step", &tip_steps);
     c.add("history.fracture.tip", &tip_ids);
     c.add("history.fracture.data", &tip_data);
+    c.add("history.paths.step", &path_steps);
+    c.add("history.paths.tip", &path_ids);
+    c.add("history.paths.data", &path_data);
     c.add("history.rows.step", &row_steps);
     c.add("history.rows.data", &rows);
     let header = Header {
@@ -269,6 +291,23 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
             x: [d[1], d[2], d[3]],
             j: [d[4], d[5]],
             k: [d[6], d[7], d[8]],
+        })
+        .collect();
+    let path_steps: Vec<u64> = r.column_any("history.paths.step")?;
+    let path_ids: Vec<u64> = r.column("history.paths.tip", path_steps.len() * 2)?;
+    let data: Vec<f64> = r.column("history.paths.data", path_steps.len() * PATH_WIDTH)?;
+    history.paths = path_steps
+        .iter()
+        .zip(path_ids.chunks_exact(2))
+        .zip(data.chunks_exact(PATH_WIDTH))
+        .map(|((&step, id), d)| PathResult {
+            step,
+            time: d[0],
+            crack: (id[0] / 2) as u32,
+            tip: (id[0] % 2) as u32,
+            contour: id[1] as u32,
+            line: [d[1], d[2]],
+            area: [d[3], d[4]],
         })
         .collect();
     let state = RunState {
