@@ -318,32 +318,6 @@ pub fn arrival(t: &[f64], s: &[f64]) -> Option<f64> {
     Some(t[i - 1] + (half - a) / (b - a) * (t[i] - t[i - 1]))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn frequency_of_a_sampled_sine() {
-        let t: Vec<f64> = (0..2000).map(|i| i as f64 * 1e-4).collect();
-        let s: Vec<f64> = t
-            .iter()
-            .map(|t| (2.0 * std::f64::consts::PI * 37.0 * t).sin() + 3.0)
-            .collect();
-        let f = frequency(&t, &s).unwrap();
-        assert!((f - 37.0).abs() < 0.05, "{f}");
-    }
-
-    #[test]
-    fn arrival_of_a_ramp_front() {
-        let t: Vec<f64> = (0..100).map(|i| i as f64).collect();
-        let s: Vec<f64> = t
-            .iter()
-            .map(|&t: &f64| ((t - 40.0) / 10.0).clamp(0.0, 1.0))
-            .collect();
-        assert!((arrival(&t, &s).unwrap() - 45.0).abs() < 1e-12);
-    }
-}
-
 /// How far J on contour `n` is from J on contour `main` at a crack tip, over the rows from
 /// time `from` on: max |J_n - J_main| / max |J_main| (J as a vector), with or without the
 /// area term. None without rows for both contours.
@@ -376,4 +350,30 @@ pub fn path_difference(
         pairs += 1;
     }
     (pairs > 0 && size > 0.0).then(|| diff / size)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frequency_of_a_sampled_sine() {
+        let t: Vec<f64> = (0..2000).map(|i| i as f64 * 1e-4).collect();
+        let s: Vec<f64> = t
+            .iter()
+            .map(|t| (2.0 * std::f64::consts::PI * 37.0 * t).sin() + 3.0)
+            .collect();
+        let f = frequency(&t, &s).unwrap();
+        assert!((f - 37.0).abs() < 0.05, "{f}");
+    }
+
+    #[test]
+    fn arrival_of_a_ramp_front() {
+        let t: Vec<f64> = (0..100).map(|i| i as f64).collect();
+        let s: Vec<f64> = t
+            .iter()
+            .map(|&t: &f64| ((t - 40.0) / 10.0).clamp(0.0, 1.0))
+            .collect();
+        assert!((arrival(&t, &s).unwrap() - 45.0).abs() < 1e-12);
+    }
 }

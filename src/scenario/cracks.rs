@@ -287,7 +287,7 @@ pub(super) fn fracture_plan<D: Dim>(
         fits("fracture.compare", m)?;
     }
     let compare_from = f.compare_from.unwrap_or(0.0);
-    if !(compare_from >= 0.0) {
+    if compare_from.is_nan() || compare_from < 0.0 {
         return Err(src.error("fracture.compare_from", "give a time >= 0 (s)"));
     }
     let opening = f.opening.unwrap_or(8.0);
