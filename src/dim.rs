@@ -74,7 +74,12 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     /// if below, 0 if there is no crossing. Exact orientation predicates (Shewchuk's, from
     /// `robust`); a point exactly on the crack line or plane counts as above, so a line
     /// through a vertex shared by two segments crosses exactly one of them.
-    fn crossing(p: Self::Vec, q: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8;
+    fn crossing(p: Self::Vec, q: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8 {
+        Self::crossing_from(p, Self::elem_side(p, v, e), q, v, e)
+    }
+    /// [`Dim::crossing`] given `sp`, the [`Dim::elem_side`] of `p` (a particle tested against
+    /// every node of its stencil computes it once).
+    fn crossing_from(p: Self::Vec, sp: i8, q: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8;
     /// Side of the line (2D) or plane (3D) of crack element `e` that `x` lies on: +1 above
     /// or on it, -1 below; the first test of [`Dim::crossing`].
     fn elem_side(x: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8;
@@ -164,10 +169,9 @@ impl Dim for D2 {
             c(x),
         ))
     }
-    fn crossing(p: DVec2, q: DVec2, v: &[DVec2], e: [u32; 3]) -> i8 {
+    fn crossing_from(p: DVec2, sp: i8, q: DVec2, v: &[DVec2], e: [u32; 3]) -> i8 {
         let c = |u: DVec2| robust::Coord { x: u.x, y: u.y };
         let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
-        let sp = Self::elem_side(p, v, e);
         if sp == Self::elem_side(q, v, e) {
             return 0;
         }
@@ -259,14 +263,13 @@ impl Dim for D3 {
         // robust::orient3d is positive below the plane of a counterclockwise triangle.
         side(-robust::orient3d(a, b, t, c(x)))
     }
-    fn crossing(p: DVec3, q: DVec3, v: &[DVec3], e: [u32; 3]) -> i8 {
+    fn crossing_from(p: DVec3, sp: i8, q: DVec3, v: &[DVec3], e: [u32; 3]) -> i8 {
         let c = |u: DVec3| robust::Coord3D {
             x: u.x,
             y: u.y,
             z: u.z,
         };
         let [a, b, t] = e.map(|k| c(v[k as usize]));
-        let sp = Self::elem_side(p, v, e);
         if sp == Self::elem_side(q, v, e) {
             return 0;
         }

@@ -26,22 +26,23 @@ fn span<D: Dim>(a: D::Vec, b: D::Vec) -> Aabb<D> {
     (lo, hi)
 }
 
-/// Crack-side mask of the line from `xp` to `xn` against elements `near` (boxes `boxes`).
+/// Crack-side mask of the line from `xp` to `xn` against elements `near` (with boxes
+/// `boxes` and the side of `xp` to each).
 fn mask_of<D: Dim>(
     xp: D::Vec,
     xn: D::Vec,
     cracks: &Cracks<D>,
-    near: &[u32],
+    near: &[(u32, i8)],
     boxes: &[Aabb<D>],
 ) -> u64 {
     let line = span::<D>(xp, xn);
     let (mut odd, mut above) = (0u32, 0u32);
-    for &e in near {
+    for &(e, sp) in near {
         let e = e as usize;
         if !overlaps::<D>(&line, &boxes[e]) {
             continue;
         }
-        let s = D::crossing(xp, xn, &cracks.x, cracks.elems[e]);
+        let s = D::crossing_from(xp, sp, xn, &cracks.x, cracks.elems[e]);
         if s != 0 {
             let bit = 1u32 << cracks.elem_crack[e];
             odd ^= bit;
@@ -109,7 +110,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let mut coded: Vec<u32> = Vec::new();
     let mut node_ids: Vec<u32> = Vec::new();
     let mut masks: Vec<u64> = Vec::new();
-    let mut near: Vec<u32> = Vec::new();
+    let mut near: Vec<(u32, i8)> = Vec::new();
     let mut tile_near: Vec<u32> = Vec::new();
     let mut local = vec![(0u32, 0u64); per];
     for tk in t_lo[2]..=t_hi[2] {
@@ -130,6 +131,15 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 if tile_near.is_empty() {
                     continue;
                 }
+                // Sorted by the boxes' lower x, so the elements a node box can meet in x are
+                // one run of the list, found by two binary searches.
+                tile_near.sort_unstable_by(|&a, &b| {
+                    boxes[a as usize].0[0].total_cmp(&boxes[b as usize].0[0])
+                });
+                let widest = tile_near
+                    .iter()
+                    .map(|&e| boxes[e as usize].1[0] - boxes[e as usize].0[0])
+                    .fold(0.0, f64::max);
                 let mut union = boxes[tile_near[0] as usize];
                 for &e in &tile_near {
                     for k in 0..D::D {
@@ -139,26 +149,15 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 }
                 for &i in tiles.particles(t as u32) {
                     let xp = p.x[i as usize];
-                    let reach_box = (xp - reach, xp + reach);
-                    if !overlaps::<D>(&reach_box, &union) {
-                        continue;
-                    }
-                    near.clear();
-                    near.extend(
-                        tile_near
-                            .iter()
-                            .copied()
-                            .filter(|&e| overlaps::<D>(&reach_box, &boxes[e as usize])),
-                    );
-                    if near.is_empty() {
+                    if !overlaps::<D>(&(xp - reach, xp + reach), &union) {
                         continue;
                     }
                     let mut any = false;
                     with_nodes!(shape, N => {
                         let st = Stencil::<N>::cached::<D>(&tiles.stencils, i as usize);
-                        // Drop elements whose line or plane has the particle and every
-                        // corner of its stencil's node box on one side: no line from the
-                        // particle to a node can cross them.
+                        // Every line from the particle to a node of its stencil lies in the
+                        // stencil's node box (which holds the particle): only elements
+                        // meeting that box can be crossed.
                         let mut corners = [D::zero(); 8];
                         for (k, c) in corners.iter_mut().enumerate().take(1 << D::D) {
                             *c = geom.origin;
@@ -167,12 +166,27 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                                 c[a] += i as f64 * geom.h[a];
                             }
                         }
+                        let node_box = (corners[0], corners[(1 << D::D) - 1]);
+                        let first = tile_near.partition_point(|&e| {
+                            boxes[e as usize].0[0] < node_box.0[0] - widest
+                        });
+                        let last = tile_near
+                            .partition_point(|&e| boxes[e as usize].0[0] <= node_box.1[0]);
+                        // Of those meeting the node box, keep the elements whose line or
+                        // plane does not have the particle and every corner of the box on
+                        // one side, with the particle's side.
                         let corners = &corners[..1 << D::D];
-                        near.retain(|&e| {
+                        near.clear();
+                        for &e in &tile_near[first..last.max(first)] {
+                            if !overlaps::<D>(&node_box, &boxes[e as usize]) {
+                                continue;
+                            }
                             let el = cracks.elems[e as usize];
                             let sp = D::elem_side(xp, &cracks.x, el);
-                            corners.iter().any(|&c| D::elem_side(c, &cracks.x, el) != sp)
-                        });
+                            if corners.iter().any(|&c| D::elem_side(c, &cracks.x, el) != sp) {
+                                near.push((e, sp));
+                            }
+                        }
                         if near.is_empty() {
                             continue;
                         }

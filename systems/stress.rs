@@ -4,6 +4,7 @@
 use crate::dim::Dim;
 use crate::particles::Particles;
 use crate::shape::Stencil;
+use crate::sym::Sym3;
 use crate::with_nodes;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
@@ -22,54 +23,59 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let fields = world.cracks.as_ref().map(|c| &c.fields);
     let Particles {
         grad_v,
+        grad_u,
         stress,
         material,
         ..
     } = &mut world.particles;
     let material = &*material;
-    (grad_v.par_chunks_mut(CHUNK), stress.par_chunks_mut(CHUNK))
-        .into_par_iter()
-        .enumerate()
-        .for_each(|(c, (gv, s))| {
-            with_nodes!(shape, N => for k in 0..gv.len() {
-                let i = c * CHUNK + k;
-                let st = Stencil::<N>::cached::<D>(stencils, i);
-                // grad v = sum_rows (sum_i v_i dw_i) ⊗ q x̂ + (sum_i v_i w_i) ⊗ g_yz.
-                let mut l = D::mat_zero();
-                match fields.and_then(|f| f.targets_of(i)) {
-                    // Near a crack: the velocity gradient of this particle's field (Eq. 20 of
-                    // Guo & Nairn 3D (2006)).
-                    Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, _, g| {
-                        l = l + D::outer(grid.velocity[n], g);
-                    }),
-                    None => st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
-                        let (mut vd, mut vw) = (D::zero(), D::zero());
-                        for a in 0..N {
-                            let v = grid.velocity[row + a];
-                            vd += v * st.dw[0][a];
-                            vw += v * st.w[0][a];
-                        }
-                        l = l + D::outer(vd, D::unit_x() * q) + D::outer(vw, gyz);
-                    }),
-                }
-                gv[k] = l;
-                let de = D::sym_part(&gv[k]) * dt;
-                materials[material[i] as usize].update(plane, de, &mut s[k]);
-            })
-        });
-    displacement_gradient(&mut world.particles, dt);
-}
-
-/// Accumulates the displacement gradient, when it is tracked: grad u += grad v dt.
-fn displacement_gradient<D: Dim>(p: &mut Particles<D>, dt: f64) {
-    if p.grad_u.is_empty() {
-        return;
+    // One chunk of particles: gather grad v, update the stress and, when it is tracked (J is
+    // measured; `gu` is then non-empty), the displacement gradient grad u += grad v dt.
+    let body = |c: usize, gv: &mut [D::Mat], s: &mut [Sym3], gu: &mut [D::Mat]| {
+        with_nodes!(shape, N => for k in 0..gv.len() {
+            let i = c * CHUNK + k;
+            let st = Stencil::<N>::cached::<D>(stencils, i);
+            // grad v = sum_rows (sum_i v_i dw_i) ⊗ q x̂ + (sum_i v_i w_i) ⊗ g_yz.
+            let mut l = D::mat_zero();
+            match fields.and_then(|f| f.targets_of(i)) {
+                // Near a crack: the velocity gradient of this particle's field (Eq. 20 of
+                // Guo & Nairn 3D (2006)).
+                Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, _, g| {
+                    l = l + D::outer(grid.velocity[n], g);
+                }),
+                None => st.for_each_row::<D>(&geom.stride, |row, q, gyz| {
+                    let (mut vd, mut vw) = (D::zero(), D::zero());
+                    for a in 0..N {
+                        let v = grid.velocity[row + a];
+                        vd += v * st.dw[0][a];
+                        vw += v * st.w[0][a];
+                    }
+                    l = l + D::outer(vd, D::unit_x() * q) + D::outer(vw, gyz);
+                }),
+            }
+            gv[k] = l;
+            if !gu.is_empty() {
+                gu[k] = gu[k] + l * dt;
+            }
+            let de = D::sym_part(&l) * dt;
+            materials[material[i] as usize].update(plane, de, &mut s[k]);
+        })
+    };
+    if grad_u.is_empty() {
+        (grad_v.par_chunks_mut(CHUNK), stress.par_chunks_mut(CHUNK))
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, (gv, s))| body(c, gv, s, &mut []));
+    } else {
+        (
+            grad_v.par_chunks_mut(CHUNK),
+            stress.par_chunks_mut(CHUNK),
+            grad_u.par_chunks_mut(CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, (gv, s, gu))| body(c, gv, s, gu));
     }
-    let Particles { grad_u, grad_v, .. } = p;
-    grad_u
-        .par_iter_mut()
-        .zip(grad_v.par_iter())
-        .for_each(|(u, l)| *u = *u + *l * dt);
 }
 
 /// Sets the grid velocity column to p/m (zero on nodes lighter than the mass tolerance).
