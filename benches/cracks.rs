@@ -1,5 +1,7 @@
 //! Crack systems on the DCB scene (`scenarios/dcb_2d.toml`, 9,600 particles, a 50 mm crack
-//! with 104 segments): `classify` per step and the J-integral at the tip per output step.
+//! with 104 segments): `classify` per step and the J-integral at the tip per output step;
+//! and frictionless `contact` (on updated velocities) per step on the ENF scene
+//! (`scenarios/enf_2d.toml`, the same beam with its arms sliding).
 //!
 //! `cargo bench --bench cracks`.
 
@@ -7,7 +9,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use fissure::dim::D2;
 use fissure::scenario::{Source, build};
 use fissure::schedule::Schedule;
-use fissure::systems::{classify, fracture};
+use fissure::systems::{classify, contact, fracture};
 use std::time::Duration;
 
 fn cracks(c: &mut Criterion) {
@@ -28,6 +30,21 @@ fn cracks(c: &mut Criterion) {
     g.bench_function("classify", |b| b.iter(|| classify::run(&mut world)));
     g.throughput(Throughput::Elements(1));
     g.bench_function("j_integral", |b| b.iter(|| fracture::run(&world, &plan)));
+    g.finish();
+
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/enf_2d.toml");
+    let src = Source::load(std::path::Path::new(path), &[]).expect("the ENF scenario loads");
+    let mut world = build::<D2>(&src).expect("the ENF scenario builds").world;
+    let mut schedule = Schedule::for_world(&world);
+    for _ in 0..200 {
+        schedule.step(&mut world).expect("stable");
+    }
+    let mut g = c.benchmark_group("cracks-enf");
+    g.sample_size(20)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3));
+    g.throughput(Throughput::Elements(world.particles.len() as u64));
+    g.bench_function("contact", |b| b.iter(|| contact::run(&mut world, true)));
     g.finish();
 }
 
