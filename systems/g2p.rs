@@ -37,10 +37,12 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                     }),
                     None => st.for_each_row::<D>(&geom.stride, |row, q, _| {
                         let (mut da, mut dn) = (D::zero(), D::zero());
+                        // One bounds check per row and column: each slice has N nodes.
+                        let (acc, vel) = (&grid.accel[row..row + N], &grid.velocity[row..row + N]);
                         for a in 0..N {
                             let w = st.w[0][a];
-                            da += grid.accel[row + a] * w;
-                            dn += grid.velocity[row + a] * w;
+                            da += acc[a] * w;
+                            dn += vel[a] * w;
                         }
                         dv += da * q;
                         vn += dn * q;
