@@ -41,6 +41,10 @@ pub struct Settings<D: Dim> {
     pub dt: f64,
     /// Nodes lighter than this carry no velocity (kg).
     pub mass_tol: f64,
+    /// Nodes lighter than this do not move cracks (kg): a thousandth of the lightest
+    /// particle. A node at the edge of a particle's support gets a sliver of mass and, with
+    /// the internal force on it, a meaningless velocity.
+    pub sliver_mass: f64,
     /// Out-of-plane thickness (m) in 2D, 1 in 3D: particle volume over particle area.
     pub thickness: f64,
 }

@@ -7,29 +7,33 @@ use crate::dim::Dim;
 use crate::shape::{ShapeKind, Stencil};
 use crate::world::World;
 
-/// Centre-of-mass velocity at node `n` (Eq. 23), and the momenta and masses of its fields
-/// above and below crack `c`.
+/// Momentum and mass at node `n`, all fields together (Eq. 23's centre of mass), and of its
+/// fields above and below crack `c`; zero for fields lighter than `sliver`.
 fn node_fields<D: Dim>(
     n: usize,
     c: usize,
     mass: &[f64],
     velocity: &[D::Vec],
     fields: &Fields,
-    tol: f64,
-) -> (D::Vec, [(D::Vec, f64); 2]) {
+    sliver: f64,
+) -> [(D::Vec, f64); 3] {
     let (mut m, mut mv) = (mass[n], velocity[n] * mass[n]);
     for r in fields.rows_of(n as u32) {
         m += mass[r];
         mv += velocity[r] * mass[r];
     }
-    if m <= tol {
-        return (D::zero(), [(D::zero(), 0.0); 2]);
+    if m <= sliver {
+        return [(D::zero(), 0.0); 3];
     }
     let side = |s: i8| {
         let e = fields.side_entry(n, c, s);
-        (velocity[e] * mass[e], mass[e])
+        if mass[e] > sliver {
+            (velocity[e] * mass[e], mass[e])
+        } else {
+            (D::zero(), 0.0)
+        }
     };
-    (mv * (1.0 / m), [side(1), side(-1)])
+    [(mv, m), side(1), side(-1)]
 }
 
 /// Moves every crack vertex and both surfaces over the step, interpolating the updated
@@ -48,7 +52,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         return;
     };
     let dt = world.settings.dt;
-    let tol = world.settings.mass_tol;
+    let sliver = world.settings.sliver_mass;
     let g = &world.grid;
     let geom = &g.geom;
     for (c, crack) in cracks.iter().enumerate() {
@@ -69,22 +73,26 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 st.w[a] = w;
                 st.dw[a] = dw;
             }
-            let mut cm = D::zero();
-            let mut sides = [(D::zero(), 0.0); 2];
+            let mut sums = [(D::zero(), 0.0); 3];
             st.for_each::<D>(&geom.stride, |n, w, _| {
-                let (v, f) = node_fields::<D>(n, c, &g.mass, &g.velocity, fields, tol);
-                cm += v * w;
-                for (s, (p, m)) in sides.iter_mut().zip(f) {
+                let f = node_fields::<D>(n, c, &g.mass, &g.velocity, fields, sliver);
+                for (s, (p, m)) in sums.iter_mut().zip(f) {
                     s.0 += p * w;
                     s.1 += m * w;
                 }
             });
-            // Each surface moves with the mass-weighted velocity of its side's fields, so a
-            // field holding a sliver of mass (and a meaningless velocity) cannot drag it.
-            let surface = |(p, m): (D::Vec, f64)| if m > tol { p * (1.0 / m) } else { cm };
+            // Mass-weighted velocities (momentum over mass), where Eqs. 22-23 weight the
+            // nodes' velocities by the shape functions alone: a node holding a sliver of mass
+            // has a meaningless velocity, and with plain weights it threw crack vertices and
+            // surfaces off (a crack end outside the body ran at tens of m/s). The crack moves
+            // with the centre of mass; each surface with its side's fields, or with the crack
+            // where its side has no mass.
+            let velocity = |(p, m): (D::Vec, f64)| if m > 0.0 { p * (1.0 / m) } else { D::zero() };
+            let cm = velocity(sums[0]);
+            let surface = |s: (D::Vec, f64)| if s.1 > 0.0 { velocity(s) } else { cm };
             xs[k] += cm * dt;
-            top[k] += surface(sides[0]) * dt;
-            bottom[k] += surface(sides[1]) * dt;
+            top[k] += surface(sums[1]) * dt;
+            bottom[k] += surface(sums[2]) * dt;
         }
     }
 }

@@ -595,6 +595,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             gravity: to_vec::<D>(gravity),
             dt,
             mass_tol: 1e-12 * min_mass,
+            sliver_mass: 1e-3 * min_mass,
             thickness,
         },
         loads,
