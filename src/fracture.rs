@@ -17,6 +17,8 @@ pub struct FracturePlan {
     pub compare: Vec<usize>,
     /// Start of the window over which the contours are compared (s).
     pub compare_from: f64,
+    /// K that fracture.png divides by (Pa sqrt(m)), e.g. s0 sqrt(pi a).
+    pub k0: Option<f64>,
 }
 
 /// J on one contour at one tip and time, its line and area parts apart (J/m^2): the

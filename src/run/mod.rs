@@ -372,7 +372,8 @@ fn drive<D: Dim>(
                 .map_err(|e| anyhow::anyhow!("cannot draw energy.png: {e}"))?;
             if let Some(cracks) = &crack_names {
                 let path = w.dir.join("fracture.png");
-                plot_fracture(&path, &name, &state.history, &expects, cracks)
+                let k0 = fracture.as_ref().and_then(|f| f.k0);
+                plot_fracture(&path, &name, &state.history, &expects, cracks, k0)
                     .map_err(|e| anyhow::anyhow!("cannot draw fracture.png: {e}"))?;
             }
         }
@@ -395,14 +396,17 @@ fn drive<D: Dim>(
     })
 }
 
-/// K_I and K_II over time at every tip, with each K expect's reference as a flat line.
+/// K_I and K_II over time at every tip, with each K expect's reference (a flat line, or a
+/// curve through the references at given times); divided by `k0` when given.
 fn plot_fracture(
     path: &Path,
     name: &str,
     h: &History,
     expects: &[Expect],
     cracks: &[String],
+    k0: Option<f64>,
 ) -> Result<(), String> {
+    let scale = 1.0 / k0.unwrap_or(1.0);
     let mut tips: Vec<(u32, u32)> = h.fracture.iter().map(|t| (t.crack, t.tip)).collect();
     tips.sort_unstable();
     tips.dedup();
@@ -418,7 +422,7 @@ fn plot_fracture(
                 h.fracture
                     .iter()
                     .filter(|t| (t.crack, t.tip) == (c, tip))
-                    .map(|t| (t.time, t.k[k]))
+                    .map(|t| (t.time, t.k[k] * scale))
                     .collect::<Vec<_>>(),
             );
         }
@@ -442,13 +446,16 @@ fn plot_fracture(
         match at {
             None => {
                 labels.push(name);
-                points.push(vec![(0.0, e.reference), (t_end, e.reference)]);
+                points.push(vec![
+                    (0.0, e.reference * scale),
+                    (t_end, e.reference * scale),
+                ]);
             }
             Some(t) => match labels.iter().position(|l| *l == name) {
-                Some(k) => points[k].push((t, e.reference)),
+                Some(k) => points[k].push((t, e.reference * scale)),
                 None => {
                     labels.push(name);
-                    points.push(vec![(t, e.reference)]);
+                    points.push(vec![(t, e.reference * scale)]);
                 }
             },
         }
@@ -461,11 +468,15 @@ fn plot_fracture(
             points: p,
         })
         .collect();
+    let axis = match k0 {
+        Some(k0) => format!("K / K0 (K0 = {k0:.4e} Pa sqrt(m))"),
+        None => "K (Pa sqrt(m))".to_string(),
+    };
     plot::lines(
         path,
         &format!("{name}: stress intensity factors"),
         "time (s)",
-        "K (Pa sqrt(m))",
+        &axis,
         &series,
     )
 }

@@ -303,6 +303,10 @@ pub(super) fn fracture_plan<D: Dim>(
         opening,
         compare,
         compare_from,
+        k0: match f.k0 {
+            Some(k) => Some(positive(src, "fracture.k0", k, "Pa sqrt(m)")?),
+            None => None,
+        },
     }))
 }
 

@@ -352,6 +352,8 @@ pub struct FractureSpec {
     /// Start of the window (s) over which summary.json and `J_path` expects compare the
     /// contours (default 0), e.g. once the first stress wave has passed the tip.
     pub compare_from: Option<f64>,
+    /// fracture.png shows K / k0 (k0 in Pa sqrt(m), e.g. s0 sqrt(pi a)); default: K.
+    pub k0: Option<f64>,
     /// The crack opening that splits G into K_I and K_II is fitted over the crack from 1 to
     /// `opening` cells behind the tip (default 8).
     pub opening: Option<f64>,
