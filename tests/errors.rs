@@ -216,6 +216,8 @@ fn bad_fracture_requests_name_the_key() {
     assert_error(&e, "fracture.compare", None, "leaves the grid");
     let e = error_with_text(&format!("{crack}[fracture]\ncompare_from = -1.0\n"));
     assert_error(&e, "fracture.compare_from", None, ">= 0");
+    let e = error_with_text(&format!("{crack}[fracture]\nk0 = 0.0\n"));
+    assert_error(&e, "fracture.k0", None, "positive");
     let expect = |body: &str| {
         format!(
             "{crack}[fracture]\n[[expect]]\ncrack = \"crack0\"\nreference = 0.0\nsource = \"s\"\ntolerance = 0.1\n{body}"
