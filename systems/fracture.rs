@@ -152,7 +152,15 @@ fn tip<D: Dim>(
     let dir = [(xt[0] - xp[0]) / len, (xt[1] - xp[1]) / len];
     let gr = j[0] * dir[0] + j[1] * dir[1];
     let h = geom.h[0].max(geom.h[1]);
-    let [d_i, d_ii] = opening_amplitudes(cracks, &verts, end, xt, dir, h, plan.opening * h);
+    // With a tip at each end, the fit stays in this tip's half of the crack.
+    let mut window = plan.opening * h;
+    if crack.tips[1 - end] {
+        let length: f64 = (verts.start..verts.end - 1)
+            .map(|k| dist(xy(cracks.x[k]), xy(cracks.x[k + 1])))
+            .sum();
+        window = window.min(0.5 * length);
+    }
+    let [d_i, d_ii] = opening_amplitudes(cracks, &verts, end, xt, dir, h, window);
     let mat = &world.materials[world.particles.material[main.nearest] as usize];
     let [k1, k2] = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
     res.k = [k1, k2, 0.0];

@@ -355,7 +355,8 @@ pub struct FractureSpec {
     /// fracture.png shows K / k0 (k0 in Pa sqrt(m), e.g. s0 sqrt(pi a)); default: K.
     pub k0: Option<f64>,
     /// The crack opening that splits G into K_I and K_II is fitted over the crack from 1 to
-    /// `opening` cells behind the tip (default 8).
+    /// `opening` cells behind the tip (default 8; on a crack with two tips, at most half its
+    /// length).
     pub opening: Option<f64>,
 }
 
