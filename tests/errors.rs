@@ -274,6 +274,14 @@ fn bad_loads_name_the_key() {
     ));
     assert_error(&e, "load[0].region", None, "singular");
     let e = error_with_text(&format!(
+        "[[load]]\n{region}normal = [1.0, 0.0]\ncentre_crack = {{ stress = [0.0, nan, 0.0], center = [0.01, 0.01], half_length = 0.002 }}\n"
+    ));
+    assert_error(&e, "load[0].centre_crack.stress", None, "finite");
+    let e = error_with_text(&format!(
+        "[[load]]\n{region}normal = [1.0, 0.0]\nwilliams = {{ KI = inf, KII = 0.0, tip = [0.01, 0.01] }}\n"
+    ));
+    assert_error(&e, "load[0].williams", None, "finite");
+    let e = error_with_text(&format!(
         "[[load]]\n{region}force = [1.0, 0.0]\nnormal = [1.0, 0.0]\n"
     ));
     assert_error(&e, "load[0].normal", None, "traction field");

@@ -37,16 +37,23 @@ impl Field {
                 &key("centre_crack"),
                 "give one traction field: `williams` or `centre_crack`",
             )),
-            (Some(w), None) => Ok(Some(Field::Williams {
-                k: [w.k1, w.k2],
-                tip: coords(src, &key("williams.tip"), &w.tip)?,
-                angle: w.direction.to_radians(),
-            })),
+            (Some(w), None) => {
+                if !(w.k1.is_finite() && w.k2.is_finite()) {
+                    return Err(
+                        src.error(&key("williams"), "KI and KII must be finite (Pa sqrt(m))")
+                    );
+                }
+                Ok(Some(Field::Williams {
+                    k: [w.k1, w.k2],
+                    tip: coords(src, &key("williams.tip"), &w.tip)?,
+                    angle: w.direction.to_radians(),
+                }))
+            }
             (None, Some(c)) => {
-                if c.stress.len() != 3 {
+                if c.stress.len() != 3 || c.stress.iter().any(|v| !v.is_finite()) {
                     return Err(src.error(
                         &key("centre_crack.stress"),
-                        "give the remote stress as [xx, yy, xy] (Pa)",
+                        "give the remote stress as three finite values [xx, yy, xy] (Pa)",
                     ));
                 }
                 if c.half_length.is_nan() || c.half_length <= 0.0 {
