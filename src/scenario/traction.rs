@@ -38,10 +38,11 @@ impl Field {
                 "give one traction field: `williams` or `centre_crack`",
             )),
             (Some(w), None) => {
-                if !(w.k1.is_finite() && w.k2.is_finite()) {
-                    return Err(
-                        src.error(&key("williams"), "KI and KII must be finite (Pa sqrt(m))")
-                    );
+                if !(w.k1.is_finite() && w.k2.is_finite() && w.direction.is_finite()) {
+                    return Err(src.error(
+                        &key("williams"),
+                        "KI, KII (Pa sqrt(m)) and direction (degrees) must be finite",
+                    ));
                 }
                 Ok(Some(Field::Williams {
                     k: [w.k1, w.k2],
@@ -54,6 +55,12 @@ impl Field {
                     return Err(src.error(
                         &key("centre_crack.stress"),
                         "give the remote stress as three finite values [xx, yy, xy] (Pa)",
+                    ));
+                }
+                if !c.angle.is_finite() {
+                    return Err(src.error(
+                        &key("centre_crack.angle"),
+                        "the angle must be finite (degrees)",
                     ));
                 }
                 if c.half_length.is_nan() || c.half_length <= 0.0 {
