@@ -67,23 +67,7 @@ fn scene(contact: &str, horizontal: bool, vx: f64, vy: f64) -> String {
     } else {
         format!("[[crack]]\n{crack}\ntips = []\ncontact = {contact}\n")
     };
-    format!(
-        r#"
-[simulation]
-dimension = 2
-plane = "stress"
-duration = 2e-6
-[grid]
-min = [0.0, 0.0]
-max = [0.04, 0.012]
-cell = [0.001, 0.001]
-[[material]]
-name = "m"
-E = 70e9
-nu = 0.3
-rho = 2700.0
-{bodies}{crack}"#
-    )
+    common::strip_2d("plane = \"stress\"", 2e-6, &format!("{bodies}{crack}"))
 }
 
 /// Total momentum of the particles above (or right of) the crack.

@@ -10,23 +10,11 @@ use fissure::schedule::Schedule;
 /// A 32 x 4 mm bar of 1 mm cells whose left half moves at -1 m/s and right half at +1 m/s,
 /// with `crack` appended (may be empty).
 fn pulled_apart(shape: &str, update: &str, crack: &str) -> String {
-    format!(
-        r#"
-[simulation]
-dimension = 2
-shape = "{shape}"
-update = "{update}"
-duration = 2e-5
-[grid]
-min = [0.0, 0.0]
-max = [0.04, 0.012]
-cell = [0.001, 0.001]
-[[material]]
-name = "m"
-E = 70e9
-nu = 0.3
-rho = 2700.0
-[[body]]
+    common::strip_2d(
+        &format!("shape = \"{shape}\"\nupdate = \"{update}\""),
+        2e-5,
+        &format!(
+            r#"[[body]]
 material = "m"
 box = {{ min = [0.004, 0.004], max = [0.02, 0.008] }}
 velocity = [-1.0, 0.0]
@@ -36,6 +24,7 @@ box = {{ min = [0.02, 0.004], max = [0.036, 0.008] }}
 velocity = [1.0, 0.0]
 {crack}
 "#
+        ),
     )
 }
 
@@ -174,20 +163,10 @@ fn cracked_scene_is_deterministic_across_threads() {
 /// its velocity and nothing is strained.
 #[test]
 fn two_close_cracks_cut_three_free_pieces() {
-    let text = r#"
-[simulation]
-dimension = 2
-duration = 2e-5
-[grid]
-min = [0.0, 0.0]
-max = [0.04, 0.012]
-cell = [0.001, 0.001]
-[[material]]
-name = "m"
-E = 70e9
-nu = 0.3
-rho = 2700.0
-[[body]]
+    let text = common::strip_2d(
+        "",
+        2e-5,
+        r#"[[body]]
 material = "m"
 box = { min = [0.004, 0.004], max = [0.0195, 0.008] }
 velocity = [-1.0, 0.0]
@@ -205,8 +184,9 @@ tips = []
 [[crack]]
 points = [[0.0205, 0.0025], [0.0205, 0.0095]]
 tips = []
-"#;
-    let w = final_world::<D2>(text, 2);
+"#,
+    );
+    let w = final_world::<D2>(&text, 2);
     let e = w.energies();
     assert!(
         e.strain < 1e-20 * e.kinetic,

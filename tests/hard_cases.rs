@@ -100,34 +100,19 @@ fn column_carries_its_weight_at_rest() {
 /// a message naming the step, the time and the particle, and keeps what it wrote.
 #[test]
 fn unstable_run_stops_with_a_message_and_keeps_files() {
-    let text = r#"
-[simulation]
-dimension = 2
-duration = 1e-3
-[grid]
-min = [0.0, 0.0]
-max = [0.02, 0.02]
-cell = [0.002, 0.002]
-[[material]]
-name = "m"
-E = 1e9
-nu = 0.3
-rho = 1000.0
-[[body]]
-material = "m"
-box = { min = [0.006, 0.006], max = [0.014, 0.014] }
-[[load]]
-region = { min = [0.006, 0.006], max = [0.008, 0.014] }
-force = [-1e9, 0.0]
-[output]
-history_interval = 1e-6
-"#;
+    let text = common::block_2d(
+        1e-3,
+        0.006,
+        0.014,
+        "[[load]]\nregion = { min = [0.006, 0.006], max = [0.008, 0.014] }\nforce = [-1e9, 0.0]\n\
+         [output]\nhistory_interval = 1e-6\n",
+    );
     let dir = std::env::temp_dir().join(format!("fissure-unstable-{}", std::process::id()));
     let opts = RunOptions {
         out: Some(dir.clone()),
         ..RunOptions::default()
     };
-    let err = run(&source(text), &opts)
+    let err = run(&source(&text), &opts)
         .expect_err("must go unstable")
         .to_string();
     assert!(

@@ -7,26 +7,9 @@ use fissure::scenario::build;
 use fissure::schedule::Schedule;
 
 fn names(extra: &str, update: &str) -> Vec<&'static str> {
-    let text = format!(
-        r#"
-[simulation]
-dimension = 2
-update = "{update}"
-duration = 1e-5
-[grid]
-min = [0.0, 0.0]
-max = [0.02, 0.02]
-cell = [0.002, 0.002]
-[[material]]
-name = "m"
-E = 1e9
-nu = 0.3
-rho = 1000.0
-[[body]]
-material = "m"
-box = {{ min = [0.004, 0.004], max = [0.016, 0.016] }}
-{extra}
-"#
+    let text = common::block_2d(1e-5, 0.004, 0.016, extra).replace(
+        "dimension = 2",
+        &format!("dimension = 2\nupdate = \"{update}\""),
     );
     let world = build::<D2>(&source(&text)).unwrap().world;
     Schedule::for_world(&world)

@@ -361,34 +361,16 @@ fn fuzz_path() -> PathBuf {
 /// A run that goes unstable keeps its last good (finite) snapshot and names it.
 #[test]
 fn unstable_run_names_its_last_good_snapshot() {
-    let text = r#"
-[simulation]
-dimension = 2
-duration = 1e-3
-[grid]
-min = [0.0, 0.0]
-max = [0.02, 0.02]
-cell = [0.002, 0.002]
-[[material]]
-name = "m"
-E = 1e9
-nu = 0.3
-rho = 1000.0
-[[body]]
-material = "m"
-box = { min = [0.006, 0.006], max = [0.014, 0.014] }
-[[load]]
-region = { min = [0.006, 0.006], max = [0.008, 0.014] }
-force = [-1e7, 0.0]
-[output]
-history_interval = 1e-6
-vtk = false
-plot = false
-[checkpoint]
-every_steps = 2
-"#;
+    let text = common::block_2d(
+        1e-3,
+        0.006,
+        0.014,
+        "[[load]]\nregion = { min = [0.006, 0.006], max = [0.008, 0.014] }\nforce = [-1e7, 0.0]\n\
+         [output]\nhistory_interval = 1e-6\nvtk = false\nplot = false\n\
+         [checkpoint]\nevery_steps = 2\n",
+    );
     let dir = scratch("unstable");
-    let err = run(&source(text), &opts(&dir, 1))
+    let err = run(&source(&text), &opts(&dir, 1))
         .expect_err("must go unstable")
         .to_string();
     let named = err

@@ -97,33 +97,19 @@ fn vtu_offsets_and_pvd_are_consistent() {
 /// arrays, and a collection listing one file per frame.
 #[test]
 fn crack_vtu_holds_the_segments() {
-    let text = r#"
-[simulation]
-dimension = 2
-duration = 2e-6
-[grid]
-min = [0.0, 0.0]
-max = [0.02, 0.02]
-cell = [0.002, 0.002]
-[[material]]
-name = "m"
-E = 1e9
-nu = 0.3
-rho = 1000.0
-[[body]]
-material = "m"
-box = { min = [0.004, 0.004], max = [0.016, 0.016] }
-[[crack]]
-line = { start = [0.003, 0.01], end = [0.01, 0.01], spacing = 1e-3 }
-[output]
-interval = 1e-6
-"#;
+    let text = common::block_2d(
+        2e-6,
+        0.004,
+        0.016,
+        "[[crack]]\nline = { start = [0.003, 0.01], end = [0.01, 0.01], spacing = 1e-3 }\n\
+         [output]\ninterval = 1e-6\n",
+    );
     let dir = std::env::temp_dir().join(format!("fissure-vtk-crack-{}", std::process::id()));
     let opts = RunOptions {
         out: Some(dir.clone()),
         ..RunOptions::default()
     };
-    run(&source(text), &opts).unwrap();
+    run(&source(&text), &opts).unwrap();
     let pvd = std::fs::read_to_string(dir.join("cracks.pvd")).unwrap();
     let doc = roxmltree::Document::parse(&pvd).expect("pvd is well-formed XML");
     let files = doc

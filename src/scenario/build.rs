@@ -470,11 +470,16 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 .ok_or_else(|| src.error(&key("probes"), format!("no probe named `{name}`")))?;
             ids.push(id);
         }
-        if let Some(qty) = ["KI", "KII", "J1", "J2"]
+        // Crack-tip quantities name a crack and a tip instead of probes.
+        let tip_qty = ["KI", "KII", "J1", "J2"]
             .iter()
-            .position(|q| *q == e.quantity)
-        {
-            let measure = super::cracks::tip_measure(src, i, e, qty)?;
+            .position(|q| *q == e.quantity);
+        let crack_measure = match tip_qty {
+            Some(qty) => Some(super::cracks::tip_measure(src, i, e, qty)?),
+            None if e.quantity == "J_path" => Some(super::cracks::path_measure(src, i, e)?),
+            None => None,
+        };
+        if let Some(measure) = crack_measure {
             positive(src, &key("tolerance"), e.tolerance, "relative")?;
             expects.push(Expect {
                 quantity: e.quantity.clone(),
@@ -484,24 +489,6 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     .cloned()
                     .chain([e.tip.clone().unwrap_or_else(|| "end".into())])
                     .chain(e.at.map(|t| format!("t={t:.3e}")))
-                    .collect(),
-                measure,
-                reference: e.reference,
-                source: e.source.clone(),
-                tolerance: e.tolerance,
-            });
-            continue;
-        }
-        if e.quantity == "J_path" {
-            let measure = super::cracks::path_measure(src, i, e)?;
-            positive(src, &key("tolerance"), e.tolerance, "relative")?;
-            expects.push(Expect {
-                quantity: e.quantity.clone(),
-                probes: e
-                    .crack
-                    .iter()
-                    .cloned()
-                    .chain([e.tip.clone().unwrap_or_else(|| "end".into())])
                     .collect(),
                 measure,
                 reference: e.reference,

@@ -225,3 +225,51 @@ time = {{ kind = "ramp", rise = 5e-6 }}
         force = v(2e4, 5e3),
     )
 }
+
+/// A 2D scene on a 20 x 20 mm grid of 2 mm cells holding one square block of a soft solid
+/// (E = 1 GPa, nu = 0.3, rho = 1000 kg/m^3) from (lo, lo) to (hi, hi) (m), run for
+/// `duration` (s); `extra` follows (loads, cracks, output).
+pub fn block_2d(duration: f64, lo: f64, hi: f64, extra: &str) -> String {
+    format!(
+        r#"
+[simulation]
+dimension = 2
+duration = {duration:e}
+[grid]
+min = [0.0, 0.0]
+max = [0.02, 0.02]
+cell = [0.002, 0.002]
+[[material]]
+name = "m"
+E = 1e9
+nu = 0.3
+rho = 1000.0
+[[body]]
+material = "m"
+box = {{ min = [{lo:e}, {lo:e}], max = [{hi:e}, {hi:e}] }}
+{extra}"#
+    )
+}
+
+/// A 2D scene on a 40 x 12 mm grid of 1 mm cells with an aluminium named "m" (E = 70 GPa,
+/// nu = 0.3, rho = 2700 kg/m^3), run for `duration` (s); `simulation` adds keys to
+/// `[simulation]` (one per line) and `rest` follows the material (bodies, cracks).
+pub fn strip_2d(simulation: &str, duration: f64, rest: &str) -> String {
+    format!(
+        r#"
+[simulation]
+dimension = 2
+{simulation}
+duration = {duration:e}
+[grid]
+min = [0.0, 0.0]
+max = [0.04, 0.012]
+cell = [0.001, 0.001]
+[[material]]
+name = "m"
+E = 70e9
+nu = 0.3
+rho = 2700.0
+{rest}"#
+    )
+}
