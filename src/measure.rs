@@ -6,6 +6,7 @@ use crate::material::Elastic;
 use crate::particles::Particles;
 use crate::world::Energies;
 use serde::Serialize;
+use std::collections::HashMap;
 
 /// What a probe averages.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -334,14 +335,18 @@ pub fn path_difference(
         let a = if area { p.area } else { [0.0; 2] };
         [p.line[0] + a[0], p.line[1] + a[1]]
     };
-    let rows: Vec<&PathResult> = h
-        .paths
-        .iter()
-        .filter(|p| p.crack == crack && p.tip == tip && p.time >= from)
+    let rows = || {
+        h.paths
+            .iter()
+            .filter(move |p| p.crack == crack && p.tip == tip && p.time >= from)
+    };
+    let other: HashMap<u64, &PathResult> = rows()
+        .filter(|p| p.contour == n)
+        .map(|p| (p.step, p))
         .collect();
     let (mut diff, mut size, mut pairs) = (0.0f64, 0.0f64, 0);
-    for m in rows.iter().filter(|p| p.contour == main) {
-        let Some(o) = rows.iter().find(|p| p.contour == n && p.step == m.step) else {
+    for m in rows().filter(|p| p.contour == main) {
+        let Some(o) = other.get(&m.step) else {
             continue;
         };
         let (a, b) = (j(m), j(o));

@@ -132,15 +132,21 @@ fn tip<D: Dim>(
         std::iter::once(plan.contour)
             .chain(plan.compare.iter().copied())
             .filter_map(|n| {
-                let cj = contour_j(world, cracks, c, &verts, xt, n, true)?;
+                // The main contour with its area term is already measured.
+                let (line, area) = if n == plan.contour && plan.area_term {
+                    (main.line, main.area)
+                } else {
+                    let m = contour_j(world, cracks, c, &verts, xt, n, true)?;
+                    (m.line, m.area)
+                };
                 Some(PathResult {
                     step: world.step,
                     time: world.time,
                     crack: c as u32,
                     tip: end as u32,
                     contour: n as u32,
-                    line: cj.line,
-                    area: cj.area,
+                    line,
+                    area,
                 })
             })
             .collect()
