@@ -278,6 +278,10 @@ fn bad_loads_name_the_key() {
     ));
     assert_error(&e, "load[0].centre_crack.stress", None, "finite");
     let e = error_with_text(&format!(
+        "[[load]]\n{region}normal = [1.0, 0.0]\ncentre_crack = {{ stress = [0.0, 1e6, 0.0], center = [0.01, 0.01], half_length = inf }}\n"
+    ));
+    assert_error(&e, "load[0].centre_crack.half_length", None, "finite");
+    let e = error_with_text(&format!(
         "[[load]]\n{region}normal = [1.0, 0.0]\nwilliams = {{ KI = inf, KII = 0.0, tip = [0.01, 0.01] }}\n"
     ));
     assert_error(&e, "load[0].williams", None, "finite");

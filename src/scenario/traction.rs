@@ -63,10 +63,10 @@ impl Field {
                         "the angle must be finite (degrees)",
                     ));
                 }
-                if c.half_length.is_nan() || c.half_length <= 0.0 {
+                if !c.half_length.is_finite() || c.half_length <= 0.0 {
                     return Err(src.error(
                         &key("centre_crack.half_length"),
-                        "the half-length must be positive (m)",
+                        "the half-length must be positive and finite (m)",
                     ));
                 }
                 let angle = c.angle.to_radians();
