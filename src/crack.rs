@@ -99,6 +99,8 @@ pub struct Cracks<D: Dim> {
     pub cracks: Vec<Crack>,
     /// Extra velocity fields this step.
     pub fields: Fields,
+    /// The last classification, reused while nothing moved far enough to change it.
+    pub classified: Classified<D>,
     /// Mass-weighted nodal displacements m u of the crack fields' entries this step (for
     /// contact detection).
     pub disp: HashMap<usize, D::Vec>,
@@ -143,8 +145,54 @@ impl<D: Dim> Default for Cracks<D> {
             elem_crack: Vec::new(),
             cracks: Vec::new(),
             fields: Fields::default(),
+            classified: Classified::default(),
             disp: HashMap::new(),
             contact_dp: Vec::new(),
+        }
+    }
+}
+
+/// What `classify` last found for each particle near a crack, kept so that a step can
+/// reuse it while neither the particle nor the crack has moved far enough to change a
+/// crossing (a skin, as in Verlet neighbour lists). Reuse gives exactly what a fresh
+/// classification would, so the record is not part of a snapshot.
+#[derive(Clone, Debug)]
+pub struct Classified<D: Dim> {
+    /// Classify every particle afresh every step (for checks; off by default).
+    pub every_step: bool,
+    /// Whether the record describes the current cracks and particles.
+    pub valid: bool,
+    /// Crack-plane vertex positions at the last full pass (m).
+    pub x0: Vec<D::Vec>,
+    /// Bound on any particle's displacement since the last full pass (m): `g2p` adds each
+    /// step's largest.
+    pub drift: f64,
+    /// Particles within reach of a crack at the last full pass, in increasing order.
+    pub watched: Vec<u32>,
+    /// Stencil base of each watched particle when it was classified.
+    pub base: Vec<[u32; 3]>,
+    /// A watched particle's record stands while `drift` plus the cracks' movement since the
+    /// full pass stays below this (m).
+    pub budget: Vec<f64>,
+    /// Whether some line from the watched particle to a stencil node crosses a crack.
+    pub crosses: Vec<bool>,
+    /// Crack-side mask of every stencil node of each watched particle (`Fields::per` each,
+    /// zero weights included).
+    pub masks: Vec<u64>,
+}
+
+impl<D: Dim> Default for Classified<D> {
+    fn default() -> Self {
+        Classified {
+            every_step: false,
+            valid: false,
+            x0: Vec::new(),
+            drift: 0.0,
+            watched: Vec::new(),
+            base: Vec::new(),
+            budget: Vec::new(),
+            crosses: Vec::new(),
+            masks: Vec::new(),
         }
     }
 }

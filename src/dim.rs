@@ -5,6 +5,7 @@
 //! Grid indices are always `[usize; 3]` with a unit third axis in 2D, so stencil loops are
 //! written once.
 
+use crate::geometry::{point_segment, point_triangle, segment_segment};
 use crate::snapshot::Columnar;
 use crate::sym::Sym3;
 use glam::{DMat2, DMat3, DVec2, DVec3};
@@ -83,6 +84,21 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     /// Side of the line (2D) or plane (3D) of crack element `e` that `x` lies on: +1 above
     /// or on it, -1 below; the first test of [`Dim::crossing`].
     fn elem_side(x: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8;
+    /// Boundary features of a crack element: end points of a 2D segment, edges of a 3D
+    /// triangle.
+    const FEATURES: usize;
+    /// Whether a line through a feature shared by two elements crosses exactly one of them
+    /// under [`Dim::crossing`]'s tie rule (true for 2D vertices; not for 3D edges, where it
+    /// crosses both or neither).
+    const SHARED_FEATURE_SAFE: bool;
+    /// Vertex indices of feature `k` of element `e` (2D: the vertex twice).
+    fn feature(e: [u32; 3], k: usize) -> [u32; 2];
+    /// Distance from `x` to crack element `e` (m).
+    fn elem_distance(x: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> f64;
+    /// Distance from `x` to the line (2D) or plane (3D) of crack element `e` (m).
+    fn plane_distance(x: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> f64;
+    /// Distance from feature `k` of crack element `e` to the segment `p`-`q` (m).
+    fn feature_distance(p: Self::Vec, q: Self::Vec, v: &[Self::Vec], e: [u32; 3], k: usize) -> f64;
 }
 
 /// +1 for a non-negative orientation, -1 otherwise (the tie rule of [`Dim::crossing`]).
@@ -102,6 +118,8 @@ pub struct D3;
 impl Dim for D2 {
     const D: usize = 2;
     const COLOURS: usize = 4;
+    const FEATURES: usize = 2;
+    const SHARED_FEATURE_SAFE: bool = true;
     type Vec = DVec2;
     type Mat = DMat2;
 
@@ -169,6 +187,25 @@ impl Dim for D2 {
             c(x),
         ))
     }
+    fn feature(e: [u32; 3], k: usize) -> [u32; 2] {
+        [e[k], e[k]]
+    }
+    fn elem_distance(x: DVec2, v: &[DVec2], e: [u32; 3]) -> f64 {
+        point_segment::<Self>(x, v[e[0] as usize], v[e[1] as usize])
+    }
+    fn plane_distance(x: DVec2, v: &[DVec2], e: [u32; 3]) -> f64 {
+        let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
+        let t = b - a;
+        let len = t.length();
+        if len > 0.0 {
+            t.perp_dot(x - a).abs() / len
+        } else {
+            (x - a).length()
+        }
+    }
+    fn feature_distance(p: DVec2, q: DVec2, v: &[DVec2], e: [u32; 3], k: usize) -> f64 {
+        point_segment::<Self>(v[e[k] as usize], p, q)
+    }
     fn crossing_from(p: DVec2, sp: i8, q: DVec2, v: &[DVec2], e: [u32; 3]) -> i8 {
         let c = |u: DVec2| robust::Coord { x: u.x, y: u.y };
         let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
@@ -186,6 +223,8 @@ impl Dim for D2 {
 impl Dim for D3 {
     const D: usize = 3;
     const COLOURS: usize = 8;
+    const FEATURES: usize = 3;
+    const SHARED_FEATURE_SAFE: bool = false;
     type Vec = DVec3;
     type Mat = DMat3;
 
@@ -262,6 +301,27 @@ impl Dim for D3 {
         let [a, b, t] = e.map(|k| c(v[k as usize]));
         // robust::orient3d is positive below the plane of a counterclockwise triangle.
         side(-robust::orient3d(a, b, t, c(x)))
+    }
+    fn feature(e: [u32; 3], k: usize) -> [u32; 2] {
+        [e[k], e[(k + 1) % 3]]
+    }
+    fn elem_distance(x: DVec3, v: &[DVec3], e: [u32; 3]) -> f64 {
+        let [a, b, c] = e.map(|k| v[k as usize]);
+        point_triangle(x, a, b, c)
+    }
+    fn plane_distance(x: DVec3, v: &[DVec3], e: [u32; 3]) -> f64 {
+        let [a, b, c] = e.map(|k| v[k as usize]);
+        let n = (b - a).cross(c - a);
+        let len = n.length();
+        if len > 0.0 {
+            n.dot(x - a).abs() / len
+        } else {
+            point_triangle(x, a, b, c)
+        }
+    }
+    fn feature_distance(p: DVec3, q: DVec3, v: &[DVec3], e: [u32; 3], k: usize) -> f64 {
+        let [a, b] = Self::feature(e, k).map(|i| v[i as usize]);
+        segment_segment(p, q, a, b)
     }
     fn crossing_from(p: DVec3, sp: i8, q: DVec3, v: &[DVec3], e: [u32; 3]) -> i8 {
         let c = |u: DVec3| robust::Coord3D {

@@ -10,6 +10,7 @@ pub mod crack;
 pub mod dim;
 pub mod error;
 pub mod fracture;
+pub mod geometry;
 pub mod grid;
 pub mod loads;
 pub mod material;

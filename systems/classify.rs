@@ -1,14 +1,22 @@
 //! `classify`: the velocity field of every particle-node pair near a crack (Guo & Nairn 2D
 //! (2004) section 2.1; 3D (2006) Appendix A) and the extra field rows of the grid. A line
 //! from particle to node that crosses a crack an odd number of times puts the pair in the
-//! node's field for that crack side; an even number counts as none. Only particles in tiles
-//! near a crack are scanned.
+//! node's field for that crack side; an even number counts as none.
+//!
+//! A full pass classifies the particles within reach of a crack and records, for each, how
+//! far it and the cracks may move before a crossing can change (its clearance, capped at a
+//! skin of a quarter cell). Later steps reclassify only the particles whose record no
+//! longer holds (clearance used up, or a new stencil) until the skin itself is used up; the
+//! result is exactly that of a full pass.
 
-use crate::crack::{Cracks, side_bit};
+use crate::crack::{Classified, Cracks, Fields, side_bit};
 use crate::dim::Dim;
-use crate::shape::Stencil;
+use crate::grid::GridGeom;
+use crate::shape::{ShapeKind, Stencil, StencilCache};
+use crate::tiles::Tiles;
 use crate::with_nodes;
 use crate::world::World;
+use std::collections::HashMap;
 
 /// Axis-aligned box (min, max).
 type Aabb<D> = (<D as Dim>::Vec, <D as Dim>::Vec);
@@ -26,225 +34,470 @@ fn span<D: Dim>(a: D::Vec, b: D::Vec) -> Aabb<D> {
     (lo, hi)
 }
 
-/// Crack-side mask of the line from `xp` to `xn` against elements `near` (with boxes
-/// `boxes` and the side of `xp` to each).
-fn mask_of<D: Dim>(
-    xp: D::Vec,
-    xn: D::Vec,
-    cracks: &Cracks<D>,
-    near: &[(u32, i8)],
-    boxes: &[Aabb<D>],
-) -> u64 {
-    let line = span::<D>(xp, xn);
-    let (mut odd, mut above) = (0u32, 0u32);
-    for &(e, sp) in near {
-        let e = e as usize;
-        if !overlaps::<D>(&line, &boxes[e]) {
-            continue;
-        }
-        let s = D::crossing_from(xp, sp, xn, &cracks.x, cracks.elems[e]);
-        if s != 0 {
-            let bit = 1u32 << cracks.elem_crack[e];
-            odd ^= bit;
-            if s > 0 {
-                above |= bit;
-            } else {
-                above &= !bit;
-            }
-        }
+fn grow<D: Dim>(b: &Aabb<D>, by: f64) -> Aabb<D> {
+    let (mut lo, mut hi) = *b;
+    for k in 0..D::D {
+        lo[k] -= by;
+        hi[k] += by;
     }
-    let mut mask = 0;
-    while odd != 0 {
-        let c = odd.trailing_zeros() as usize;
-        odd &= odd - 1;
-        mask |= side_bit(c, if above >> c & 1 == 1 { 1 } else { -1 });
-    }
-    mask
+    (lo, hi)
 }
 
-/// Classifies the particles near cracks from their cached stencils and sizes the grid's
-/// extra field rows. Nothing to do in a scene without cracks.
+/// The crack elements with their boxes, sorted along the axis in which the cracks spread
+/// most, so the elements a box can meet are one run of the list.
+struct Elements<'a, D: Dim> {
+    x: &'a [D::Vec],
+    elems: &'a [[u32; 3]],
+    elem_crack: &'a [u16],
+    boxes: Vec<Aabb<D>>,
+    order: Vec<u32>,
+    axis: usize,
+    widest: f64,
+    /// Per element and boundary feature, the one other element sharing that feature when
+    /// a crossing through it is parity-safe ([`Dim::SHARED_FEATURE_SAFE`]), else `NONE`.
+    neighbour: Vec<[u32; 3]>,
+}
+
+/// No element.
+const NONE: u32 = u32::MAX;
+
+impl<'a, D: Dim> Elements<'a, D> {
+    fn new(x: &'a [D::Vec], elems: &'a [[u32; 3]], elem_crack: &'a [u16]) -> Self {
+        let boxes: Vec<Aabb<D>> = elems
+            .iter()
+            .map(|e| {
+                let (lo, hi) = span::<D>(x[e[0] as usize], x[e[1] as usize]);
+                if D::D == 3 {
+                    let v = x[e[2] as usize];
+                    (span::<D>(lo, v).0, span::<D>(hi, v).1)
+                } else {
+                    (lo, hi)
+                }
+            })
+            .collect();
+        let extent = |k: usize| {
+            let lo = boxes.iter().map(|b| b.0[k]).fold(f64::INFINITY, f64::min);
+            let hi = boxes
+                .iter()
+                .map(|b| b.1[k])
+                .fold(f64::NEG_INFINITY, f64::max);
+            hi - lo
+        };
+        let axis = (0..D::D)
+            .max_by(|&a, &b| extent(a).total_cmp(&extent(b)))
+            .unwrap_or(0);
+        let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
+        order.sort_by(|&a, &b| boxes[a as usize].0[axis].total_cmp(&boxes[b as usize].0[axis]));
+        let widest = boxes
+            .iter()
+            .map(|b| b.1[axis] - b.0[axis])
+            .fold(0.0, f64::max);
+        let mut neighbour = vec![[NONE; 3]; elems.len()];
+        if D::SHARED_FEATURE_SAFE {
+            let mut sharing: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
+            for (e, &el) in elems.iter().enumerate() {
+                for k in 0..D::FEATURES {
+                    let mut f = D::feature(el, k);
+                    f.sort_unstable();
+                    sharing.entry(f).or_default().push(e as u32);
+                }
+            }
+            for (e, &el) in elems.iter().enumerate() {
+                for (k, nb) in neighbour[e].iter_mut().enumerate().take(D::FEATURES) {
+                    let mut f = D::feature(el, k);
+                    f.sort_unstable();
+                    if let [a, b] = sharing[&f][..] {
+                        *nb = if a == e as u32 { b } else { a };
+                    }
+                }
+            }
+        }
+        Elements {
+            x,
+            elems,
+            elem_crack,
+            boxes,
+            order,
+            axis,
+            widest,
+            neighbour,
+        }
+    }
+
+    /// The run of `order` whose boxes can meet `b` along the sorting axis.
+    fn run(&self, b: &Aabb<D>) -> &[u32] {
+        let (ax, boxes) = (self.axis, &self.boxes);
+        let first = self
+            .order
+            .partition_point(|&e| boxes[e as usize].0[ax] < b.0[ax] - self.widest);
+        let last = self
+            .order
+            .partition_point(|&e| boxes[e as usize].0[ax] <= b.1[ax]);
+        &self.order[first..last.max(first)]
+    }
+
+    /// Whether some element's box meets `b`.
+    fn any_meeting(&self, b: &Aabb<D>) -> bool {
+        (self.run(b).iter()).any(|&e| overlaps::<D>(b, &self.boxes[e as usize]))
+    }
+
+    /// Replaces `out` with the elements whose boxes meet `b`, in increasing element order.
+    fn meeting(&self, b: &Aabb<D>, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend((self.run(b).iter()).filter(|&&e| overlaps::<D>(b, &self.boxes[e as usize])));
+        out.sort_unstable();
+    }
+
+    /// Crack-side mask of the line from `xp` to `xn` against elements `near` (with the side
+    /// of `xp` to each), taken in increasing element order so the result never depends on
+    /// how the elements were found.
+    fn mask(&self, xp: D::Vec, xn: D::Vec, near: &[(u32, i8)]) -> u64 {
+        let line = span::<D>(xp, xn);
+        let (mut odd, mut above) = (0u32, 0u32);
+        for &(e, sp) in near {
+            let e = e as usize;
+            if !overlaps::<D>(&line, &self.boxes[e]) {
+                continue;
+            }
+            let s = D::crossing_from(xp, sp, xn, self.x, self.elems[e]);
+            if s != 0 {
+                let bit = 1u32 << self.elem_crack[e];
+                odd ^= bit;
+                if s > 0 {
+                    above |= bit;
+                } else {
+                    above &= !bit;
+                }
+            }
+        }
+        let mut mask = 0;
+        while odd != 0 {
+            let c = odd.trailing_zeros() as usize;
+            odd &= odd - 1;
+            mask |= side_bit(c, if above >> c & 1 == 1 { 1 } else { -1 });
+        }
+        mask
+    }
+}
+
+/// Scratch lists reused from particle to particle.
+struct Scratch<D: Dim> {
+    close: Vec<u32>,
+    near: Vec<(u32, i8)>,
+    nodes: Vec<D::Vec>,
+}
+
+impl<D: Dim> Scratch<D> {
+    fn new() -> Self {
+        Scratch {
+            close: Vec::new(),
+            near: Vec::new(),
+            nodes: Vec::new(),
+        }
+    }
+}
+
+/// What one classification step reads.
+struct Pass<'a, D: Dim> {
+    geom: &'a GridGeom<D>,
+    shape: ShapeKind,
+    stencils: &'a StencilCache,
+    elements: Elements<'a, D>,
+    /// Largest clearance recorded (m).
+    skin: f64,
+    /// Round-off allowance on the distances and on the sums of displacements (m).
+    slack: f64,
+}
+
+impl<D: Dim> Pass<'_, D> {
+    /// Stencil nodes per particle.
+    fn per(&self) -> usize {
+        self.shape.nodes().pow(D::D as u32)
+    }
+
+    /// Classifies particle `xp` with stencil `st`: writes the crack-side mask of every
+    /// stencil node to `masks` and, when `clear`, returns its clearance (at most the skin),
+    /// the distance it and the cracks may move before any of those masks can change;
+    /// otherwise zero.
+    fn classify_one<const N: usize>(
+        &self,
+        xp: D::Vec,
+        st: &Stencil<N>,
+        clear: bool,
+        s: &mut Scratch<D>,
+        masks: &mut [u64],
+    ) -> f64 {
+        let (geom, elements) = (self.geom, &self.elements);
+        // Every line from the particle to a node of its stencil lies in the stencil's node
+        // box (which holds the particle).
+        let mut corners = [D::zero(); 8];
+        for (k, c) in corners.iter_mut().enumerate().take(1 << D::D) {
+            *c = geom.origin;
+            for a in 0..D::D {
+                let i = st.base[a] + (N - 1) * (k >> a & 1);
+                c[a] += i as f64 * geom.h[a];
+            }
+        }
+        let corners = &corners[..1 << D::D];
+        let node_box = (corners[0], corners[corners.len() - 1]);
+        let reach = if clear { self.skin } else { 0.0 };
+        elements.meeting(&grow::<D>(&node_box, reach), &mut s.close);
+        // Node positions in the stencil's order (x fastest, then y, then z).
+        s.nodes.clear();
+        if clear || elements.any_meeting(&node_box) {
+            let nk = if D::D == 3 { N } else { 1 };
+            for k in 0..nk {
+                for j in 0..N {
+                    for i in 0..N {
+                        let mut xn = geom.origin;
+                        for (a, o) in [i, j, k].into_iter().enumerate().take(D::D) {
+                            xn[a] += (st.base[a] + o) as f64 * geom.h[a];
+                        }
+                        s.nodes.push(xn);
+                    }
+                }
+            }
+        }
+        // Elements meeting the node box whose line or plane does not have the particle and
+        // every corner on one side can be crossed now. Every element within the skin bounds
+        // the clearance: a crossing can change only when the particle or a node meets the
+        // element or one of its features meets the particle-node line; a feature shared with
+        // an element the particle sees from the same side matters only once the particle
+        // reaches either's line or plane. Once the clearance is zero the particle is redone
+        // every step anyway.
+        s.near.clear();
+        let x = elements.x;
+        let mut clearance = if clear { self.skin } else { 0.0 };
+        for &e in &s.close {
+            let el = elements.elems[e as usize];
+            let sp = D::elem_side(xp, x, el);
+            if overlaps::<D>(&node_box, &elements.boxes[e as usize])
+                && corners.iter().any(|&c| D::elem_side(c, x, el) != sp)
+            {
+                s.near.push((e, sp));
+            }
+            if clearance <= self.slack {
+                continue;
+            }
+            clearance = clearance.min(D::elem_distance(xp, x, el));
+            let mut open = [false; 3];
+            for (k, o) in open.iter_mut().enumerate().take(D::FEATURES) {
+                let nb = elements.neighbour[e as usize][k];
+                if nb != NONE && D::elem_side(xp, x, elements.elems[nb as usize]) == sp {
+                    let both = D::plane_distance(xp, x, el).min(D::plane_distance(
+                        xp,
+                        x,
+                        elements.elems[nb as usize],
+                    ));
+                    clearance = clearance.min(both);
+                } else {
+                    *o = true;
+                }
+            }
+            for &xn in &s.nodes {
+                let mut c = D::elem_distance(xn, x, el);
+                for k in (0..D::FEATURES).filter(|&k| open[k]) {
+                    c = c.min(D::feature_distance(xp, xn, x, el, k));
+                }
+                clearance = clearance.min(c);
+            }
+        }
+        // A record that must hold over later steps needs every node's mask; one redone
+        // every step needs only those of this step's non-zero weights.
+        masks.fill(0);
+        if !s.near.is_empty() {
+            let mut l = 0;
+            st.for_each::<D>(&geom.stride, |_, w, _| {
+                if clear || w != 0.0 {
+                    masks[l] = elements.mask(xp, s.nodes[l], &s.near);
+                }
+                l += 1;
+            });
+        }
+        clearance
+    }
+
+    /// Classifies watched particle `j` at `xp`: its masks, stencil base and budget, with
+    /// `used` the movement since the full pass that the budget no longer has to absorb. A
+    /// particle whose clearance was zero with the same stencil keeps a zero one until the
+    /// next full pass (a node on a crack line, a line through a crack tip): it is redone
+    /// every step, and its clearance is not worth measuring each time.
+    fn one(&self, rec: &mut Classified<D>, j: usize, xp: D::Vec, used: f64, s: &mut Scratch<D>) {
+        let per = self.per();
+        let i = rec.watched[j] as usize;
+        let masks = &mut rec.masks[j * per..(j + 1) * per];
+        let clear = rec.budget[j] > f64::NEG_INFINITY || self.stencils.base[i] != rec.base[j];
+        let clearance = with_nodes!(self.shape, N => {
+            let st = Stencil::<N>::cached::<D>(self.stencils, i);
+            self.classify_one(xp, &st, clear, s, masks)
+        });
+        rec.crosses[j] = masks.iter().any(|&m| m != 0);
+        rec.base[j] = self.stencils.base[i];
+        rec.budget[j] = if clearance > self.slack {
+            clearance - self.slack + used
+        } else {
+            f64::NEG_INFINITY
+        };
+    }
+
+    /// Finds the particles a crack could reach before the skin is used up (a stencil
+    /// reaches at most two cells from its particle) and classifies each.
+    fn full(&self, tiles: &Tiles, xs: &[D::Vec], rec: &mut Classified<D>) {
+        let geom = self.geom;
+        let mut reach = geom.h * 2.0;
+        for k in 0..D::D {
+            reach[k] += self.skin;
+        }
+        rec.watched.clear();
+        if let Some(all) = (self.elements.boxes.iter().copied())
+            .reduce(|a, b| (span::<D>(a.0, b.0).0, span::<D>(a.1, b.1).1))
+        {
+            let mut t_lo = [0usize; 3];
+            let mut t_hi = [0usize; 3];
+            for k in 0..D::D {
+                let cell = |x: f64| ((x - geom.origin[k]) * geom.inv_h[k]).max(0.0) as usize;
+                t_lo[k] = (cell(all.0[k] - reach[k]) / tiles.size).min(tiles.counts[k] - 1);
+                t_hi[k] = (cell(all.1[k] + reach[k]) / tiles.size).min(tiles.counts[k] - 1);
+            }
+            for tk in t_lo[2]..=t_hi[2] {
+                for tj in t_lo[1]..=t_hi[1] {
+                    for ti in t_lo[0]..=t_hi[0] {
+                        let t = ti + tiles.counts[0] * (tj + tiles.counts[1] * tk);
+                        rec.watched
+                            .extend(tiles.particles(t as u32).iter().filter(|&&i| {
+                                let xp = xs[i as usize];
+                                self.elements.any_meeting(&(xp - reach, xp + reach))
+                            }));
+                    }
+                }
+            }
+        }
+        rec.watched.sort_unstable();
+        let n = rec.watched.len();
+        rec.base.resize(n, [0; 3]);
+        rec.budget.resize(n, 0.0);
+        rec.crosses.resize(n, false);
+        rec.masks.resize(n * self.per(), 0);
+        rec.budget.fill(f64::INFINITY);
+        let mut s = Scratch::new();
+        for j in 0..n {
+            let xp = xs[rec.watched[j] as usize];
+            self.one(rec, j, xp, 0.0, &mut s);
+        }
+    }
+
+    /// Reclassifies the watched particles whose record no longer holds: a new stencil, or
+    /// more movement than their clearance allows. `moved` is how far the cracks moved since
+    /// the full pass.
+    fn refresh(&self, xs: &[D::Vec], moved: f64, rec: &mut Classified<D>) {
+        let mut s = Scratch::new();
+        for j in 0..rec.watched.len() {
+            let i = rec.watched[j] as usize;
+            if self.stencils.base[i] == rec.base[j] && rec.drift + moved < rec.budget[j] {
+                continue;
+            }
+            // From now on the particle moves at most the drift still to come, and the cracks
+            // at most their movement from the full pass plus `moved` back to it.
+            let used = rec.drift - moved;
+            self.one(rec, j, xs[i], used, &mut s);
+        }
+    }
+
+    /// The grid entries of the particles whose lines cross a crack, with this step's
+    /// weights (a node of zero weight keeps its own field), and the extra field rows;
+    /// returns how many rows.
+    fn fields(&self, rec: &Classified<D>, particles: usize, f: &mut Fields) -> usize {
+        let per = self.per();
+        let geom = self.geom;
+        f.per = per;
+        f.nodes = geom.node_count();
+        f.slot.clear();
+        f.slot.resize(particles, u32::MAX);
+        f.coded.clear();
+        f.targets.clear();
+        let mut local = vec![(0u32, 0u64); per];
+        let mut pairs: Vec<(u32, u64)> = Vec::new();
+        for (j, &i) in rec.watched.iter().enumerate() {
+            if !rec.crosses[j] {
+                continue;
+            }
+            let masks = &rec.masks[j * per..(j + 1) * per];
+            let mut any = false;
+            with_nodes!(self.shape, N => {
+                let st = Stencil::<N>::cached::<D>(self.stencils, i as usize);
+                let mut l = 0;
+                st.for_each::<D>(&geom.stride, |n, w, _| {
+                    let m = if w != 0.0 { masks[l] } else { 0 };
+                    any |= m != 0;
+                    local[l] = (n as u32, m);
+                    l += 1;
+                });
+            });
+            if any {
+                f.slot[i as usize] = f.coded.len() as u32;
+                f.coded.push(i);
+                pairs.extend(local.iter().copied());
+            }
+        }
+        let mut rows: Vec<(u32, u64)> = pairs.iter().copied().filter(|p| p.1 != 0).collect();
+        rows.sort_unstable();
+        rows.dedup();
+        f.targets.extend(pairs.iter().map(|&(n, m)| {
+            if m == 0 {
+                n
+            } else {
+                let r = rows.binary_search(&(n, m)).expect("row of a recorded pair");
+                (f.nodes + r) as u32
+            }
+        }));
+        f.node = rows.iter().map(|r| r.0).collect();
+        f.mask = rows.iter().map(|r| r.1).collect();
+        rows.len()
+    }
+}
+
+/// Classifies the particles near cracks (afresh, or reusing the last record where it still
+/// holds) and sizes the grid's extra field rows. Nothing to do in a scene without cracks.
 pub fn run<D: Dim>(world: &mut World<D>) {
-    let Some(cracks) = world.cracks.as_mut() else {
+    let Some(Cracks {
+        x,
+        elems,
+        elem_crack,
+        fields,
+        classified: rec,
+        ..
+    }) = world.cracks.as_mut()
+    else {
         return;
     };
     let geom = &world.grid.geom;
     let tiles = &world.tiles;
-    let p = &world.particles;
-    let shape = world.settings.shape;
-    let per = shape.nodes().pow(D::D as u32);
-    let nodes = geom.node_count();
-    let boxes: Vec<Aabb<D>> = cracks
-        .elems
-        .iter()
-        .map(|e| {
-            let v = |k: usize| cracks.x[e[k] as usize];
-            let (mut lo, mut hi) = span::<D>(v(0), v(1));
-            if D::D == 3 {
-                let (l2, h2) = span::<D>(v(2), v(2));
-                for k in 0..3 {
-                    lo[k] = lo[k].min(l2[k]);
-                    hi[k] = hi[k].max(h2[k]);
-                }
-            }
-            (lo, hi)
-        })
-        .collect();
-    // A stencil reaches at most two cells from its particle.
-    let reach = geom.h * 2.0;
-    let mut all = boxes[0];
-    for b in &boxes {
-        for k in 0..D::D {
-            all.0[k] = all.0[k].min(b.0[k]);
-            all.1[k] = all.1[k].max(b.1[k]);
-        }
+    let h_min = (0..D::D).map(|k| geom.h[k]).fold(f64::INFINITY, f64::min);
+    let pass = Pass {
+        geom,
+        shape: world.settings.shape,
+        stencils: &tiles.stencils,
+        elements: Elements::<D>::new(x, elems, elem_crack),
+        skin: 0.25 * h_min,
+        slack: 1e-6 * h_min,
+    };
+    let moved = if rec.valid && rec.x0.len() == x.len() {
+        x.iter()
+            .zip(&rec.x0)
+            .map(|(&a, &b)| D::dot(a - b, a - b))
+            .fold(0.0, f64::max)
+            .sqrt()
+    } else {
+        f64::INFINITY
+    };
+    if rec.every_step || rec.drift + moved + pass.slack >= pass.skin {
+        pass.full(tiles, &world.particles.x, rec);
+        rec.x0.clone_from(x);
+        rec.drift = 0.0;
+        rec.valid = true;
+    } else {
+        pass.refresh(&world.particles.x, moved, rec);
     }
-    let mut t_lo = [0usize; 3];
-    let mut t_hi = [0usize; 3];
-    for k in 0..D::D {
-        let cell = |x: f64| ((x - geom.origin[k]) * geom.inv_h[k]).max(0.0) as usize;
-        t_lo[k] = (cell(all.0[k] - reach[k]) / tiles.size).min(tiles.counts[k] - 1);
-        t_hi[k] = (cell(all.1[k] + reach[k]) / tiles.size).min(tiles.counts[k] - 1);
-    }
-
-    let mut coded: Vec<u32> = Vec::new();
-    let mut node_ids: Vec<u32> = Vec::new();
-    let mut masks: Vec<u64> = Vec::new();
-    let mut near: Vec<(u32, i8)> = Vec::new();
-    let mut tile_near: Vec<u32> = Vec::new();
-    let mut local = vec![(0u32, 0u64); per];
-    for tk in t_lo[2]..=t_hi[2] {
-        for tj in t_lo[1]..=t_hi[1] {
-            for ti in t_lo[0]..=t_hi[0] {
-                let t = ti + tiles.counts[0] * (tj + tiles.counts[1] * tk);
-                // Elements within reach of the tile, then of each of its particles.
-                let (mut lo, mut hi) = (geom.origin, geom.origin);
-                for (k, c) in [ti, tj, tk].into_iter().enumerate().take(D::D) {
-                    lo[k] += (c * tiles.size) as f64 * geom.h[k] - reach[k];
-                    hi[k] += ((c + 1) * tiles.size) as f64 * geom.h[k] + reach[k];
-                }
-                tile_near.clear();
-                tile_near.extend(
-                    (0..boxes.len() as u32)
-                        .filter(|&e| overlaps::<D>(&(lo, hi), &boxes[e as usize])),
-                );
-                if tile_near.is_empty() {
-                    continue;
-                }
-                // Sorted by the boxes' lower x, so the elements a node box can meet in x are
-                // one run of the list, found by two binary searches.
-                tile_near.sort_unstable_by(|&a, &b| {
-                    boxes[a as usize].0[0].total_cmp(&boxes[b as usize].0[0])
-                });
-                let widest = tile_near
-                    .iter()
-                    .map(|&e| boxes[e as usize].1[0] - boxes[e as usize].0[0])
-                    .fold(0.0, f64::max);
-                let mut union = boxes[tile_near[0] as usize];
-                for &e in &tile_near {
-                    for k in 0..D::D {
-                        union.0[k] = union.0[k].min(boxes[e as usize].0[k]);
-                        union.1[k] = union.1[k].max(boxes[e as usize].1[k]);
-                    }
-                }
-                for &i in tiles.particles(t as u32) {
-                    let xp = p.x[i as usize];
-                    if !overlaps::<D>(&(xp - reach, xp + reach), &union) {
-                        continue;
-                    }
-                    let mut any = false;
-                    with_nodes!(shape, N => {
-                        let st = Stencil::<N>::cached::<D>(&tiles.stencils, i as usize);
-                        // Every line from the particle to a node of its stencil lies in the
-                        // stencil's node box (which holds the particle): only elements
-                        // meeting that box can be crossed.
-                        let mut corners = [D::zero(); 8];
-                        for (k, c) in corners.iter_mut().enumerate().take(1 << D::D) {
-                            *c = geom.origin;
-                            for a in 0..D::D {
-                                let i = st.base[a] + (N - 1) * (k >> a & 1);
-                                c[a] += i as f64 * geom.h[a];
-                            }
-                        }
-                        let node_box = (corners[0], corners[(1 << D::D) - 1]);
-                        let first = tile_near.partition_point(|&e| {
-                            boxes[e as usize].0[0] < node_box.0[0] - widest
-                        });
-                        let last = tile_near
-                            .partition_point(|&e| boxes[e as usize].0[0] <= node_box.1[0]);
-                        // Of those meeting the node box, keep the elements whose line or
-                        // plane does not have the particle and every corner of the box on
-                        // one side, with the particle's side.
-                        let corners = &corners[..1 << D::D];
-                        near.clear();
-                        for &e in &tile_near[first..last.max(first)] {
-                            if !overlaps::<D>(&node_box, &boxes[e as usize]) {
-                                continue;
-                            }
-                            let el = cracks.elems[e as usize];
-                            let sp = D::elem_side(xp, &cracks.x, el);
-                            if corners.iter().any(|&c| D::elem_side(c, &cracks.x, el) != sp) {
-                                near.push((e, sp));
-                            }
-                        }
-                        if near.is_empty() {
-                            continue;
-                        }
-                        let mut l = 0;
-                        st.for_each::<D>(&geom.stride, |n, w, _| {
-                            let m = if w != 0.0 {
-                                mask_of::<D>(xp, geom.node_position(n), cracks, &near, &boxes)
-                            } else {
-                                0
-                            };
-                            any |= m != 0;
-                            local[l] = (n as u32, m);
-                            l += 1;
-                        });
-                    });
-                    if any {
-                        coded.push(i);
-                        node_ids.extend(local.iter().map(|l| l.0));
-                        masks.extend(local.iter().map(|l| l.1));
-                    }
-                }
-            }
-        }
-    }
-
-    // Coded particles in index order, so every later pass is deterministic.
-    let mut order: Vec<usize> = (0..coded.len()).collect();
-    order.sort_unstable_by_key(|&k| coded[k]);
-    let mut rows: Vec<(u32, u64)> = node_ids
-        .iter()
-        .zip(&masks)
-        .filter(|(_, m)| **m != 0)
-        .map(|(n, m)| (*n, *m))
-        .collect();
-    rows.sort_unstable();
-    rows.dedup();
-    let f = &mut cracks.fields;
-    f.per = per;
-    f.nodes = nodes;
-    f.slot.clear();
-    f.slot.resize(p.len(), u32::MAX);
-    f.coded.clear();
-    f.targets.clear();
-    for (slot, &k) in order.iter().enumerate() {
-        f.coded.push(coded[k]);
-        f.slot[coded[k] as usize] = slot as u32;
-        for l in k * per..(k + 1) * per {
-            let (n, m) = (node_ids[l], masks[l]);
-            f.targets.push(if m == 0 {
-                n
-            } else {
-                let r = rows.binary_search(&(n, m)).expect("row of a recorded pair");
-                (nodes + r) as u32
-            });
-        }
-    }
-    f.node = rows.iter().map(|r| r.0).collect();
-    f.mask = rows.iter().map(|r| r.1).collect();
-    let extra = rows.len();
+    let extra = pass.fields(rec, world.particles.len(), fields);
     world.grid.set_extra_fields(extra);
 }

@@ -16,15 +16,18 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let geom = &grid.geom;
     let stencils = &world.tiles.stencils;
     let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let track = fields.is_some();
     let Particles { x, v, u, .. } = &mut world.particles;
-    (
+    // Largest squared velocity moving a particle, when cracks need the bound on drift.
+    let fastest = (
         x.par_chunks_mut(CHUNK),
         v.par_chunks_mut(CHUNK),
         u.par_chunks_mut(CHUNK),
     )
         .into_par_iter()
         .enumerate()
-        .for_each(|(c, (x, v, u))| {
+        .map(|(c, (x, v, u))| {
+            let mut fastest = 0.0f64;
             with_nodes!(shape, N => for k in 0..x.len() {
                 let i = c * CHUNK + k;
                 let st = Stencil::<N>::cached::<D>(stencils, i);
@@ -51,8 +54,16 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 v[k] += dv * dt;
                 x[k] += vn * dt;
                 u[k] += vn * dt;
-            })
-        });
+                if track {
+                    fastest = fastest.max(D::dot(vn, vn));
+                }
+            });
+            fastest
+        })
+        .reduce(|| 0.0, f64::max);
+    if let Some(c) = world.cracks.as_mut() {
+        c.classified.drift += fastest.sqrt() * dt;
+    }
     world.tiles.fresh = false;
     load_work_end(world);
 }
