@@ -1,5 +1,6 @@
 //! Crack systems on the DCB scene (`scenarios/dcb_2d.toml`, 9,600 particles, a 50 mm crack
-//! with 104 segments): `classify` per step and the J-integral at the tip per output step;
+//! with 104 segments): `classify` per step, as a full pass and reusing its record (only
+//! the particles with no clearance redone), and the J-integral at the tip per output step;
 //! and frictionless `contact` (on updated velocities) per step on the ENF scene
 //! (`scenarios/enf_2d.toml`, the same beam with its arms sliding).
 //!
@@ -27,7 +28,18 @@ fn cracks(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3));
     g.throughput(Throughput::Elements(world.particles.len() as u64));
-    g.bench_function("classify", |b| b.iter(|| classify::run(&mut world)));
+    let every_step = |world: &mut fissure::world::World<D2>, on: bool| {
+        world
+            .cracks
+            .as_mut()
+            .expect("the DCB has a crack")
+            .classified
+            .every_step = on;
+    };
+    every_step(&mut world, true);
+    g.bench_function("classify_full", |b| b.iter(|| classify::run(&mut world)));
+    every_step(&mut world, false);
+    g.bench_function("classify_reuse", |b| b.iter(|| classify::run(&mut world)));
     g.throughput(Throughput::Elements(1));
     g.bench_function("j_integral", |b| b.iter(|| fracture::run(&world, &plan)));
     g.finish();

@@ -213,9 +213,13 @@ impl Fields {
     /// Grid entry of node `n`'s field on `side` (+1 above, -1 below) of crack `c`: the row
     /// whose particles crossed the crack from that side, or else the node's own field.
     pub fn side_entry(&self, n: usize, c: usize, side: i8) -> usize {
+        self.side_entry_in(self.rows_of(n as u32), n, c, side)
+    }
+
+    /// [`Fields::side_entry`] given `rows`, node `n`'s [`Fields::rows_of`].
+    pub fn side_entry_in(&self, mut rows: Range<usize>, n: usize, c: usize, side: i8) -> usize {
         let bit = side_bit(c, side);
-        self.rows_of(n as u32)
-            .find(|&r| self.mask[r - self.nodes] & bit != 0)
+        rows.find(|&r| self.mask[r - self.nodes] & bit != 0)
             .unwrap_or(n)
     }
 

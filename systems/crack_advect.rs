@@ -18,7 +18,8 @@ fn node_fields<D: Dim>(
     sliver: f64,
 ) -> [(D::Vec, f64); 3] {
     let (mut m, mut mv) = (mass[n], velocity[n] * mass[n]);
-    for r in fields.rows_of(n as u32) {
+    let rows = fields.rows_of(n as u32);
+    for r in rows.clone() {
         m += mass[r];
         mv += velocity[r] * mass[r];
     }
@@ -26,7 +27,7 @@ fn node_fields<D: Dim>(
         return [(D::zero(), 0.0); 3];
     }
     let side = |s: i8| {
-        let e = fields.side_entry(n, c, s);
+        let e = fields.side_entry_in(rows.clone(), n, c, s);
         if mass[e] > sliver {
             (velocity[e] * mass[e], mass[e])
         } else {
