@@ -160,9 +160,7 @@ impl<D: Dim> Default for Cracks<D> {
 pub struct Classified<D: Dim> {
     /// Classify every particle afresh every step (for checks; off by default).
     pub every_step: bool,
-    /// Whether the record describes the current cracks and particles.
-    pub valid: bool,
-    /// Crack-plane vertex positions at the last full pass (m).
+    /// Crack-plane vertex positions at the last full pass (m); empty before the first.
     pub x0: Vec<D::Vec>,
     /// Bound on any particle's displacement since the last full pass (m): `g2p` adds each
     /// step's largest.
@@ -174,7 +172,8 @@ pub struct Classified<D: Dim> {
     /// A watched particle's record stands while `drift` plus the cracks' movement since the
     /// full pass stays below this (m).
     pub budget: Vec<f64>,
-    /// Whether some line from the watched particle to a stencil node crosses a crack.
+    /// Whether some line from the watched particle to a stencil node crosses a crack (kept
+    /// so a step scans only those particles' masks).
     pub crosses: Vec<bool>,
     /// Crack-side mask of every stencil node of each watched particle (`Fields::per` each,
     /// zero weights included).
@@ -185,7 +184,6 @@ impl<D: Dim> Default for Classified<D> {
     fn default() -> Self {
         Classified {
             every_step: false,
-            valid: false,
             x0: Vec::new(),
             drift: 0.0,
             watched: Vec::new(),

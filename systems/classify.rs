@@ -56,6 +56,8 @@ struct Elements<'a, D: Dim> {
     /// Per element and boundary feature, the one other element sharing that feature when
     /// a crossing through it is parity-safe ([`Dim::SHARED_FEATURE_SAFE`]), else `NONE`.
     neighbour: Vec<[u32; 3]>,
+    /// Box of all the elements (None without elements).
+    all: Option<Aabb<D>>,
 }
 
 /// No element.
@@ -75,14 +77,9 @@ impl<'a, D: Dim> Elements<'a, D> {
                 }
             })
             .collect();
-        let extent = |k: usize| {
-            let lo = boxes.iter().map(|b| b.0[k]).fold(f64::INFINITY, f64::min);
-            let hi = boxes
-                .iter()
-                .map(|b| b.1[k])
-                .fold(f64::NEG_INFINITY, f64::max);
-            hi - lo
-        };
+        let all =
+            (boxes.iter().copied()).reduce(|a, b| (span::<D>(a.0, b.0).0, span::<D>(a.1, b.1).1));
+        let extent = |k: usize| all.map_or(0.0, |b| b.1[k] - b.0[k]);
         let axis = (0..D::D)
             .max_by(|&a, &b| extent(a).total_cmp(&extent(b)))
             .unwrap_or(0);
@@ -121,6 +118,7 @@ impl<'a, D: Dim> Elements<'a, D> {
             axis,
             widest,
             neighbour,
+            all,
         }
     }
 
@@ -242,9 +240,10 @@ impl<D: Dim> Pass<'_, D> {
         let node_box = (corners[0], corners[corners.len() - 1]);
         let reach = if clear { self.skin } else { 0.0 };
         elements.meeting(&grow::<D>(&node_box, reach), &mut s.close);
-        // Node positions in the stencil's order (x fastest, then y, then z).
+        // Node positions in the stencil's order (x fastest, then y, then z), from the base
+        // rather than `node_position` (which divides), when some element is close.
         s.nodes.clear();
-        if clear || elements.any_meeting(&node_box) {
+        if !s.close.is_empty() {
             let nk = if D::D == 3 { N } else { 1 };
             for k in 0..nk {
                 for j in 0..N {
@@ -349,9 +348,7 @@ impl<D: Dim> Pass<'_, D> {
             reach[k] += self.skin;
         }
         rec.watched.clear();
-        if let Some(all) = (self.elements.boxes.iter().copied())
-            .reduce(|a, b| (span::<D>(a.0, b.0).0, span::<D>(a.1, b.1).1))
-        {
+        if let Some(all) = self.elements.all {
             let mut t_lo = [0usize; 3];
             let mut t_hi = [0usize; 3];
             for k in 0..D::D {
@@ -375,10 +372,10 @@ impl<D: Dim> Pass<'_, D> {
         rec.watched.sort_unstable();
         let n = rec.watched.len();
         rec.base.resize(n, [0; 3]);
-        rec.budget.resize(n, 0.0);
+        rec.budget.clear();
+        rec.budget.resize(n, f64::INFINITY);
         rec.crosses.resize(n, false);
         rec.masks.resize(n * self.per(), 0);
-        rec.budget.fill(f64::INFINITY);
         let mut s = Scratch::new();
         for j in 0..n {
             let xp = xs[rec.watched[j] as usize];
@@ -481,7 +478,8 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         skin: 0.25 * h_min,
         slack: 1e-6 * h_min,
     };
-    let moved = if rec.valid && rec.x0.len() == x.len() {
+    // A record exists once a full pass has stored the vertices it saw (a crack has some).
+    let moved = if rec.x0.len() == x.len() {
         x.iter()
             .zip(&rec.x0)
             .map(|(&a, &b)| D::dot(a - b, a - b))
@@ -494,7 +492,6 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         pass.full(tiles, &world.particles.x, rec);
         rec.x0.clone_from(x);
         rec.drift = 0.0;
-        rec.valid = true;
     } else {
         pass.refresh(&world.particles.x, moved, rec);
     }

@@ -229,18 +229,12 @@ tips = []
     }
 }
 
-/// Builds `text` and steps it to the end, classifying every particle afresh every step when
+/// Steps `text` to the end on one thread, classifying every particle afresh every step when
 /// `every_step`, else reusing what still holds.
 fn stepped(text: &str, every_step: bool) -> fissure::world::World<D2> {
-    let scene = build::<D2>(&source(text)).unwrap_or_else(|e| panic!("{e}"));
-    let mut world = scene.world;
-    world.cracks.as_mut().unwrap().classified.every_step = every_step;
-    let mut schedule = Schedule::for_world(&world);
-    let steps = (scene.duration / world.settings.dt).ceil() as u64;
-    while world.step < steps {
-        schedule.step(&mut world).unwrap_or_else(|e| panic!("{e}"));
-    }
-    world
+    common::final_world_with::<D2>(text, 1, |w| {
+        w.cracks.as_mut().unwrap().classified.every_step = every_step;
+    })
 }
 
 /// The classification record is reused only while nothing can have changed a crossing, so

@@ -25,6 +25,15 @@ pub fn history(text: &str) -> History {
 
 /// Builds the scene and steps it to the end on `threads` threads, returning the world.
 pub fn final_world<D: Dim>(text: &str, threads: usize) -> World<D> {
+    final_world_with(text, threads, |_| {})
+}
+
+/// As [`final_world`], with `prepare` applied to the world before the first step.
+pub fn final_world_with<D: Dim>(
+    text: &str,
+    threads: usize,
+    prepare: impl FnOnce(&mut World<D>) + Send,
+) -> World<D> {
     let src = source(text);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -33,6 +42,7 @@ pub fn final_world<D: Dim>(text: &str, threads: usize) -> World<D> {
     pool.install(|| {
         let scene = build::<D>(&src).unwrap_or_else(|e| panic!("{e}"));
         let mut world = scene.world;
+        prepare(&mut world);
         let mut schedule = Schedule::for_world(&world);
         let steps = (scene.duration / world.settings.dt).ceil() as u64;
         while world.step < steps {
