@@ -66,9 +66,12 @@ fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, shape: &str, update: &str
     g.bench_function("p2g", |b| b.iter(|| p2g::run(&mut world, true)));
     g.bench_function("grid_update", |b| b.iter(|| grid_update::run(&mut world)));
     g.bench_function("g2p", |b| b.iter(|| g2p::run(&mut world)));
+    g.bench_function("g2p_remap", |b| b.iter(|| g2p::run_with_remap(&mut world)));
     bin::run(&mut world).expect("in grid");
-    g.bench_function("remap", |b| b.iter(|| p2g::remap(&mut world)));
     g.bench_function("stress", |b| b.iter(|| stress::run(&mut world, 1.0)));
+    g.bench_function("stress_force", |b| {
+        b.iter(|| stress::run_with_force(&mut world, 1.0))
+    });
     g.bench_function("step", |b| {
         b.iter(|| schedule.step(&mut world).expect("stable"))
     });

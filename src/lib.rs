@@ -8,6 +8,7 @@
 pub mod bodies;
 pub mod crack;
 pub mod dim;
+pub mod disjoint;
 pub mod error;
 pub mod fracture;
 pub mod geometry;

@@ -35,14 +35,19 @@ pub enum System {
         /// Fraction of the step.
         fraction: f64,
     },
-    /// Scatter the internal force alone.
-    InternalForce,
+    /// Constitutive update as `Stress`, then scatter of the internal force from the new
+    /// stress, in one pass (USF and USAVG).
+    StressForce {
+        /// Fraction of the step.
+        fraction: f64,
+    },
     /// Integrate nodal momenta, apply damping, gravity and prescribed velocities.
     GridUpdate,
-    /// Gather to particles: velocities, positions, displacements.
+    /// Gather to particles: velocities, positions, displacements (USF).
     G2p,
-    /// Re-scatter updated particle momenta for the final stress update.
-    Remap,
+    /// As `G2p`, then re-scatter the updated particle momenta for the final stress update
+    /// (USL and USAVG), in one pass.
+    G2pRemap,
 }
 
 impl System {
@@ -56,10 +61,10 @@ impl System {
             System::P2g { .. } => "p2g",
             System::MomentumBc { .. } => "grid_bc",
             System::Stress { .. } => "stress",
-            System::InternalForce => "internal_force",
+            System::StressForce { .. } => "stress_force",
             System::GridUpdate => "grid_update",
             System::G2p => "g2p",
-            System::Remap => "remap",
+            System::G2pRemap => "g2p_remap",
         }
     }
 }
@@ -104,18 +109,17 @@ impl Schedule {
         }
         if update != Update::Usl {
             let fraction = if update == Update::Usf { 1.0 } else { 0.5 };
-            s.extend([Stress { fraction }, InternalForce]);
+            s.push(StressForce { fraction });
         }
         s.push(GridUpdate);
         if contact {
             s.push(Contact { update: true });
         }
-        s.push(G2p);
+        s.push(if update == Update::Usf { G2p } else { G2pRemap });
         if cracks {
             s.push(CrackAdvect);
         }
         if update != Update::Usf {
-            s.push(Remap);
             if bc {
                 s.push(MomentumBc { end: true });
             }
@@ -141,10 +145,10 @@ impl Schedule {
                 System::P2g { internal } => p2g::run(world, internal),
                 System::MomentumBc { end } => grid_update::momentum_bc(world, end),
                 System::Stress { fraction } => stress::run(world, fraction),
-                System::InternalForce => p2g::internal_force(world),
+                System::StressForce { fraction } => stress::run_with_force(world, fraction),
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),
-                System::Remap => p2g::remap(world),
+                System::G2pRemap => g2p::run_with_remap(world),
             }
             self.seconds[k] += t0.elapsed().as_secs_f64();
         }

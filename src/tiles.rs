@@ -104,6 +104,15 @@ impl Tiles {
         }
     }
 
+    /// As [`for_each_coloured`](Self::for_each_coloured), returning the largest value `f`
+    /// gives (0 when there is none); a maximum does not depend on the order of the tiles.
+    pub fn max_coloured(&self, f: impl Fn(u32) -> f64 + Sync + Send) -> f64 {
+        self.colours
+            .iter()
+            .map(|class| class.par_iter().map(|&t| f(t)).reduce(|| 0.0, f64::max))
+            .fold(0.0, f64::max)
+    }
+
     /// Rebuilds `start`, `order` and `colours` from `tile_of` (counting sort).
     pub fn sort(&mut self) {
         let nt = self.len();

@@ -1,24 +1,27 @@
 //! `g2p`: grid-to-particle gather. FLIP velocity update, position and displacement update.
 
 use crate::dim::Dim;
+use crate::disjoint::Disjoint;
+use crate::grid::Grid;
 use crate::particles::Particles;
 use crate::shape::Stencil;
+use crate::systems::p2g::scatter_coded;
 use crate::with_nodes;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Updates particle velocities (v += dt sum S a_i), positions and displacements
-/// (x += dt sum S v_i'); the particles' bins are stale afterwards.
+/// (x += dt sum S v_i'), in parallel over particle chunks (USF); the particles' bins are
+/// stale afterwards.
 pub fn run<D: Dim>(world: &mut World<D>) {
     let dt = world.settings.dt;
     let shape = world.settings.shape;
     let grid = &world.grid;
-    let geom = &grid.geom;
     let stencils = &world.tiles.stencils;
     let fields = world.cracks.as_ref().map(|c| &c.fields);
     let track = fields.is_some();
+    let nodal = (&grid.accel[..], &grid.velocity[..]);
     let Particles { x, v, u, .. } = &mut world.particles;
-    // Largest squared velocity moving a particle, when cracks need the bound on drift.
     let fastest = (
         x.par_chunks_mut(CHUNK),
         v.par_chunks_mut(CHUNK),
@@ -31,26 +34,8 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             with_nodes!(shape, N => for k in 0..x.len() {
                 let i = c * CHUNK + k;
                 let st = Stencil::<N>::cached::<D>(stencils, i);
-                let (mut dv, mut vn) = (D::zero(), D::zero());
-                match fields.and_then(|f| f.targets_of(i)) {
-                    // Near a crack: each node's entry for this particle's field.
-                    Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, w, _| {
-                        dv += grid.accel[n] * w;
-                        vn += grid.velocity[n] * w;
-                    }),
-                    None => st.for_each_row::<D>(&geom.stride, |row, q, _| {
-                        let (mut da, mut dn) = (D::zero(), D::zero());
-                        // One bounds check per row and column: each slice has N nodes.
-                        let (acc, vel) = (&grid.accel[row..row + N], &grid.velocity[row..row + N]);
-                        for a in 0..N {
-                            let w = st.w[0][a];
-                            da += acc[a] * w;
-                            dn += vel[a] * w;
-                        }
-                        dv += da * q;
-                        vn += dn * q;
-                    }),
-                }
+                let targets = fields.and_then(|f| f.targets_of(i));
+                let (dv, vn) = gather::<D, N>(&st, targets, nodal, &grid.geom.stride);
                 v[k] += dv * dt;
                 x[k] += vn * dt;
                 u[k] += vn * dt;
@@ -61,8 +46,116 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             fastest
         })
         .reduce(|| 0.0, f64::max);
+    finish(world, fastest);
+}
+
+/// As [`run`], then each particle's updated momentum m v is scattered back to the zeroed
+/// grid momenta with the start-of-step shape functions (USL and USAVG), in one pass over
+/// the tiles in colour classes. The final stress update then reads grid velocities that
+/// are mass-weighted averages of particle velocities (the modified USL of Sulsky, Zhou &
+/// Schreyer 1995); without this remap, nodes with a tiny share of mass get huge velocities
+/// and linear shape functions go unstable. The nodal masses stay those of `p2g`.
+pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
+    let dt = world.settings.dt;
+    let shape = world.settings.shape;
+    let grid = &mut world.grid;
+    grid.momentum.par_iter_mut().for_each(|m| *m = D::zero());
+    let Grid {
+        geom,
+        mass,
+        momentum,
+        force,
+        velocity,
+        accel,
+    } = grid;
+    let nodal = (&accel[..], &velocity[..]);
+    let tiles = &world.tiles;
+    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let track = fields.is_some();
+    let p = &mut world.particles;
+    let pmass = &p.mass;
+    let (x_w, v_w, u_w, momentum_w) = (
+        Disjoint::new(&mut p.x),
+        Disjoint::new(&mut p.v),
+        Disjoint::new(&mut p.u),
+        Disjoint::new(momentum),
+    );
+    let stride = &geom.stride;
+    let fastest = tiles.max_coloured(|t| {
+        let mut fastest = 0.0f64;
+        with_nodes!(shape, N => for &i in tiles.particles(t) {
+            let i = i as usize;
+            let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
+            let targets = fields.and_then(|f| f.targets_of(i));
+            let (dv, vn) = gather::<D, N>(&st, targets, nodal, stride);
+            // SAFETY: every particle is in exactly one tile and each tile is handled by one
+            // thread, so no other thread touches particle i's entries; tiles of one colour
+            // class touch disjoint nodes (tiles.rs).
+            unsafe {
+                let v = v_w.get(i) + dv * dt;
+                v_w.set(i, v);
+                x_w.set(i, x_w.get(i) + vn * dt);
+                u_w.set(i, u_w.get(i) + vn * dt);
+                // Particles near a crack are scattered field by field afterwards.
+                if targets.is_none() {
+                    let mv = v * pmass[i];
+                    st.for_each_row::<D>(stride, |row, q, _| {
+                        let mvq = mv * q;
+                        for a in 0..N {
+                            momentum_w.add(row + a, mvq * st.w[0][a]);
+                        }
+                    });
+                }
+            }
+            if track {
+                fastest = fastest.max(D::dot(vn, vn));
+            }
+        });
+        fastest
+    });
+    if let Some(f) = fields {
+        let columns = (&mut mass[..], &mut momentum[..], &mut force[..]);
+        scatter_coded::<D, false, true, false>(f, p, shape, &tiles.stencils, columns, geom);
+    }
+    finish(world, fastest);
+}
+
+/// The velocity change per unit time and the velocity moving one particle: the stencil's
+/// sums of a_i S and v_i' S, near a crack over its own field's entries.
+#[inline(always)]
+fn gather<D: Dim, const N: usize>(
+    st: &Stencil<N>,
+    targets: Option<&[u32]>,
+    (accel, velocity): (&[D::Vec], &[D::Vec]),
+    stride: &[usize; 3],
+) -> (D::Vec, D::Vec) {
+    let (mut dv, mut vn) = (D::zero(), D::zero());
+    match targets {
+        Some(t) => st.for_each_target::<D>(stride, t, |n, w, _| {
+            dv += accel[n] * w;
+            vn += velocity[n] * w;
+        }),
+        None => st.for_each_row::<D>(stride, |row, q, _| {
+            let (mut da, mut dn) = (D::zero(), D::zero());
+            // One bounds check per row and column: each slice has N nodes.
+            let (acc, vel) = (&accel[row..row + N], &velocity[row..row + N]);
+            for a in 0..N {
+                let w = st.w[0][a];
+                da += acc[a] * w;
+                dn += vel[a] * w;
+            }
+            dv += da * q;
+            vn += dn * q;
+        }),
+    }
+    (dv, vn)
+}
+
+/// After the particles moved: the crack record's drift (when cracks need the bound; the
+/// largest squared velocity is `fastest`), stale bins, the load work.
+fn finish<D: Dim>(world: &mut World<D>, fastest: f64) {
     if let Some(c) = world.cracks.as_mut() {
-        c.classified.drift += fastest.sqrt() * dt;
+        c.classified.drift += fastest.sqrt() * world.settings.dt;
     }
     world.tiles.fresh = false;
     load_work_end(world);

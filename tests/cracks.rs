@@ -131,12 +131,10 @@ fn crack_systems_only_in_scenes_with_cracks() {
             "bin",
             "classify",
             "p2g",
-            "stress",
-            "internal_force",
+            "stress_force",
             "grid_update",
-            "g2p",
+            "g2p_remap",
             "crack_advect",
-            "remap",
             "stress"
         ]
     );

@@ -23,14 +23,7 @@ fn names(extra: &str, update: &str) -> Vec<&'static str> {
 fn usf_without_boundaries_has_no_remap_and_no_grid_bc() {
     assert_eq!(
         names("", "usf"),
-        [
-            "bin",
-            "p2g",
-            "stress",
-            "internal_force",
-            "grid_update",
-            "g2p"
-        ]
+        ["bin", "p2g", "stress_force", "grid_update", "g2p"]
     );
 }
 
@@ -38,7 +31,7 @@ fn usf_without_boundaries_has_no_remap_and_no_grid_bc() {
 fn usl_remaps_before_its_stress_update() {
     assert_eq!(
         names("", "usl"),
-        ["bin", "p2g", "grid_update", "g2p", "remap", "stress"]
+        ["bin", "p2g", "grid_update", "g2p_remap", "stress"]
     );
 }
 
@@ -51,11 +44,9 @@ fn boundaries_add_grid_bc_after_each_momentum_scatter() {
             "bin",
             "p2g",
             "grid_bc",
-            "stress",
-            "internal_force",
+            "stress_force",
             "grid_update",
-            "g2p",
-            "remap",
+            "g2p_remap",
             "grid_bc",
             "stress"
         ]

@@ -1,0 +1,70 @@
+//! Shared write access to a column whose entries are partitioned between threads.
+//!
+//! The tile schedule guarantees the partition: tiles of one colour class never share a
+//! node, and every particle sits in exactly one tile, each tile handled by one thread. The
+//! scatter systems use this to write grid and particle columns from several threads
+//! without atomics or locks, in a fixed order.
+
+use std::marker::PhantomData;
+use std::ops::AddAssign;
+
+/// A column borrowed for writes at indices that no two threads touch at once.
+pub struct Disjoint<'a, T> {
+    ptr: *mut T,
+    len: usize,
+    _borrow: PhantomData<&'a mut [T]>,
+}
+
+// SAFETY: entries are only reached through the unsafe accessors, whose contract requires
+// that no two threads access one index at once; the column is exclusively borrowed for the
+// writer's lifetime.
+unsafe impl<T: Send> Sync for Disjoint<'_, T> {}
+// SAFETY: as for Sync; the pointer refers to a column that outlives the writer.
+unsafe impl<T: Send> Send for Disjoint<'_, T> {}
+
+impl<'a, T: Copy> Disjoint<'a, T> {
+    /// Borrows `column` for disjoint writes.
+    pub fn new(column: &'a mut [T]) -> Self {
+        Disjoint {
+            ptr: column.as_mut_ptr(),
+            len: column.len(),
+            _borrow: PhantomData,
+        }
+    }
+
+    /// Entry `i`.
+    ///
+    /// # Safety
+    /// No other thread may write entry `i` during the call.
+    #[inline(always)]
+    pub unsafe fn get(&self, i: usize) -> T {
+        assert!(i < self.len);
+        // SAFETY: i is in bounds (checked above); the caller guarantees no concurrent write.
+        unsafe { *self.ptr.add(i) }
+    }
+
+    /// Overwrites entry `i`.
+    ///
+    /// # Safety
+    /// No other thread may access entry `i` during the call.
+    #[inline(always)]
+    pub unsafe fn set(&self, i: usize, value: T) {
+        assert!(i < self.len);
+        // SAFETY: i is in bounds (checked above); the caller guarantees exclusive access.
+        unsafe { *self.ptr.add(i) = value };
+    }
+
+    /// Adds `value` to entry `i`.
+    ///
+    /// # Safety
+    /// No other thread may access entry `i` during the call.
+    #[inline(always)]
+    pub unsafe fn add(&self, i: usize, value: T)
+    where
+        T: AddAssign,
+    {
+        assert!(i < self.len);
+        // SAFETY: i is in bounds (checked above); the caller guarantees exclusive access.
+        unsafe { *self.ptr.add(i) += value };
+    }
+}
