@@ -3,7 +3,8 @@
 //! `cargo bench --bench systems` (all cores) or `RAYON_NUM_THREADS=1 cargo bench --bench
 //! systems` (one thread). USAVG unless the label says otherwise. Scenes: a block filling
 //! the grid at 2 particles per cell per axis, 2D 256 x 256 cells (262,144 particles), 3D
-//! 40 x 40 x 40 cells (512,000 particles).
+//! 40 x 40 x 40 cells (512,000 particles); the `-16k` and `-27k` scenes (2D 64 x 64, 3D
+//! 15 x 15 x 15 cells) fit in the caches, as the validation scenarios do.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use fissure::dim::{D2, D3, Dim};
@@ -12,8 +13,8 @@ use fissure::schedule::Schedule;
 use fissure::systems::{bin, g2p, grid_update, p2g, stress};
 use std::time::Duration;
 
-fn scene_text(dim: usize, shape: &str, update: &str) -> String {
-    let (n, h) = if dim == 2 { (256, 1e-3) } else { (40, 1e-3) };
+fn scene_text(dim: usize, n: usize, shape: &str, update: &str) -> String {
+    let h = 1e-3;
     let v = |x: f64| vec![format!("{x}"); dim].join(", ");
     let len = n as f64 * h;
     format!(
@@ -46,8 +47,8 @@ velocity = [{vel}]
     )
 }
 
-fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, shape: &str, update: &str) {
-    let text = scene_text(D::D, shape, update);
+fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, n: usize, shape: &str, update: &str) {
+    let text = scene_text(D::D, n, shape, update);
     let src = Source::parse(label, &text, &[]).expect("bench scene parses");
     let mut world = build::<D>(&src).expect("bench scene builds").world;
     let mut schedule = Schedule::for_world(&world);
@@ -72,18 +73,25 @@ fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, shape: &str, update: &str
     g.bench_function("stress_force", |b| {
         b.iter(|| stress::run_with_force(&mut world, 1.0))
     });
+    // As the launcher does, the step runs inside the pool, so its parallel loops are not
+    // each handed over from an outside thread.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .build()
+        .expect("thread pool");
     g.bench_function("step", |b| {
-        b.iter(|| schedule.step(&mut world).expect("stable"))
+        b.iter(|| pool.install(|| schedule.step(&mut world).expect("stable")))
     });
     g.finish();
 }
 
 fn systems(c: &mut Criterion) {
-    bench_scene::<D2>(c, "2d-linear", "linear", "usavg");
-    bench_scene::<D2>(c, "2d-linear-usl", "linear", "usl");
-    bench_scene::<D2>(c, "2d-ugimp", "ugimp", "usavg");
-    bench_scene::<D3>(c, "3d-ugimp", "ugimp", "usavg");
-    bench_scene::<D3>(c, "3d-bspline", "bspline", "usavg");
+    bench_scene::<D2>(c, "2d-linear", 256, "linear", "usavg");
+    bench_scene::<D2>(c, "2d-linear-16k", 64, "linear", "usavg");
+    bench_scene::<D2>(c, "2d-linear-usl", 256, "linear", "usl");
+    bench_scene::<D2>(c, "2d-ugimp", 256, "ugimp", "usavg");
+    bench_scene::<D3>(c, "3d-ugimp", 40, "ugimp", "usavg");
+    bench_scene::<D3>(c, "3d-ugimp-27k", 15, "ugimp", "usavg");
+    bench_scene::<D3>(c, "3d-bspline", 40, "bspline", "usavg");
 }
 
 criterion_group!(benches, systems);

@@ -4,9 +4,6 @@
 //! [`Stencil`] of at most 3 nodes per axis.
 
 use crate::dim::Dim;
-use crate::grid::GridGeom;
-use crate::world::CHUNK;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Which shape function maps particles to the grid.
@@ -180,37 +177,16 @@ pub struct StencilCache {
 }
 
 impl StencilCache {
-    /// Evaluates the stencils of particles at `x` with half-widths `half` (empty unless uGIMP).
-    pub fn fill<D: Dim>(
-        &mut self,
-        shape: ShapeKind,
-        geom: &GridGeom<D>,
-        x: &[D::Vec],
-        half: &[D::Vec],
-    ) {
-        let per = 6 * D::D;
-        self.base.resize(x.len(), [0; 3]);
-        self.weights.resize(x.len() * per, 0.0);
-        (
-            self.base.par_chunks_mut(CHUNK),
-            self.weights.par_chunks_mut(CHUNK * per),
-        )
-            .into_par_iter()
-            .enumerate()
-            .for_each(|(c, (base, weights))| {
-                for k in 0..base.len() {
-                    let i = c * CHUNK + k;
-                    let hw = if half.is_empty() { D::zero() } else { half[i] };
-                    for a in 0..D::D {
-                        let xi = (x[i][a] - geom.origin[a]) * geom.inv_h[a];
-                        let (b, w, dw) = shape.axis(xi, hw[a] * geom.inv_h[a], geom.inv_h[a]);
-                        base[k][a] = b as u32;
-                        let out = &mut weights[k * per + 6 * a..k * per + 6 * a + 6];
-                        out[..3].copy_from_slice(&w);
-                        out[3..].copy_from_slice(&dw);
-                    }
-                }
-            });
+    /// Cached values per particle: three weights and three derivatives per axis.
+    pub fn per<D: Dim>() -> usize {
+        6 * D::D
+    }
+
+    /// Sizes the cache for `n` particles and lends its columns for `bin` to fill.
+    pub fn resize<D: Dim>(&mut self, n: usize) -> (&mut [[u32; 3]], &mut [f64]) {
+        self.base.resize(n, [0; 3]);
+        self.weights.resize(n * Self::per::<D>(), 0.0);
+        (&mut self.base, &mut self.weights)
     }
 }
 
@@ -218,7 +194,7 @@ impl<const N: usize> Stencil<N> {
     /// The cached stencil of particle `i`.
     #[inline(always)]
     pub fn cached<D: Dim>(cache: &StencilCache, i: usize) -> Self {
-        let per = 6 * D::D;
+        let per = StencilCache::per::<D>();
         let b = cache.base[i];
         let mut st = Stencil {
             base: [b[0] as usize, b[1] as usize, b[2] as usize],

@@ -3,11 +3,13 @@
 
 use crate::dim::Dim;
 use crate::error::Unstable;
+use crate::shape::StencilCache;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
-/// Bins every particle by the tile of the cell that contains it. Nothing to do when the
-/// particles have not moved since the last binning; no re-sort when none changed tile.
+/// Bins every particle by the tile of the cell that contains it and evaluates its stencil,
+/// in one pass over the positions. Nothing to do when the particles have not moved since
+/// the last binning; no re-sort when none changed tile.
 pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
     if world.tiles.fresh {
         return Ok(());
@@ -19,26 +21,40 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
     let mut tile_of = std::mem::take(&mut tiles.tile_of);
     let sorted = tile_of.len() == p.len();
     tile_of.resize(p.len(), u32::MAX);
-    let tiles_ref = &*tiles;
-    // Per chunk: the first particle outside the grid, and whether any particle changed tile.
-    let chunks: Vec<(Option<usize>, bool)> = tile_of
-        .par_chunks_mut(CHUNK)
+    let per = StencilCache::per::<D>();
+    let cell_part = &tiles.cell_part;
+    let (base, weights) = tiles.stencils.resize::<D>(p.len());
+    // Per chunk: the first particle whose stencil leaves the grid, and whether any particle
+    // changed tile.
+    let chunks: Vec<(Option<usize>, bool)> = (
+        tile_of.par_chunks_mut(CHUNK),
+        base.par_chunks_mut(CHUNK),
+        weights.par_chunks_mut(CHUNK * per),
+    )
+        .into_par_iter()
         .enumerate()
-        .map(|(c, out)| {
+        .map(|(c, (out, base, weights))| {
             let mut moved = false;
-            for (k, t) in out.iter_mut().enumerate() {
+            let rows = base.iter_mut().zip(weights.chunks_exact_mut(per));
+            for (k, (t, (b, w))) in out.iter_mut().zip(rows).enumerate() {
                 let i = c * CHUNK + k;
-                let x = p.x[i];
-                if !geom.fits(shape, x, p.half_of(i)) {
-                    return (Some(i), true);
-                }
-                let mut cell = [0; 3];
+                let (x, half) = (p.x[i], p.half_of(i));
+                let mut tile = 0;
                 for a in 0..D::D {
-                    cell[a] = ((x[a] - geom.origin[a]) * geom.inv_h[a]) as usize;
+                    let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
+                    let l = half[a] * geom.inv_h[a];
+                    // Also false for a non-finite position.
+                    if !shape.fits(xi, l, geom.cells[a]) {
+                        return (Some(i), true);
+                    }
+                    tile += cell_part[a][xi as usize];
+                    let (first, sw, sdw) = shape.axis(xi, l, geom.inv_h[a]);
+                    b[a] = first as u32;
+                    w[6 * a..6 * a + 3].copy_from_slice(&sw);
+                    w[6 * a + 3..6 * a + 6].copy_from_slice(&sdw);
                 }
-                let new = tiles_ref.tile_of_cell(cell);
-                moved |= new != *t;
-                *t = new;
+                moved |= tile != *t;
+                *t = tile;
             }
             (None, moved)
         })
@@ -66,7 +82,6 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
     if moved || !sorted {
         tiles.sort();
     }
-    tiles.stencils.fill(shape, geom, &p.x, &p.half);
     tiles.fresh = true;
     Ok(())
 }
