@@ -70,8 +70,8 @@ fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, n: usize, shape: &str, up
     g.bench_function("g2p_remap", |b| b.iter(|| g2p::run_with_remap(&mut world)));
     bin::run(&mut world).expect("in grid");
     g.bench_function("stress", |b| b.iter(|| stress::run(&mut world, 1.0)));
-    g.bench_function("stress_force", |b| {
-        b.iter(|| stress::run_with_force(&mut world, 1.0))
+    g.bench_function("internal_force", |b| {
+        b.iter(|| p2g::internal_force(&mut world))
     });
     // As the launcher does, the step runs inside the pool, so its parallel loops are not
     // each handed over from an outside thread.

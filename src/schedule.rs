@@ -35,12 +35,8 @@ pub enum System {
         /// Fraction of the step.
         fraction: f64,
     },
-    /// Constitutive update as `Stress`, then scatter of the internal force from the new
-    /// stress, in one pass (USF and USAVG).
-    StressForce {
-        /// Fraction of the step.
-        fraction: f64,
-    },
+    /// Scatter the internal force alone.
+    InternalForce,
     /// Integrate nodal momenta, apply damping, gravity and prescribed velocities.
     GridUpdate,
     /// Gather to particles: velocities, positions, displacements (USF).
@@ -61,7 +57,7 @@ impl System {
             System::P2g { .. } => "p2g",
             System::MomentumBc { .. } => "grid_bc",
             System::Stress { .. } => "stress",
-            System::StressForce { .. } => "stress_force",
+            System::InternalForce => "internal_force",
             System::GridUpdate => "grid_update",
             System::G2p => "g2p",
             System::G2pRemap => "g2p_remap",
@@ -109,7 +105,7 @@ impl Schedule {
         }
         if update != Update::Usl {
             let fraction = if update == Update::Usf { 1.0 } else { 0.5 };
-            s.push(StressForce { fraction });
+            s.extend([Stress { fraction }, InternalForce]);
         }
         s.push(GridUpdate);
         if contact {
@@ -145,7 +141,7 @@ impl Schedule {
                 System::P2g { internal } => p2g::run(world, internal),
                 System::MomentumBc { end } => grid_update::momentum_bc(world, end),
                 System::Stress { fraction } => stress::run(world, fraction),
-                System::StressForce { fraction } => stress::run_with_force(world, fraction),
+                System::InternalForce => p2g::internal_force(world),
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),

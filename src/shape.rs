@@ -154,15 +154,31 @@ impl<const N: usize> Stencil<N> {
     /// loops factor their per-row work out of the per-node work this way.
     #[inline(always)]
     pub fn for_each_row<D: Dim>(&self, stride: &[usize; 3], mut f: impl FnMut(usize, f64, D::Vec)) {
-        let nk = if D::D == 3 { N } else { 1 };
-        for k in 0..nk {
-            for j in 0..N {
-                let row =
-                    self.base[0] + stride[1] * (self.base[1] + j) + stride[2] * (self.base[2] + k);
-                let (w1, w2) = (self.w[1][j], self.w[2][k]);
-                f(row, w1 * w2, D::yz(self.dw[1][j] * w2, w1 * self.dw[2][k]));
-            }
+        for r in 0..Self::rows::<D>() {
+            let (row, q, gyz) = self.row::<D>(stride, r);
+            f(row, q, gyz);
         }
+    }
+
+    /// Number of rows of `N` nodes along x: `N` in 2D, `N * N` in 3D.
+    #[inline(always)]
+    pub fn rows<D: Dim>() -> usize {
+        if D::D == 3 { N * N } else { N }
+    }
+
+    /// Row `r` as [`for_each_row`](Self::for_each_row) passes it: (first node, q, g_yz).
+    /// Loops over `0..rows()` calling this compile to straight code where a closure called
+    /// from many unrolled sites may be left out of line (found in 3D uGIMP).
+    #[inline(always)]
+    pub fn row<D: Dim>(&self, stride: &[usize; 3], r: usize) -> (usize, f64, D::Vec) {
+        let (j, k) = (r % N, r / N);
+        let first = self.base[0] + stride[1] * (self.base[1] + j) + stride[2] * (self.base[2] + k);
+        let (w1, w2) = (self.w[1][j], self.w[2][k]);
+        (
+            first,
+            w1 * w2,
+            D::yz(self.dw[1][j] * w2, w1 * self.dw[2][k]),
+        )
     }
 }
 

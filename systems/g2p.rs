@@ -99,12 +99,13 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
                 // Particles near a crack are scattered field by field afterwards.
                 if targets.is_none() {
                     let mv = v * pmass[i];
-                    st.for_each_row::<D>(stride, |row, q, _| {
+                    for r in 0..Stencil::<N>::rows::<D>() {
+                        let (row, q, _) = st.row::<D>(stride, r);
                         let mvq = mv * q;
                         for a in 0..N {
                             momentum_w.add(row + a, mvq * st.w[0][a]);
                         }
-                    });
+                    }
                 }
             }
             if track {
@@ -135,18 +136,21 @@ fn gather<D: Dim, const N: usize>(
             dv += accel[n] * w;
             vn += velocity[n] * w;
         }),
-        None => st.for_each_row::<D>(stride, |row, q, _| {
-            let (mut da, mut dn) = (D::zero(), D::zero());
-            // One bounds check per row and column: each slice has N nodes.
-            let (acc, vel) = (&accel[row..row + N], &velocity[row..row + N]);
-            for a in 0..N {
-                let w = st.w[0][a];
-                da += acc[a] * w;
-                dn += vel[a] * w;
+        None => {
+            for r in 0..Stencil::<N>::rows::<D>() {
+                let (row, q, _) = st.row::<D>(stride, r);
+                let (mut da, mut dn) = (D::zero(), D::zero());
+                // One bounds check per row and column: each slice has N nodes.
+                let (acc, vel) = (&accel[row..row + N], &velocity[row..row + N]);
+                for a in 0..N {
+                    let w = st.w[0][a];
+                    da += acc[a] * w;
+                    dn += vel[a] * w;
+                }
+                dv += da * q;
+                vn += dn * q;
             }
-            dv += da * q;
-            vn += dn * q;
-        }),
+        }
     }
     (dv, vn)
 }

@@ -24,6 +24,43 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
     scatter_loads(world);
 }
 
+/// Scatters the internal force -V sigma . grad S alone (USF and USAVG, after the first
+/// stress update), tile by tile in colour classes, onto the loads already in the force
+/// column.
+pub fn internal_force<D: Dim>(world: &mut World<D>) {
+    let Grid {
+        geom,
+        mass,
+        momentum,
+        force,
+        ..
+    } = &mut world.grid;
+    let force_w = Disjoint::new(force);
+    let p = &world.particles;
+    let shape = world.settings.shape;
+    let (geom, tiles) = (&*geom, &world.tiles);
+    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    tiles.for_each_coloured(|t| {
+        with_nodes!(shape, N => for &i in tiles.particles(t) {
+            let i = i as usize;
+            // Particles near a crack are scattered field by field afterwards.
+            if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+                continue;
+            }
+            let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
+            // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
+            // tile is handled by one thread.
+            unsafe {
+                add_internal_force::<D, N>(&st, &geom.stride, &p.stress[i], p.volume[i], &force_w)
+            };
+        })
+    });
+    if let Some(f) = fields {
+        let columns = (&mut mass[..], &mut momentum[..], &mut force[..]);
+        scatter_coded::<D, false, false, true>(f, p, shape, &tiles.stencils, columns, geom);
+    }
+}
+
 /// One scatter pass over the tiles, colour class by colour class (Guo & Nairn 2D (2004)
 /// Eqs. 3 and 6, single velocity field): mass and momentum (each zeroed first), and the
 /// internal force -V sigma . grad S when `FORCE` (a compile-time flag keeps the hot loop
@@ -82,12 +119,12 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
 }
 
 /// Adds particle `i`'s internal force -V sigma . grad S to its stencil's nodes (Guo & Nairn
-/// 2D (2004) Eq. 6), row by row as in [`Stencil::for_each_row`].
+/// 2D (2004) Eq. 6), row by row (see [`Stencil::for_each_row`]).
 ///
 /// # Safety
 /// No other thread may access the stencil's nodes of `force` during the call.
 #[inline(always)]
-pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
+unsafe fn add_internal_force<D: Dim, const N: usize>(
     st: &Stencil<N>,
     stride: &[usize; 3],
     s: &Sym3,
@@ -96,14 +133,15 @@ pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
 ) {
     let vol = -volume;
     let sx = D::stress_dot(s, D::unit_x()) * vol;
-    st.for_each_row::<D>(stride, |row, q, gyz| {
+    for r in 0..Stencil::<N>::rows::<D>() {
+        let (row, q, gyz) = st.row::<D>(stride, r);
         let sxq = sx * q;
         let syz = D::stress_dot(s, gyz) * vol;
         for a in 0..N {
             // SAFETY: the caller guarantees exclusive access to these nodes.
             unsafe { force.add(row + a, sxq * st.dw[0][a] + syz * st.w[0][a]) };
         }
-    });
+    }
 }
 
 /// The scatter of the particles near a crack, each pair into its field's grid entry

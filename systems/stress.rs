@@ -2,12 +2,9 @@
 //! from the grid velocities p/m, in parallel over particle chunks.
 
 use crate::dim::Dim;
-use crate::disjoint::Disjoint;
-use crate::grid::Grid;
 use crate::particles::Particles;
 use crate::shape::Stencil;
 use crate::sym::Sym3;
-use crate::systems::p2g::{add_internal_force, scatter_coded};
 use crate::with_nodes;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
@@ -62,64 +59,6 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     }
 }
 
-/// As [`run`], then each particle's internal force -V sigma . grad S from its new stress is
-/// scattered to the grid's force column (USF and USAVG), in one pass over the tiles in
-/// colour classes: the stencil is read once for both.
-pub fn run_with_force<D: Dim>(world: &mut World<D>, fraction: f64) {
-    node_velocities(world);
-    let dt = world.settings.dt * fraction;
-    let (shape, plane) = (world.settings.shape, world.settings.plane);
-    let Grid {
-        geom,
-        mass,
-        momentum,
-        force,
-        velocity,
-        ..
-    } = &mut world.grid;
-    let (geom, velocity) = (&*geom, &*velocity);
-    let materials = &world.materials;
-    let tiles = &world.tiles;
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
-    let p = &mut world.particles;
-    let track = !p.grad_u.is_empty();
-    let (material, volume) = (&p.material, &p.volume);
-    let (gv_w, s_w, gu_w, force_w) = (
-        Disjoint::new(&mut p.grad_v),
-        Disjoint::new(&mut p.stress),
-        Disjoint::new(&mut p.grad_u),
-        Disjoint::new(force),
-    );
-    tiles.for_each_coloured(|t| {
-        with_nodes!(shape, N => for &i in tiles.particles(t) {
-            let i = i as usize;
-            let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
-            let targets = fields.and_then(|f| f.targets_of(i));
-            let l = velocity_gradient::<D, N>(&st, targets, velocity, &geom.stride);
-            // SAFETY: every particle is in exactly one tile and each tile is handled by one
-            // thread, so no other thread touches particle i's entries; tiles of one colour
-            // class touch disjoint nodes (tiles.rs).
-            unsafe {
-                gv_w.set(i, l);
-                if track {
-                    gu_w.set(i, gu_w.get(i) + l * dt);
-                }
-                let mut s = s_w.get(i);
-                materials[material[i] as usize].update(plane, D::sym_part(&l) * dt, &mut s);
-                s_w.set(i, s);
-                // Particles near a crack are scattered field by field afterwards.
-                if targets.is_none() {
-                    add_internal_force::<D, N>(&st, &geom.stride, &s, volume[i], &force_w);
-                }
-            }
-        })
-    });
-    if let Some(f) = fields {
-        let columns = (&mut mass[..], &mut momentum[..], &mut force[..]);
-        scatter_coded::<D, false, false, true>(f, p, shape, &tiles.stencils, columns, geom);
-    }
-}
-
 /// grad v of one particle: sum over its stencil of v_i ⊗ grad S_i, row by row
 /// (sum_rows (sum_i v_i dw_i) ⊗ q x̂ + (sum_i v_i w_i) ⊗ g_yz); near a crack, over its own
 /// field's entries (Guo & Nairn 3D (2006) Eq. 20).
@@ -135,15 +74,18 @@ fn velocity_gradient<D: Dim, const N: usize>(
         Some(t) => st.for_each_target::<D>(stride, t, |n, _, g| {
             l = l + D::outer(velocity[n], g);
         }),
-        None => st.for_each_row::<D>(stride, |row, q, gyz| {
-            let (mut vd, mut vw) = (D::zero(), D::zero());
-            // One bounds check per row: the slice has N nodes.
-            for (a, &v) in velocity[row..row + N].iter().enumerate() {
-                vd += v * st.dw[0][a];
-                vw += v * st.w[0][a];
+        None => {
+            for r in 0..Stencil::<N>::rows::<D>() {
+                let (row, q, gyz) = st.row::<D>(stride, r);
+                let (mut vd, mut vw) = (D::zero(), D::zero());
+                // One bounds check per row: the slice has N nodes.
+                for (a, &v) in velocity[row..row + N].iter().enumerate() {
+                    vd += v * st.dw[0][a];
+                    vw += v * st.w[0][a];
+                }
+                l = l + D::outer(vd, D::unit_x() * q) + D::outer(vw, gyz);
             }
-            l = l + D::outer(vd, D::unit_x() * q) + D::outer(vw, gyz);
-        }),
+        }
     }
     l
 }

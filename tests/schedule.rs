@@ -23,7 +23,14 @@ fn names(extra: &str, update: &str) -> Vec<&'static str> {
 fn usf_without_boundaries_has_no_remap_and_no_grid_bc() {
     assert_eq!(
         names("", "usf"),
-        ["bin", "p2g", "stress_force", "grid_update", "g2p"]
+        [
+            "bin",
+            "p2g",
+            "stress",
+            "internal_force",
+            "grid_update",
+            "g2p"
+        ]
     );
 }
 
@@ -44,7 +51,8 @@ fn boundaries_add_grid_bc_after_each_momentum_scatter() {
             "bin",
             "p2g",
             "grid_bc",
-            "stress_force",
+            "stress",
+            "internal_force",
             "grid_update",
             "g2p_remap",
             "grid_bc",
