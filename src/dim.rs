@@ -55,6 +55,9 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     fn dot(a: Self::Vec, b: Self::Vec) -> f64;
     /// Outer product `a ⊗ b` (entry (i, j) = a_i b_j).
     fn outer(a: Self::Vec, b: Self::Vec) -> Self::Mat;
+    /// `l + a ⊗ (q x̂) + b ⊗ g_yz` for `g_yz` = (0, gy[, gz]): one stencil row's share of a
+    /// velocity gradient, without the products by the zero entries.
+    fn add_row(l: Self::Mat, a: Self::Vec, q: f64, b: Self::Vec, g_yz: Self::Vec) -> Self::Mat;
     /// Matrix entry (i, j).
     fn entry(m: &Self::Mat, i: usize, j: usize) -> f64;
     /// Symmetric part of a velocity gradient embedded in 3x3 (zz = yz = xz = 0 in 2D).
@@ -144,6 +147,10 @@ impl Dim for D2 {
     #[inline(always)]
     fn outer(a: DVec2, b: DVec2) -> DMat2 {
         DMat2::from_cols(a * b.x, a * b.y)
+    }
+    #[inline(always)]
+    fn add_row(l: DMat2, a: DVec2, q: f64, b: DVec2, g_yz: DVec2) -> DMat2 {
+        DMat2::from_cols(l.x_axis + a * q, l.y_axis + b * g_yz.y)
     }
     #[inline(always)]
     fn entry(m: &DMat2, i: usize, j: usize) -> f64 {
@@ -249,6 +256,14 @@ impl Dim for D3 {
     #[inline(always)]
     fn outer(a: DVec3, b: DVec3) -> DMat3 {
         DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+    }
+    #[inline(always)]
+    fn add_row(l: DMat3, a: DVec3, q: f64, b: DVec3, g_yz: DVec3) -> DMat3 {
+        DMat3::from_cols(
+            l.x_axis + a * q,
+            l.y_axis + b * g_yz.y,
+            l.z_axis + b * g_yz.z,
+        )
     }
     #[inline(always)]
     fn entry(m: &DMat3, i: usize, j: usize) -> f64 {

@@ -83,7 +83,7 @@ fn velocity_gradient<D: Dim, const N: usize>(
                     vd += v * st.dw[0][a];
                     vw += v * st.w[0][a];
                 }
-                l = l + D::outer(vd, D::unit_x() * q) + D::outer(vw, gyz);
+                l = D::add_row(l, vd, q, vw, gyz);
             }
         }
     }
