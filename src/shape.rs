@@ -60,14 +60,14 @@ impl ShapeKind {
             }
             ShapeKind::Ugimp => {
                 let base = (xi - l) as usize;
-                let mut w = [0.0; 3];
-                let mut dw = [0.0; 3];
-                for a in 0..3 {
-                    let (s, g) = gimp_1d(xi - (base + a) as f64, l);
-                    w[a] = s;
-                    dw[a] = g * inv_h;
-                }
-                (base, w, dw)
+                let r = xi - base as f64;
+                // The middle node by partition of unity (weights sum to 1, derivatives to 0).
+                let ((s0, g0), (s2, g2)) = (gimp_1d(r, l), gimp_1d(r - 2.0, l));
+                (
+                    base,
+                    [s0, 1.0 - s0 - s2, s2],
+                    [g0 * inv_h, -(g0 + g2) * inv_h, g2 * inv_h],
+                )
             }
             ShapeKind::Bspline => {
                 let base = (xi - 0.5) as usize;
