@@ -1,4 +1,5 @@
-//! `g2p`: grid-to-particle gather. FLIP velocity update, position and displacement update.
+//! `g2p`: grid-to-particle gather (FLIP velocity update, position and displacement update),
+//! and `g2p_remap`, the same followed by the momentum remap of USL and USAVG.
 
 use crate::dim::Dim;
 use crate::disjoint::Disjoint;
