@@ -3,7 +3,6 @@
 
 use crate::dim::Dim;
 use crate::disjoint::Disjoint;
-use crate::grid::Grid;
 use crate::particles::Particles;
 use crate::shape::Stencil;
 use crate::systems::p2g::scatter_coded;
@@ -61,15 +60,7 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
     let shape = world.settings.shape;
     let grid = &mut world.grid;
     grid.momentum.par_iter_mut().for_each(|m| *m = D::zero());
-    let Grid {
-        geom,
-        mass,
-        momentum,
-        force,
-        velocity,
-        accel,
-    } = grid;
-    let nodal = (&accel[..], &velocity[..]);
+    let nodal = (&grid.accel[..], &grid.velocity[..]);
     let tiles = &world.tiles;
     let fields = world.cracks.as_ref().map(|c| &c.fields);
     let track = fields.is_some();
@@ -79,9 +70,9 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
         Disjoint::new(&mut p.x),
         Disjoint::new(&mut p.v),
         Disjoint::new(&mut p.u),
-        Disjoint::new(momentum),
+        Disjoint::new(&mut grid.momentum),
     );
-    let stride = &geom.stride;
+    let stride = &grid.geom.stride;
     let fastest = tiles.max_coloured(|t| {
         let mut fastest = 0.0f64;
         with_nodes!(shape, N => for &i in tiles.particles(t) {
@@ -116,8 +107,7 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
         fastest
     });
     if let Some(f) = fields {
-        let columns = (&mut mass[..], &mut momentum[..], &mut force[..]);
-        scatter_coded::<D, false, true, false>(f, p, shape, &tiles.stencils, columns, geom);
+        scatter_coded::<D, false, true, false>(f, p, shape, &tiles.stencils, grid);
     }
     finish(world, fastest);
 }

@@ -4,7 +4,7 @@
 use crate::crack::Fields;
 use crate::dim::Dim;
 use crate::disjoint::Disjoint;
-use crate::grid::{Grid, GridGeom};
+use crate::grid::Grid;
 use crate::particles::Particles;
 use crate::shape::{ShapeKind, Stencil, StencilCache};
 use crate::sym::Sym3;
@@ -28,17 +28,11 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
 /// stress update), tile by tile in colour classes, onto the loads already in the force
 /// column.
 pub fn internal_force<D: Dim>(world: &mut World<D>) {
-    let Grid {
-        geom,
-        mass,
-        momentum,
-        force,
-        ..
-    } = &mut world.grid;
-    let force_w = Disjoint::new(force);
+    let grid = &mut world.grid;
+    let force_w = Disjoint::new(&mut grid.force);
     let p = &world.particles;
     let shape = world.settings.shape;
-    let (geom, tiles) = (&*geom, &world.tiles);
+    let (geom, tiles) = (&grid.geom, &world.tiles);
     let fields = world.cracks.as_ref().map(|c| &c.fields);
     tiles.for_each_coloured(|t| {
         with_nodes!(shape, N => for &i in tiles.particles(t) {
@@ -56,8 +50,7 @@ pub fn internal_force<D: Dim>(world: &mut World<D>) {
         })
     });
     if let Some(f) = fields {
-        let columns = (&mut mass[..], &mut momentum[..], &mut force[..]);
-        scatter_coded::<D, false, false, true>(f, p, shape, &tiles.stencils, columns, geom);
+        scatter_coded::<D, false, false, true>(f, p, shape, &tiles.stencils, grid);
     }
 }
 
@@ -66,23 +59,17 @@ pub fn internal_force<D: Dim>(world: &mut World<D>) {
 /// internal force -V sigma . grad S when `FORCE` (a compile-time flag keeps the hot loop
 /// free of branches).
 fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
-    let Grid {
-        geom,
-        mass,
-        momentum,
-        force,
-        ..
-    } = &mut world.grid;
-    mass.par_iter_mut().for_each(|m| *m = 0.0);
-    momentum.par_iter_mut().for_each(|m| *m = D::zero());
+    let grid = &mut world.grid;
+    grid.mass.par_iter_mut().for_each(|m| *m = 0.0);
+    grid.momentum.par_iter_mut().for_each(|m| *m = D::zero());
     let (mass_w, momentum_w, force_w) = (
-        Disjoint::new(mass),
-        Disjoint::new(momentum),
-        Disjoint::new(force),
+        Disjoint::new(&mut grid.mass),
+        Disjoint::new(&mut grid.momentum),
+        Disjoint::new(&mut grid.force),
     );
     let p = &world.particles;
     let shape = world.settings.shape;
-    let geom = &*geom;
+    let geom = &grid.geom;
     let fields = world.cracks.as_ref().map(|c| &c.fields);
     world.tiles.for_each_coloured(|t| {
         with_nodes!(shape, N => for &i in world.tiles.particles(t) {
@@ -112,14 +99,12 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
         })
     });
     if let Some(f) = fields {
-        let stencils = &world.tiles.stencils;
-        let columns = (&mut mass[..], &mut momentum[..], &mut force[..]);
-        scatter_coded::<D, true, true, FORCE>(f, p, shape, stencils, columns, geom);
+        scatter_coded::<D, true, true, FORCE>(f, p, shape, &world.tiles.stencils, grid);
     }
 }
 
 /// Adds particle `i`'s internal force -V sigma . grad S to its stencil's nodes (Guo & Nairn
-/// 2D (2004) Eq. 6), row by row (see [`Stencil::for_each_row`]).
+/// 2D (2004) Eq. 6), row by row (see [`Stencil::row`]).
 ///
 /// # Safety
 /// No other thread may access the stencil's nodes of `force` during the call.
@@ -151,9 +136,15 @@ pub(crate) fn scatter_coded<D: Dim, const MASS: bool, const MOMENTUM: bool, cons
     p: &Particles<D>,
     shape: ShapeKind,
     stencils: &StencilCache,
-    (mass, momentum, force): (&mut [f64], &mut [D::Vec], &mut [D::Vec]),
-    geom: &GridGeom<D>,
+    grid: &mut Grid<D>,
 ) {
+    let Grid {
+        geom,
+        mass,
+        momentum,
+        force,
+        ..
+    } = grid;
     for &i in &fields.coded {
         let i = i as usize;
         let targets = fields.targets_of(i).expect("coded particle");
