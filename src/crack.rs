@@ -101,6 +101,8 @@ pub struct Cracks<D: Dim> {
     pub fields: Fields,
     /// The last classification, reused while nothing moved far enough to change it.
     pub classified: Classified<D>,
+    /// The elements' neighbours, rebuilt by `classify` when the elements change.
+    pub links: Links,
     /// Mass-weighted nodal displacements m u of the crack fields' entries this step (for
     /// contact detection).
     pub disp: HashMap<usize, D::Vec>,
@@ -133,6 +135,9 @@ pub struct Fields {
     pub mask: Vec<u64>,
     /// Grid nodes (extra rows start here).
     pub nodes: usize,
+    /// Scratch of `classify`, per grid node: the first extra row found there while the
+    /// rows are collected (`u32::MAX` outside that).
+    pub head: Vec<u32>,
 }
 
 impl<D: Dim> Default for Cracks<D> {
@@ -146,6 +151,7 @@ impl<D: Dim> Default for Cracks<D> {
             cracks: Vec::new(),
             fields: Fields::default(),
             classified: Classified::default(),
+            links: Links::default(),
             disp: HashMap::new(),
             contact_dp: Vec::new(),
         }
@@ -178,6 +184,18 @@ pub struct Classified<D: Dim> {
     /// Crack-side mask of every stencil node of each watched particle (`Fields::per` each,
     /// zero weights included).
     pub masks: Vec<u64>,
+}
+
+/// Which crack elements share a boundary feature (a vertex in 2D), as `classify` needs it:
+/// it depends on the connectivity only, so it is kept from step to step (not part of a
+/// snapshot).
+#[derive(Clone, Debug, Default)]
+pub struct Links {
+    /// The elements the table was built for.
+    pub elems: Vec<[u32; 3]>,
+    /// Per element and feature, the one other element sharing that feature when a
+    /// crossing through it is parity-safe, else `u32::MAX` (none).
+    pub neighbour: Vec<[u32; 3]>,
 }
 
 impl<D: Dim> Default for Classified<D> {

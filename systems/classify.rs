@@ -55,7 +55,7 @@ struct Elements<'a, D: Dim> {
     widest: f64,
     /// Per element and boundary feature, the one other element sharing that feature when
     /// a crossing through it is parity-safe ([`Dim::SHARED_FEATURE_SAFE`]), else `NONE`.
-    neighbour: Vec<[u32; 3]>,
+    neighbour: &'a [[u32; 3]],
     /// Box of all the elements (None without elements).
     all: Option<Aabb<D>>,
 }
@@ -64,7 +64,12 @@ struct Elements<'a, D: Dim> {
 const NONE: u32 = u32::MAX;
 
 impl<'a, D: Dim> Elements<'a, D> {
-    fn new(x: &'a [D::Vec], elems: &'a [[u32; 3]], elem_crack: &'a [u16]) -> Self {
+    fn new(
+        x: &'a [D::Vec],
+        elems: &'a [[u32; 3]],
+        elem_crack: &'a [u16],
+        neighbour: &'a [[u32; 3]],
+    ) -> Self {
         let boxes: Vec<Aabb<D>> = elems
             .iter()
             .map(|e| {
@@ -89,26 +94,6 @@ impl<'a, D: Dim> Elements<'a, D> {
             .iter()
             .map(|b| b.1[axis] - b.0[axis])
             .fold(0.0, f64::max);
-        let mut neighbour = vec![[NONE; 3]; elems.len()];
-        if D::SHARED_FEATURE_SAFE {
-            let mut sharing: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
-            for (e, &el) in elems.iter().enumerate() {
-                for k in 0..D::FEATURES {
-                    let mut f = D::feature(el, k);
-                    f.sort_unstable();
-                    sharing.entry(f).or_default().push(e as u32);
-                }
-            }
-            for (e, &el) in elems.iter().enumerate() {
-                for (k, nb) in neighbour[e].iter_mut().enumerate().take(D::FEATURES) {
-                    let mut f = D::feature(el, k);
-                    f.sort_unstable();
-                    if let [a, b] = sharing[&f][..] {
-                        *nb = if a == e as u32 { b } else { a };
-                    }
-                }
-            }
-        }
         Elements {
             x,
             elems,
@@ -176,6 +161,33 @@ impl<'a, D: Dim> Elements<'a, D> {
         }
         mask
     }
+}
+
+/// Per element and boundary feature, the one other element sharing that feature when a
+/// crossing through it is parity-safe ([`Dim::SHARED_FEATURE_SAFE`]), else `NONE`. Depends
+/// on the elements' connectivity only, so `run` rebuilds it only when that changes.
+fn neighbours<D: Dim>(elems: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    let mut neighbour = vec![[NONE; 3]; elems.len()];
+    if D::SHARED_FEATURE_SAFE {
+        let mut sharing: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
+        for (e, &el) in elems.iter().enumerate() {
+            for k in 0..D::FEATURES {
+                let mut f = D::feature(el, k);
+                f.sort_unstable();
+                sharing.entry(f).or_default().push(e as u32);
+            }
+        }
+        for (e, &el) in elems.iter().enumerate() {
+            for (k, nb) in neighbour[e].iter_mut().enumerate().take(D::FEATURES) {
+                let mut f = D::feature(el, k);
+                f.sort_unstable();
+                if let [a, b] = sharing[&f][..] {
+                    *nb = if a == e as u32 { b } else { a };
+                }
+            }
+        }
+    }
+    neighbour
 }
 
 /// Scratch lists reused from particle to particle.
@@ -408,10 +420,12 @@ impl<D: Dim> Pass<'_, D> {
         let geom = self.geom;
         f.per = per;
         f.nodes = geom.node_count();
-        f.slot.clear();
+        // Only last step's coded particles have a slot to clear.
+        for &i in &f.coded {
+            f.slot[i as usize] = u32::MAX;
+        }
         f.slot.resize(particles, u32::MAX);
         f.coded.clear();
-        f.targets.clear();
         let mut local = vec![(0u32, 0u64); per];
         let mut pairs: Vec<(u32, u64)> = Vec::new();
         for (j, &i) in rec.watched.iter().enumerate() {
@@ -436,19 +450,43 @@ impl<D: Dim> Pass<'_, D> {
                 pairs.extend(local.iter().copied());
             }
         }
-        let mut rows: Vec<(u32, u64)> = pairs.iter().copied().filter(|p| p.1 != 0).collect();
-        rows.sort_unstable();
-        rows.dedup();
-        f.targets.extend(pairs.iter().map(|&(n, m)| {
-            if m == 0 {
-                n
-            } else {
-                let r = rows.binary_search(&(n, m)).expect("row of a recorded pair");
-                (f.nodes + r) as u32
-            }
-        }));
-        f.node = rows.iter().map(|r| r.0).collect();
-        f.mask = rows.iter().map(|r| r.1).collect();
+        // The distinct (node, mask) of the pairs with a mask, found through a chain per
+        // node, then numbered in increasing order.
+        f.head.resize(f.nodes, u32::MAX);
+        let mut rows: Vec<(u32, u64)> = Vec::new();
+        let mut next: Vec<u32> = Vec::new();
+        let row_of: Vec<u32> = (pairs.iter())
+            .map(|&(n, m)| {
+                if m == 0 {
+                    return u32::MAX;
+                }
+                let mut r = f.head[n as usize];
+                while r != u32::MAX && rows[r as usize].1 != m {
+                    r = next[r as usize];
+                }
+                if r == u32::MAX {
+                    r = rows.len() as u32;
+                    rows.push((n, m));
+                    next.push(f.head[n as usize]);
+                    f.head[n as usize] = r;
+                }
+                r
+            })
+            .collect();
+        let mut order: Vec<u32> = (0..rows.len() as u32).collect();
+        order.sort_unstable_by_key(|&r| rows[r as usize]);
+        let mut rank = vec![0u32; rows.len()];
+        for (k, &r) in order.iter().enumerate() {
+            rank[r as usize] = (f.nodes + k) as u32;
+            f.head[rows[r as usize].0 as usize] = u32::MAX;
+        }
+        f.targets.clear();
+        f.targets
+            .extend((pairs.iter().zip(&row_of)).map(|(&(n, _), &r)| {
+                if r == u32::MAX { n } else { rank[r as usize] }
+            }));
+        f.node = order.iter().map(|&r| rows[r as usize].0).collect();
+        f.mask = order.iter().map(|&r| rows[r as usize].1).collect();
         rows.len()
     }
 }
@@ -462,11 +500,16 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         elem_crack,
         fields,
         classified: rec,
+        links,
         ..
     }) = world.cracks.as_mut()
     else {
         return;
     };
+    if links.elems != *elems {
+        links.neighbour = neighbours::<D>(elems);
+        links.elems.clone_from(elems);
+    }
     let geom = &world.grid.geom;
     let tiles = &world.tiles;
     let h_min = (0..D::D).map(|k| geom.h[k]).fold(f64::INFINITY, f64::min);
@@ -474,7 +517,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         geom,
         shape: world.settings.shape,
         stencils: &tiles.stencils,
-        elements: Elements::<D>::new(x, elems, elem_crack),
+        elements: Elements::<D>::new(x, elems, elem_crack, &links.neighbour),
         skin: 0.25 * h_min,
         slack: 1e-6 * h_min,
     };
