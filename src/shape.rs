@@ -244,6 +244,28 @@ macro_rules! with_nodes {
     };
 }
 
+/// Evaluates `$body` with the const `$s` bound to the shape function, so the compiler
+/// specialises per-particle shape code (no match on the kind inside a particle loop).
+#[macro_export]
+macro_rules! with_shape {
+    ($shape:expr, $s:ident => $body:expr) => {
+        match $shape {
+            $crate::shape::ShapeKind::Linear => {
+                const $s: $crate::shape::ShapeKind = $crate::shape::ShapeKind::Linear;
+                $body
+            }
+            $crate::shape::ShapeKind::Ugimp => {
+                const $s: $crate::shape::ShapeKind = $crate::shape::ShapeKind::Ugimp;
+                $body
+            }
+            $crate::shape::ShapeKind::Bspline => {
+                const $s: $crate::shape::ShapeKind = $crate::shape::ShapeKind::Bspline;
+                $body
+            }
+        }
+    };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,6 +4,7 @@
 use crate::dim::Dim;
 use crate::error::Unstable;
 use crate::shape::StencilCache;
+use crate::with_shape;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
@@ -34,29 +35,31 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
         .into_par_iter()
         .enumerate()
         .map(|(c, (out, base, weights))| {
-            let mut moved = false;
-            let rows = base.iter_mut().zip(weights.chunks_exact_mut(per));
-            for (k, (t, (b, w))) in out.iter_mut().zip(rows).enumerate() {
-                let i = c * CHUNK + k;
-                let (x, half) = (p.x[i], p.half_of(i));
-                let mut tile = 0;
-                for a in 0..D::D {
-                    let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
-                    let l = half[a] * geom.inv_h[a];
-                    // Also false for a non-finite position.
-                    if !shape.fits(xi, l, geom.cells[a]) {
-                        return (Some(i), true);
+            with_shape!(shape, S => {
+                let mut moved = false;
+                let rows = base.iter_mut().zip(weights.chunks_exact_mut(per));
+                for (k, (t, (b, w))) in out.iter_mut().zip(rows).enumerate() {
+                    let i = c * CHUNK + k;
+                    let (x, half) = (p.x[i], p.half_of(i));
+                    let mut tile = 0;
+                    for a in 0..D::D {
+                        let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
+                        let l = half[a] * geom.inv_h[a];
+                        // Also false for a non-finite position.
+                        if !S.fits(xi, l, geom.cells[a]) {
+                            return (Some(i), true);
+                        }
+                        tile += cell_part[a][xi as usize];
+                        let (first, sw, sdw) = S.axis(xi, l, geom.inv_h[a]);
+                        b[a] = first as u32;
+                        w[6 * a..6 * a + 3].copy_from_slice(&sw);
+                        w[6 * a + 3..6 * a + 6].copy_from_slice(&sdw);
                     }
-                    tile += cell_part[a][xi as usize];
-                    let (first, sw, sdw) = shape.axis(xi, l, geom.inv_h[a]);
-                    b[a] = first as u32;
-                    w[6 * a..6 * a + 3].copy_from_slice(&sw);
-                    w[6 * a + 3..6 * a + 6].copy_from_slice(&sdw);
+                    moved |= tile != *t;
+                    *t = tile;
                 }
-                moved |= tile != *t;
-                *t = tile;
-            }
-            (None, moved)
+                (None, moved)
+            })
         })
         .collect();
     tiles.tile_of = tile_of;
