@@ -54,17 +54,21 @@ impl<'a, T: Copy> Disjoint<'a, T> {
         unsafe { *self.ptr.add(i) = value };
     }
 
-    /// Adds `value` to entry `i`.
+    /// Adds `values[a]` to entry `start + a` for every `a`: one bounds check for the run
+    /// (a stencil row's nodes are consecutive entries).
     ///
     /// # Safety
-    /// No other thread may access entry `i` during the call.
+    /// No other thread may access entries `start..start + N` during the call.
     #[inline(always)]
-    pub unsafe fn add(&self, i: usize, value: T)
+    pub unsafe fn add_run<const N: usize>(&self, start: usize, values: [T; N])
     where
         T: AddAssign,
     {
-        assert!(i < self.len);
-        // SAFETY: i is in bounds (checked above); the caller guarantees exclusive access.
-        unsafe { *self.ptr.add(i) += value };
+        assert!(start < self.len && N <= self.len - start);
+        for (a, v) in values.into_iter().enumerate() {
+            // SAFETY: start + a < start + N <= len (checked above); the caller guarantees
+            // exclusive access.
+            unsafe { *self.ptr.add(start + a) += v };
+        }
     }
 }

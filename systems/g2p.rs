@@ -33,9 +33,12 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             let mut fastest = 0.0f64;
             with_nodes!(shape, N => for k in 0..x.len() {
                 let i = c * CHUNK + k;
+                // Particles near a crack move afterwards.
+                if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+                    continue;
+                }
                 let st = Stencil::<N>::cached::<D>(stencils, i);
-                let targets = fields.and_then(|f| f.targets_of(i));
-                let (dv, vn) = gather::<D, N>(&st, targets, nodal, &grid.geom.stride);
+                let (dv, vn) = gather::<D, N>(&st, nodal, &grid.geom.stride);
                 v[k] += dv * dt;
                 x[k] += vn * dt;
                 u[k] += vn * dt;
@@ -46,6 +49,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             fastest
         })
         .reduce(|| 0.0, f64::max);
+    let fastest = fastest.max(move_coded(world));
     finish(world, fastest);
 }
 
@@ -77,9 +81,12 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
         let mut fastest = 0.0f64;
         with_nodes!(shape, N => for &i in tiles.particles(t) {
             let i = i as usize;
+            // Particles near a crack move, and are scattered field by field, afterwards.
+            if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+                continue;
+            }
             let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
-            let targets = fields.and_then(|f| f.targets_of(i));
-            let (dv, vn) = gather::<D, N>(&st, targets, nodal, stride);
+            let (dv, vn) = gather::<D, N>(&st, nodal, stride);
             // SAFETY: every particle is in exactly one tile and each tile is handled by one
             // thread, so no other thread touches particle i's entries; tiles of one colour
             // class touch disjoint nodes (tiles.rs).
@@ -88,16 +95,11 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
                 v_w.set(i, v);
                 x_w.set(i, x_w.get(i) + vn * dt);
                 u_w.set(i, u_w.get(i) + vn * dt);
-                // Particles near a crack are scattered field by field afterwards.
-                if targets.is_none() {
-                    let mv = v * pmass[i];
-                    for r in 0..Stencil::<N>::rows::<D>() {
-                        let (row, q, _) = st.row::<D>(stride, r);
-                        let mvq = mv * q;
-                        for a in 0..N {
-                            momentum_w.add(row + a, mvq * st.w[0][a]);
-                        }
-                    }
+                let mv = v * pmass[i];
+                for r in 0..Stencil::<N>::rows::<D>() {
+                    let (row, q, _) = st.row::<D>(stride, r);
+                    let mvq = mv * q;
+                    momentum_w.add_run(row, std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a]));
                 }
             }
             if track {
@@ -106,44 +108,72 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
         });
         fastest
     });
-    if let Some(f) = fields {
-        scatter_coded::<D, false, true, false>(f, p, shape, &tiles.stencils, grid);
+    let fastest = fastest.max(move_coded(world));
+    if let Some(c) = world.cracks.as_ref() {
+        let p = &world.particles;
+        scatter_coded::<D, false, true, false>(
+            &c.fields,
+            p,
+            shape,
+            &world.tiles.stencils,
+            &mut world.grid,
+        );
     }
     finish(world, fastest);
 }
 
-/// The velocity change per unit time and the velocity moving one particle: the stencil's
-/// sums of a_i S and v_i' S, near a crack over its own field's entries.
+/// The velocity change per unit time and the velocity moving one particle away from
+/// cracks: the stencil's sums of a_i S and v_i' S, row by row.
 #[inline(always)]
 fn gather<D: Dim, const N: usize>(
     st: &Stencil<N>,
-    targets: Option<&[u32]>,
     (accel, velocity): (&[D::Vec], &[D::Vec]),
     stride: &[usize; 3],
 ) -> (D::Vec, D::Vec) {
     let (mut dv, mut vn) = (D::zero(), D::zero());
-    match targets {
-        Some(t) => st.for_each_target::<D>(stride, t, |n, w, _| {
-            dv += accel[n] * w;
-            vn += velocity[n] * w;
-        }),
-        None => {
-            for r in 0..Stencil::<N>::rows::<D>() {
-                let (row, q, _) = st.row::<D>(stride, r);
-                let (mut da, mut dn) = (D::zero(), D::zero());
-                // One bounds check per row and column: each slice has N nodes.
-                let (acc, vel) = (&accel[row..row + N], &velocity[row..row + N]);
-                for a in 0..N {
-                    let w = st.w[0][a];
-                    da += acc[a] * w;
-                    dn += vel[a] * w;
-                }
-                dv += da * q;
-                vn += dn * q;
-            }
+    for r in 0..Stencil::<N>::rows::<D>() {
+        let (row, q, _) = st.row::<D>(stride, r);
+        let (mut da, mut dn) = (D::zero(), D::zero());
+        // One bounds check per row and column: each slice has N nodes.
+        let (acc, vel) = (&accel[row..row + N], &velocity[row..row + N]);
+        for a in 0..N {
+            let w = st.w[0][a];
+            da += acc[a] * w;
+            dn += vel[a] * w;
         }
+        dv += da * q;
+        vn += dn * q;
     }
     (dv, vn)
+}
+
+/// Moves the particles near a crack, each from its own field's entries (v += dt sum S a_i,
+/// x and u += dt sum S v_i'), sequentially; returns the largest squared velocity moving
+/// one of them (zero without cracks).
+fn move_coded<D: Dim>(world: &mut World<D>) -> f64 {
+    let Some(c) = world.cracks.as_ref() else {
+        return 0.0;
+    };
+    let (dt, shape) = (world.settings.dt, world.settings.shape);
+    let (grid, p) = (&world.grid, &mut world.particles);
+    let mut fastest = 0.0f64;
+    for &i in &c.fields.coded {
+        let i = i as usize;
+        let targets = c.fields.targets_of(i).expect("coded particle");
+        let (mut dv, mut vn) = (D::zero(), D::zero());
+        with_nodes!(shape, N => {
+            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
+            st.for_each_target::<D>(&grid.geom.stride, targets, |n, w, _| {
+                dv += grid.accel[n] * w;
+                vn += grid.velocity[n] * w;
+            });
+        });
+        p.v[i] += dv * dt;
+        p.x[i] += vn * dt;
+        p.u[i] += vn * dt;
+        fastest = fastest.max(D::dot(vn, vn));
+    }
+    fastest
 }
 
 /// After the particles moved: the crack record's drift (when cracks need the bound; the

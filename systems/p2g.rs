@@ -82,14 +82,11 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
             st.for_each_row::<D>(&geom.stride, |row, q, _| {
                 let (mq, mvq) = (m * q, mv * q);
-                for a in 0..N {
-                    let w = st.w[0][a];
-                    // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and
-                    // each tile is handled by one thread.
-                    unsafe {
-                        mass_w.add(row + a, mq * w);
-                        momentum_w.add(row + a, mvq * w);
-                    }
+                // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
+                // tile is handled by one thread.
+                unsafe {
+                    mass_w.add_run(row, std::array::from_fn::<_, N, _>(|a| mq * st.w[0][a]));
+                    momentum_w.add_run(row, std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a]));
                 }
             });
             if FORCE {
@@ -122,10 +119,9 @@ unsafe fn add_internal_force<D: Dim, const N: usize>(
         let (row, q, gyz) = st.row::<D>(stride, r);
         let sxq = sx * q;
         let syz = D::stress_dot(s, gyz) * vol;
-        for a in 0..N {
-            // SAFETY: the caller guarantees exclusive access to these nodes.
-            unsafe { force.add(row + a, sxq * st.dw[0][a] + syz * st.w[0][a]) };
-        }
+        let f = std::array::from_fn::<_, N, _>(|a| sxq * st.dw[0][a] + syz * st.w[0][a]);
+        // SAFETY: the caller guarantees exclusive access to these nodes.
+        unsafe { force.add_run(row, f) };
     }
 }
 

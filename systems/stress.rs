@@ -2,6 +2,7 @@
 //! from the grid velocities p/m, in parallel over particle chunks.
 
 use crate::dim::Dim;
+use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
 use crate::shape::Stencil;
 use crate::sym::Sym3;
@@ -29,17 +30,18 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
         ..
     } = &mut world.particles;
     let material = &*material;
+    let stride = &grid.geom.stride;
     let body = |c: usize, gv: &mut [D::Mat], s: &mut [Sym3], gu: &mut [D::Mat]| {
         with_nodes!(shape, N => for k in 0..gv.len() {
             let i = c * CHUNK + k;
-            let st = Stencil::<N>::cached::<D>(stencils, i);
-            let targets = fields.and_then(|f| f.targets_of(i));
-            let l = velocity_gradient::<D, N>(&st, targets, &grid.velocity, &grid.geom.stride);
-            gv[k] = l;
-            if !gu.is_empty() {
-                gu[k] = gu[k] + l * dt;
+            // Particles near a crack are updated from their fields' entries afterwards.
+            if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+                continue;
             }
-            materials[material[i] as usize].update(plane, D::sym_part(&l) * dt, &mut s[k]);
+            let st = Stencil::<N>::cached::<D>(stencils, i);
+            let l = velocity_gradient::<D, N>(&st, &grid.velocity, stride);
+            let m = &materials[material[i] as usize];
+            apply::<D>(l, dt, plane, m, &mut gv[k], &mut s[k], gu.get_mut(k));
         })
     };
     if grad_u.is_empty() {
@@ -57,35 +59,69 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
             .enumerate()
             .for_each(|(c, (gv, s, gu))| body(c, gv, s, gu));
     }
+    // grad v over each stencil node's own field entry (Guo & Nairn 3D (2006) Eq. 20).
+    for &i in fields.map_or(&[][..], |f| &f.coded) {
+        let i = i as usize;
+        let targets = fields
+            .and_then(|f| f.targets_of(i))
+            .expect("coded particle");
+        let mut l = D::mat_zero();
+        with_nodes!(shape, N => {
+            let st = Stencil::<N>::cached::<D>(stencils, i);
+            st.for_each_target::<D>(stride, targets, |n, _, g| {
+                l = l + D::outer(grid.velocity[n], g);
+            });
+        });
+        let m = &materials[material[i] as usize];
+        apply::<D>(
+            l,
+            dt,
+            plane,
+            m,
+            &mut grad_v[i],
+            &mut stress[i],
+            grad_u.get_mut(i),
+        );
+    }
 }
 
-/// grad v of one particle: sum over its stencil of v_i ⊗ grad S_i, row by row
-/// (sum_rows (sum_i v_i dw_i) ⊗ q x̂ + (sum_i v_i w_i) ⊗ g_yz); near a crack, over its own
-/// field's entries (Guo & Nairn 3D (2006) Eq. 20).
+/// One particle's update from its velocity gradient `l`: grad v, grad u (when kept) and the
+/// stress over `dt`.
+#[inline(always)]
+fn apply<D: Dim>(
+    l: D::Mat,
+    dt: f64,
+    plane: Plane,
+    m: &Elastic,
+    gv: &mut D::Mat,
+    s: &mut Sym3,
+    gu: Option<&mut D::Mat>,
+) {
+    *gv = l;
+    if let Some(gu) = gu {
+        *gu = *gu + l * dt;
+    }
+    m.update(plane, D::sym_part(&l) * dt, s);
+}
+
+/// grad v of one particle away from cracks: sum over its stencil of v_i ⊗ grad S_i, row by
+/// row (sum_rows (sum_i v_i dw_i) ⊗ q x̂ + (sum_i v_i w_i) ⊗ g_yz).
 #[inline(always)]
 fn velocity_gradient<D: Dim, const N: usize>(
     st: &Stencil<N>,
-    targets: Option<&[u32]>,
     velocity: &[D::Vec],
     stride: &[usize; 3],
 ) -> D::Mat {
     let mut l = D::mat_zero();
-    match targets {
-        Some(t) => st.for_each_target::<D>(stride, t, |n, _, g| {
-            l = l + D::outer(velocity[n], g);
-        }),
-        None => {
-            for r in 0..Stencil::<N>::rows::<D>() {
-                let (row, q, gyz) = st.row::<D>(stride, r);
-                let (mut vd, mut vw) = (D::zero(), D::zero());
-                // One bounds check per row: the slice has N nodes.
-                for (a, &v) in velocity[row..row + N].iter().enumerate() {
-                    vd += v * st.dw[0][a];
-                    vw += v * st.w[0][a];
-                }
-                l = D::add_row(l, vd, q, vw, gyz);
-            }
+    for r in 0..Stencil::<N>::rows::<D>() {
+        let (row, q, gyz) = st.row::<D>(stride, r);
+        let (mut vd, mut vw) = (D::zero(), D::zero());
+        // One bounds check per row: the slice has N nodes.
+        for (a, &v) in velocity[row..row + N].iter().enumerate() {
+            vd += v * st.dw[0][a];
+            vw += v * st.w[0][a];
         }
+        l = D::add_row(l, vd, q, vw, gyz);
     }
     l
 }
