@@ -11,8 +11,8 @@ use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Updates particle velocities (v += dt sum S a_i), positions and displacements
-/// (x += dt sum S v_i'), in parallel over particle chunks (USF); the particles' bins are
-/// stale afterwards.
+/// (x += dt sum S v_i'), in parallel over particle chunks (USF), the particles near a crack
+/// afterwards from their fields' entries; the particles' bins are stale afterwards.
 pub fn run<D: Dim>(world: &mut World<D>) {
     let dt = world.settings.dt;
     let shape = world.settings.shape;
@@ -55,7 +55,8 @@ pub fn run<D: Dim>(world: &mut World<D>) {
 
 /// As [`run`], then each particle's updated momentum m v is scattered back to the zeroed
 /// grid momenta with the start-of-step shape functions (USL and USAVG), in one pass over
-/// the tiles in colour classes. The final stress update then reads grid velocities that
+/// the tiles in colour classes (the particles near a crack afterwards, sequentially, field
+/// by field). The final stress update then reads grid velocities that
 /// are mass-weighted averages of particle velocities (the modified USL of Sulsky, Zhou &
 /// Schreyer 1995); without this remap, nodes with a tiny share of mass get huge velocities
 /// and linear shape functions go unstable. The nodal masses stay those of `p2g`.

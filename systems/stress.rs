@@ -1,5 +1,6 @@
 //! `stress`: small-strain constitutive update, d(eps) = sym(grad v) dt, with grad v gathered
-//! from the grid velocities p/m, in parallel over particle chunks.
+//! from the grid velocities p/m, in parallel over particle chunks (the particles near a
+//! crack afterwards, from their fields' entries).
 
 use crate::dim::Dim;
 use crate::material::{Elastic, Plane};
@@ -59,12 +60,12 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
             .enumerate()
             .for_each(|(c, (gv, s, gu))| body(c, gv, s, gu));
     }
-    // grad v over each stencil node's own field entry (Guo & Nairn 3D (2006) Eq. 20).
-    for &i in fields.map_or(&[][..], |f| &f.coded) {
+    // The particles near a crack: grad v over each stencil node's entry for the particle's
+    // side (Guo & Nairn 3D (2006) Eq. 20), sequentially.
+    let Some(f) = fields else { return };
+    for &i in &f.coded {
         let i = i as usize;
-        let targets = fields
-            .and_then(|f| f.targets_of(i))
-            .expect("coded particle");
+        let targets = f.targets_of(i).expect("coded particle");
         let mut l = D::mat_zero();
         with_nodes!(shape, N => {
             let st = Stencil::<N>::cached::<D>(stencils, i);
