@@ -166,16 +166,27 @@ impl<const N: usize> Stencil<N> {
         if D::D == 3 { N * N } else { N }
     }
 
+    /// Index of the first node of the row at offsets `j` (y) and `k` (z) from the base; in 2D
+    /// the z term is left out at compile time.
+    #[inline(always)]
+    fn first_node<D: Dim>(&self, stride: &[usize; 3], j: usize, k: usize) -> usize {
+        let first = self.base[0] + stride[1] * (self.base[1] + j);
+        if D::D == 3 {
+            first + stride[2] * (self.base[2] + k)
+        } else {
+            first
+        }
+    }
+
     /// Row `r` as [`for_each_row`](Self::for_each_row) passes it: (first node, q, g_yz).
     /// Loops over `0..rows()` calling this compile to straight code where a closure called
     /// from many unrolled sites may be left out of line (found in 3D uGIMP).
     #[inline(always)]
     pub fn row<D: Dim>(&self, stride: &[usize; 3], r: usize) -> (usize, f64, D::Vec) {
         let (j, k) = (r % N, r / N);
-        let first = self.base[0] + stride[1] * (self.base[1] + j) + stride[2] * (self.base[2] + k);
         let (w1, w2) = (self.w[1][j], self.w[2][k]);
         (
-            first,
+            self.first_node::<D>(stride, j, k),
             w1 * w2,
             D::yz(self.dw[1][j] * w2, w1 * self.dw[2][k]),
         )
