@@ -214,6 +214,12 @@ impl<D: Dim> Default for Classified<D> {
 }
 
 impl Fields {
+    /// Whether particle `p` sees a crack (and so is handled field by field).
+    #[inline(always)]
+    pub fn is_coded(&self, p: usize) -> bool {
+        self.slot[p] != u32::MAX
+    }
+
     /// Grid entries of coded particle `p`'s stencil nodes, if it is coded.
     #[inline(always)]
     pub fn targets_of(&self, p: usize) -> Option<&[u32]> {

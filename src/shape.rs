@@ -135,8 +135,7 @@ impl<const N: usize> Stencil<N> {
         let nk = if D::D == 3 { N } else { 1 };
         for k in 0..nk {
             for j in 0..N {
-                let row =
-                    self.base[0] + stride[1] * (self.base[1] + j) + stride[2] * (self.base[2] + k);
+                let row = self.first_node::<D>(stride, j, k);
                 let wjk = self.w[1][j] * self.w[2][k];
                 for i in 0..N {
                     f(

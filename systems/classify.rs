@@ -451,7 +451,7 @@ impl<D: Dim> Pass<'_, D> {
             }
         }
         // The distinct (node, mask) of the pairs with a mask, found through a chain per
-        // node, then numbered in increasing order.
+        // node, then given grid entries in increasing (node, mask) order.
         f.head.resize(f.nodes, u32::MAX);
         let mut rows: Vec<(u32, u64)> = Vec::new();
         let mut next: Vec<u32> = Vec::new();
@@ -475,15 +475,15 @@ impl<D: Dim> Pass<'_, D> {
             .collect();
         let mut order: Vec<u32> = (0..rows.len() as u32).collect();
         order.sort_unstable_by_key(|&r| rows[r as usize]);
-        let mut rank = vec![0u32; rows.len()];
+        let mut entry = vec![0u32; rows.len()];
         for (k, &r) in order.iter().enumerate() {
-            rank[r as usize] = (f.nodes + k) as u32;
+            entry[r as usize] = (f.nodes + k) as u32;
             f.head[rows[r as usize].0 as usize] = u32::MAX;
         }
         f.targets.clear();
         f.targets
             .extend((pairs.iter().zip(&row_of)).map(|(&(n, _), &r)| {
-                if r == u32::MAX { n } else { rank[r as usize] }
+                if r == u32::MAX { n } else { entry[r as usize] }
             }));
         f.node = order.iter().map(|&r| rows[r as usize].0).collect();
         f.mask = order.iter().map(|&r| rows[r as usize].1).collect();

@@ -34,7 +34,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             with_nodes!(shape, N => for k in 0..x.len() {
                 let i = c * CHUNK + k;
                 // Particles near a crack move afterwards.
-                if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+                if fields.is_some_and(|f| f.is_coded(i)) {
                     continue;
                 }
                 let st = Stencil::<N>::cached::<D>(stencils, i);
@@ -83,7 +83,7 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
         with_nodes!(shape, N => for &i in tiles.particles(t) {
             let i = i as usize;
             // Particles near a crack move, and are scattered field by field, afterwards.
-            if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+            if fields.is_some_and(|f| f.is_coded(i)) {
                 continue;
             }
             let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);

@@ -38,7 +38,7 @@ pub fn internal_force<D: Dim>(world: &mut World<D>) {
         with_nodes!(shape, N => for &i in tiles.particles(t) {
             let i = i as usize;
             // Particles near a crack are scattered field by field afterwards.
-            if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+            if fields.is_some_and(|f| f.is_coded(i)) {
                 continue;
             }
             let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
@@ -75,7 +75,7 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
         with_nodes!(shape, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
             // Particles near a crack are scattered field by field afterwards.
-            if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+            if fields.is_some_and(|f| f.is_coded(i)) {
                 continue;
             }
             let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);

@@ -36,7 +36,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
         with_nodes!(shape, N => for k in 0..gv.len() {
             let i = c * CHUNK + k;
             // Particles near a crack are updated from their fields' entries afterwards.
-            if fields.is_some_and(|f| f.slot[i] != u32::MAX) {
+            if fields.is_some_and(|f| f.is_coded(i)) {
                 continue;
             }
             let st = Stencil::<N>::cached::<D>(stencils, i);
