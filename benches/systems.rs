@@ -10,7 +10,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use fissure::dim::{D2, D3, Dim};
 use fissure::scenario::{Source, build};
 use fissure::schedule::Schedule;
-use fissure::systems::{bin, g2p, grid_update, p2g, stress};
+use fissure::systems::{bin, g2p, grid_update, p2g, stress, stress_bin, stress_force};
 use std::time::Duration;
 
 fn scene_text(dim: usize, n: usize, shape: &str, update: &str) -> String {
@@ -70,8 +70,11 @@ fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, n: usize, shape: &str, up
     g.bench_function("g2p_remap", |b| b.iter(|| g2p::run_with_remap(&mut world)));
     bin::run(&mut world).expect("in grid");
     g.bench_function("stress", |b| b.iter(|| stress::run(&mut world, 1.0)));
-    g.bench_function("internal_force", |b| {
-        b.iter(|| p2g::internal_force(&mut world))
+    g.bench_function("stress_bin", |b| {
+        b.iter(|| stress_bin::run(&mut world, 1.0).expect("in grid"))
+    });
+    g.bench_function("stress_force", |b| {
+        b.iter(|| stress_force::run(&mut world, 1.0))
     });
     // As the launcher does, the step runs inside the pool, so its parallel loops are not
     // each handed over from an outside thread.

@@ -18,7 +18,8 @@ pub struct Particles<D: Dim> {
     pub volume: Vec<f64>,
     /// Cauchy stress (Pa), small strain.
     pub stress: Vec<Sym3>,
-    /// Velocity gradient dv_i/dx_j (1/s) from the most recent gather.
+    /// Velocity gradient dv_i/dx_j (1/s) from the most recent gather; only allocated when
+    /// J-integrals are measured (their area term reads it).
     pub grad_v: Vec<D::Mat>,
     /// Index into the world's material table.
     pub material: Vec<u16>,
@@ -65,7 +66,6 @@ impl<D: Dim> Particles<D> {
         self.mass.push(mass);
         self.volume.push(volume);
         self.stress.push(Sym3::default());
-        self.grad_v.push(D::mat_zero());
         self.material.push(material);
     }
 
@@ -75,11 +75,10 @@ impl<D: Dim> Particles<D> {
         let base = 3 * vec
             + 2 * std::mem::size_of::<f64>()
             + std::mem::size_of::<Sym3>()
-            + std::mem::size_of::<D::Mat>()
             + std::mem::size_of::<u16>();
         let mat = std::mem::size_of::<D::Mat>();
         base + if self.half.is_empty() { 0 } else { vec }
-            + if self.grad_u.is_empty() { 0 } else { mat }
+            + if self.grad_u.is_empty() { 0 } else { 2 * mat }
     }
 
     /// Reorders every column so that new particle `k` is old particle `order[k]`.

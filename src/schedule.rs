@@ -2,7 +2,9 @@
 
 use crate::dim::Dim;
 use crate::error::Unstable;
-use crate::systems::{bin, classify, contact, crack_advect, g2p, grid_update, p2g, stress};
+use crate::systems::{
+    bin, classify, contact, crack_advect, g2p, grid_update, p2g, stress, stress_bin, stress_force,
+};
 use crate::world::{Update, World};
 use std::time::Instant;
 
@@ -35,8 +37,16 @@ pub enum System {
         /// Fraction of the step.
         fraction: f64,
     },
-    /// Scatter the internal force alone.
-    InternalForce,
+    /// The closing stress update of USL and USAVG fused with the binning for the next step.
+    StressBin {
+        /// Fraction of the step.
+        fraction: f64,
+    },
+    /// The opening stress update of USF and USAVG fused with the internal-force scatter.
+    StressForce {
+        /// Fraction of the step.
+        fraction: f64,
+    },
     /// Integrate nodal momenta, apply damping, gravity and prescribed velocities.
     GridUpdate,
     /// Gather to particles: velocities, positions, displacements (USF).
@@ -57,7 +67,8 @@ impl System {
             System::P2g { .. } => "p2g",
             System::MomentumBc { .. } => "grid_bc",
             System::Stress { .. } => "stress",
-            System::InternalForce => "internal_force",
+            System::StressForce { .. } => "stress_force",
+            System::StressBin { .. } => "stress_bin",
             System::GridUpdate => "grid_update",
             System::G2p => "g2p",
             System::G2pRemap => "g2p_remap",
@@ -105,7 +116,7 @@ impl Schedule {
         }
         if update != Update::Usl {
             let fraction = if update == Update::Usf { 1.0 } else { 0.5 };
-            s.extend([Stress { fraction }, InternalForce]);
+            s.push(StressForce { fraction });
         }
         s.push(GridUpdate);
         if contact {
@@ -120,7 +131,14 @@ impl Schedule {
                 s.push(MomentumBc { end: true });
             }
             let fraction = if update == Update::Usl { 1.0 } else { 0.5 };
-            s.push(Stress { fraction });
+            // Without cracks the closing update also bins the particles for the next step;
+            // with cracks the J-integral between steps reads the start-of-step stencils
+            // that match the fields, so binning waits for the next step.
+            s.push(if cracks {
+                Stress { fraction }
+            } else {
+                StressBin { fraction }
+            });
         }
         let seconds = vec![0.0; s.len()];
         Schedule {
@@ -143,7 +161,8 @@ impl Schedule {
                 System::P2g { internal } => p2g::run(world, internal),
                 System::MomentumBc { end } => grid_update::momentum_bc(world, end),
                 System::Stress { fraction } => stress::run(world, fraction),
-                System::InternalForce => p2g::internal_force(world),
+                System::StressForce { fraction } => stress_force::run(world, fraction),
+                System::StressBin { fraction } => stress_bin::run(world, fraction)?,
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),

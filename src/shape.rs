@@ -221,13 +221,18 @@ impl<const N: usize> Stencil<N> {
     #[inline(always)]
     pub fn cached<D: Dim>(cache: &StencilCache, i: usize) -> Self {
         let per = StencilCache::per::<D>();
-        let b = cache.base[i];
+        Self::from_cache::<D>(cache.base[i], &cache.weights[i * per..(i + 1) * per])
+    }
+
+    /// A stencil from one particle's cache entries: its first nodes and its
+    /// [`per`](StencilCache::per) weights and derivatives.
+    #[inline(always)]
+    pub fn from_cache<D: Dim>(b: [u32; 3], src: &[f64]) -> Self {
         let mut st = Stencil {
             base: [b[0] as usize, b[1] as usize, b[2] as usize],
             w: [[1.0, 0.0, 0.0]; 3],
             dw: [[0.0; 3]; 3],
         };
-        let src = &cache.weights[i * per..(i + 1) * per];
         for a in 0..D::D {
             st.w[a].copy_from_slice(&src[6 * a..6 * a + 3]);
             st.dw[a].copy_from_slice(&src[6 * a + 3..6 * a + 6]);

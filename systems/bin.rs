@@ -3,7 +3,9 @@
 
 use crate::dim::Dim;
 use crate::error::Unstable;
-use crate::shape::StencilCache;
+use crate::grid::GridGeom;
+use crate::shape::{ShapeKind, StencilCache};
+use crate::tiles::Tiles;
 use crate::with_shape;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
@@ -16,15 +18,32 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
         return Ok(());
     }
     let p = &world.particles;
-    let geom = &world.grid.geom;
-    let tiles = &mut world.tiles;
-    let shape = world.settings.shape;
+    let (geom, shape) = (&world.grid.geom, world.settings.shape);
+    match place(&p.x, &p.half, geom, shape, &mut world.tiles, |_, _, _| {}) {
+        Ok(()) => Ok(()),
+        Err(i) => Err(outside(world, i, world.step, world.time)),
+    }
+}
+
+/// Evaluates every particle's stencil and tile in one pass over particle chunks, calling
+/// `before(i, base, weights)` with particle `i`'s cached stencil just before it is
+/// overwritten (so a system can fuse its last use of the old stencils into the binning),
+/// then sorts the tiles if any particle changed tile. Returns the first particle whose
+/// stencil leaves the grid (the bins are then left stale).
+pub(crate) fn place<D: Dim>(
+    x: &[D::Vec],
+    half: &[D::Vec],
+    geom: &GridGeom<D>,
+    shape: ShapeKind,
+    tiles: &mut Tiles,
+    before: impl Fn(usize, [u32; 3], &[f64]) + Sync,
+) -> Result<(), usize> {
     let mut tile_of = std::mem::take(&mut tiles.tile_of);
-    let sorted = tile_of.len() == p.len();
-    tile_of.resize(p.len(), u32::MAX);
+    let sorted = tile_of.len() == x.len();
+    tile_of.resize(x.len(), u32::MAX);
     let per = StencilCache::per::<D>();
     let cell_part = &tiles.cell_part;
-    let (base, weights) = tiles.stencils.resize::<D>(p.len());
+    let (base, weights) = tiles.stencils.resize::<D>(x.len());
     // Per chunk: the first particle whose stencil leaves the grid, and whether any particle
     // changed tile.
     let chunks: Vec<(Option<usize>, bool)> = (
@@ -40,10 +59,11 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
                 let rows = base.iter_mut().zip(weights.chunks_exact_mut(per));
                 for (k, (t, (b, w))) in out.iter_mut().zip(rows).enumerate() {
                     let i = c * CHUNK + k;
-                    let (x, half) = (p.x[i], p.half_of(i));
+                    before(i, *b, w);
+                    let half = if half.is_empty() { D::zero() } else { half[i] };
                     let mut tile = 0;
                     for a in 0..D::D {
-                        let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
+                        let xi = (x[i][a] - geom.origin[a]) * geom.inv_h[a];
                         let l = half[a] * geom.inv_h[a];
                         // Also false for a non-finite position.
                         if !S.fits(xi, l, geom.cells[a]) {
@@ -63,28 +83,33 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
         })
         .collect();
     tiles.tile_of = tile_of;
-    let bad = chunks.iter().find_map(|c| c.0);
-    let moved = chunks.iter().any(|c| c.1);
-    if let Some(i) = bad {
-        let x = D::to_xyz(p.x[i]);
-        let what = if x.iter().all(|c| c.is_finite()) {
-            format!(
-                "left the grid at ({:.6e}, {:.6e}, {:.6e}) m (its stencil must stay inside the grid)",
-                x[0], x[1], x[2]
-            )
-        } else {
-            "has a non-finite position (NaN or infinity)".to_string()
-        };
-        return Err(Unstable {
-            step: world.step,
-            time: world.time,
-            particle: i,
-            what,
-        });
+    if let Some(i) = chunks.iter().find_map(|c| c.0) {
+        tiles.fresh = false;
+        return Err(i);
     }
-    if moved || !sorted {
+    if chunks.iter().any(|c| c.1) || !sorted {
         tiles.sort();
     }
     tiles.fresh = true;
     Ok(())
+}
+
+/// The instability of particle `i`, whose stencil left the grid (or whose position is not
+/// finite), at the positions of `step` and `time`.
+pub(crate) fn outside<D: Dim>(world: &World<D>, i: usize, step: u64, time: f64) -> Unstable {
+    let x = D::to_xyz(world.particles.x[i]);
+    let what = if x.iter().all(|c| c.is_finite()) {
+        format!(
+            "left the grid at ({:.6e}, {:.6e}, {:.6e}) m (its stencil must stay inside the grid)",
+            x[0], x[1], x[2]
+        )
+    } else {
+        "has a non-finite position (NaN or infinity)".to_string()
+    };
+    Unstable {
+        step,
+        time,
+        particle: i,
+        what,
+    }
 }

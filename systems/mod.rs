@@ -9,3 +9,5 @@ pub mod g2p;
 pub mod grid_update;
 pub mod p2g;
 pub mod stress;
+pub mod stress_bin;
+pub mod stress_force;

@@ -24,36 +24,6 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
     scatter_loads(world);
 }
 
-/// Scatters the internal force -V sigma . grad S alone (USF and USAVG, after the first
-/// stress update), tile by tile in colour classes, onto the loads already in the force
-/// column.
-pub fn internal_force<D: Dim>(world: &mut World<D>) {
-    let grid = &mut world.grid;
-    let force_w = Disjoint::new(&mut grid.force);
-    let p = &world.particles;
-    let shape = world.settings.shape;
-    let (geom, tiles) = (&grid.geom, &world.tiles);
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
-    tiles.for_each_coloured(|t| {
-        with_nodes!(shape, N => for &i in tiles.particles(t) {
-            let i = i as usize;
-            // Particles near a crack are scattered field by field afterwards.
-            if fields.is_some_and(|f| f.is_coded(i)) {
-                continue;
-            }
-            let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
-            // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
-            // tile is handled by one thread.
-            unsafe {
-                add_internal_force::<D, N>(&st, &geom.stride, &p.stress[i], p.volume[i], &force_w)
-            };
-        })
-    });
-    if let Some(f) = fields {
-        scatter_coded::<D, false, false, true>(f, p, shape, &tiles.stencils, grid);
-    }
-}
-
 /// One scatter pass over the tiles, colour class by colour class (Guo & Nairn 2D (2004)
 /// Eqs. 3 and 6, single velocity field): mass and momentum (each zeroed first), and the
 /// internal force -V sigma . grad S when `FORCE` (a compile-time flag keeps the hot loop
@@ -106,7 +76,7 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
 /// # Safety
 /// No other thread may access the stencil's nodes of `force` during the call.
 #[inline(always)]
-unsafe fn add_internal_force<D: Dim, const N: usize>(
+pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
     st: &Stencil<N>,
     stride: &[usize; 3],
     s: &Sym3,

@@ -11,10 +11,10 @@ use crate::with_nodes;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
-/// Gathers grad v = sum (p_i/m_i) ⊗ grad S into the particles' grad_v column and updates
-/// the stress over `fraction` of the step, in parallel over particle chunks. The grid's
-/// velocity column is overwritten with p/m first (grid_update rewrites it with end-of-step
-/// velocities afterwards).
+/// Gathers grad v = sum (p_i/m_i) ⊗ grad S and updates the stress over `fraction` of the
+/// step (and grad v, grad u when J-integrals need them), in parallel over particle chunks.
+/// The grid's velocity column is overwritten with p/m first (grid_update rewrites it with
+/// end-of-step velocities afterwards).
 pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     node_velocities(world);
     let dt = world.settings.dt * fraction;
@@ -32,8 +32,8 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     } = &mut world.particles;
     let material = &*material;
     let stride = &grid.geom.stride;
-    let body = |c: usize, gv: &mut [D::Mat], s: &mut [Sym3], gu: &mut [D::Mat]| {
-        with_nodes!(shape, N => for k in 0..gv.len() {
+    let body = |c: usize, s: &mut [Sym3], mut grads: Grads<D>| {
+        with_nodes!(shape, N => for k in 0..s.len() {
             let i = c * CHUNK + k;
             // Particles near a crack are updated from their fields' entries afterwards.
             if fields.is_some_and(|f| f.is_coded(i)) {
@@ -42,64 +42,70 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
             let st = Stencil::<N>::cached::<D>(stencils, i);
             let l = velocity_gradient::<D, N>(&st, &grid.velocity, stride);
             let m = &materials[material[i] as usize];
-            apply::<D>(l, dt, plane, m, &mut gv[k], &mut s[k], gu.get_mut(k));
+            let grads = grads.as_mut().map(|(gv, gu)| (&mut gv[k], &mut gu[k]));
+            apply::<D>(l, dt, plane, m, &mut s[k], grads);
         })
     };
     if grad_u.is_empty() {
-        (grad_v.par_chunks_mut(CHUNK), stress.par_chunks_mut(CHUNK))
-            .into_par_iter()
+        stress
+            .par_chunks_mut(CHUNK)
             .enumerate()
-            .for_each(|(c, (gv, s))| body(c, gv, s, &mut []));
+            .for_each(|(c, s)| body(c, s, None));
     } else {
         (
-            grad_v.par_chunks_mut(CHUNK),
             stress.par_chunks_mut(CHUNK),
+            grad_v.par_chunks_mut(CHUNK),
             grad_u.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
             .enumerate()
-            .for_each(|(c, (gv, s, gu))| body(c, gv, s, gu));
+            .for_each(|(c, (s, gv, gu))| body(c, s, Some((gv, gu))));
     }
-    // The particles near a crack: grad v over each stencil node's entry for the particle's
-    // side (Guo & Nairn 3D (2006) Eq. 20), sequentially.
-    let Some(f) = fields else { return };
+    update_coded(world, dt);
+}
+
+/// A chunk's grad v and grad u columns, when they are kept.
+type Grads<'a, D> = Option<(&'a mut [<D as Dim>::Mat], &'a mut [<D as Dim>::Mat])>;
+
+/// The update of the particles near a crack: grad v over each stencil node's entry for the
+/// particle's side (Guo & Nairn 3D (2006) Eq. 20), sequentially in particle order.
+pub(crate) fn update_coded<D: Dim>(world: &mut World<D>, dt: f64) {
+    let Some(c) = world.cracks.as_ref() else {
+        return;
+    };
+    let (shape, plane) = (world.settings.shape, world.settings.plane);
+    let (grid, f) = (&world.grid, &c.fields);
+    let p = &mut world.particles;
+    let keep = !p.grad_u.is_empty();
     for &i in &f.coded {
         let i = i as usize;
         let targets = f.targets_of(i).expect("coded particle");
         let mut l = D::mat_zero();
         with_nodes!(shape, N => {
-            let st = Stencil::<N>::cached::<D>(stencils, i);
-            st.for_each_target::<D>(stride, targets, |n, _, g| {
+            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
+            st.for_each_target::<D>(&grid.geom.stride, targets, |n, _, g| {
                 l = l + D::outer(grid.velocity[n], g);
             });
         });
-        let m = &materials[material[i] as usize];
-        apply::<D>(
-            l,
-            dt,
-            plane,
-            m,
-            &mut grad_v[i],
-            &mut stress[i],
-            grad_u.get_mut(i),
-        );
+        let m = &world.materials[p.material[i] as usize];
+        let grads = keep.then(|| (&mut p.grad_v[i], &mut p.grad_u[i]));
+        apply::<D>(l, dt, plane, m, &mut p.stress[i], grads);
     }
 }
 
-/// One particle's update from its velocity gradient `l`: grad v, grad u (when kept) and the
-/// stress over `dt`.
+/// One particle's update from its velocity gradient `l`: the stress over `dt`, and grad v
+/// and grad u when they are kept.
 #[inline(always)]
-fn apply<D: Dim>(
+pub(crate) fn apply<D: Dim>(
     l: D::Mat,
     dt: f64,
     plane: Plane,
     m: &Elastic,
-    gv: &mut D::Mat,
     s: &mut Sym3,
-    gu: Option<&mut D::Mat>,
+    grads: Option<(&mut D::Mat, &mut D::Mat)>,
 ) {
-    *gv = l;
-    if let Some(gu) = gu {
+    if let Some((gv, gu)) = grads {
+        *gv = l;
         *gu = *gu + l * dt;
     }
     m.update(plane, D::sym_part(&l) * dt, s);
@@ -108,7 +114,7 @@ fn apply<D: Dim>(
 /// grad v of one particle away from cracks: sum over its stencil of v_i ⊗ grad S_i, row by
 /// row (sum_rows (sum_i v_i dw_i) ⊗ q x̂ + (sum_i v_i w_i) ⊗ g_yz).
 #[inline(always)]
-fn velocity_gradient<D: Dim, const N: usize>(
+pub(crate) fn velocity_gradient<D: Dim, const N: usize>(
     st: &Stencil<N>,
     velocity: &[D::Vec],
     stride: &[usize; 3],
@@ -128,7 +134,7 @@ fn velocity_gradient<D: Dim, const N: usize>(
 }
 
 /// Sets the grid velocity column to p/m (zero on nodes lighter than the mass tolerance).
-fn node_velocities<D: Dim>(world: &mut World<D>) {
+pub(crate) fn node_velocities<D: Dim>(world: &mut World<D>) {
     let tol = world.settings.mass_tol;
     let g = &mut world.grid;
     let (mass, momentum) = (&g.mass, &g.momentum);

@@ -4,7 +4,9 @@ mod common;
 use common::source;
 use fissure::dim::D2;
 use fissure::scenario::build;
-use fissure::schedule::Schedule;
+use fissure::schedule::{Schedule, System};
+use fissure::systems::bin;
+use fissure::world::World;
 
 fn names(extra: &str, update: &str) -> Vec<&'static str> {
     let text = common::block_2d(1e-5, 0.004, 0.016, extra).replace(
@@ -23,22 +25,15 @@ fn names(extra: &str, update: &str) -> Vec<&'static str> {
 fn usf_without_boundaries_has_no_remap_and_no_grid_bc() {
     assert_eq!(
         names("", "usf"),
-        [
-            "bin",
-            "p2g",
-            "stress",
-            "internal_force",
-            "grid_update",
-            "g2p"
-        ]
+        ["bin", "p2g", "stress_force", "grid_update", "g2p"]
     );
 }
 
 #[test]
-fn usl_remaps_before_its_stress_update() {
+fn usl_remaps_before_its_stress_update_which_bins_the_next_step() {
     assert_eq!(
         names("", "usl"),
-        ["bin", "p2g", "grid_update", "g2p_remap", "stress"]
+        ["bin", "p2g", "grid_update", "g2p_remap", "stress_bin"]
     );
 }
 
@@ -51,12 +46,47 @@ fn boundaries_add_grid_bc_after_each_momentum_scatter() {
             "bin",
             "p2g",
             "grid_bc",
-            "stress",
-            "internal_force",
+            "stress_force",
             "grid_update",
             "g2p_remap",
             "grid_bc",
-            "stress"
+            "stress_bin"
         ]
     );
+}
+
+/// The closing stress update fused with the binning (`stress_bin`) gives the bits of the two
+/// systems run apart, and leaves the bins and stencils a fresh binning builds.
+#[test]
+fn fused_stress_bin_matches_stress_then_bin() {
+    for (shape, update) in [("ugimp", "usavg"), ("linear", "usl")] {
+        let text = common::mixed_scene(2, shape, update);
+        let mut fused = build::<D2>(&source(&text)).unwrap().world;
+        let mut apart = fused.clone();
+        let mut fused_schedule = Schedule::for_world(&fused);
+        let mut apart_schedule = fused_schedule.clone();
+        for sys in &mut apart_schedule.systems {
+            if let System::StressBin { fraction } = *sys {
+                *sys = System::Stress { fraction };
+            }
+        }
+        assert_ne!(fused_schedule.systems, apart_schedule.systems);
+        for _ in 0..30 {
+            fused_schedule.step(&mut fused).unwrap();
+            apart_schedule.step(&mut apart).unwrap();
+        }
+        assert!(fused.tiles.fresh && !apart.tiles.fresh);
+        bin::run(&mut apart).unwrap();
+        let bits = |w: &World<D2>| {
+            format!(
+                "{:?} {:?} {:?} {:?} {:?}",
+                w.particles.stress,
+                w.particles.x,
+                w.tiles.order,
+                w.tiles.stencils.base,
+                w.tiles.stencils.weights
+            )
+        };
+        assert!(bits(&fused) == bits(&apart), "{shape} {update}");
+    }
 }

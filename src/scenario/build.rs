@@ -567,6 +567,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     let fracture = super::cracks::fracture_plan(src, cracks.as_ref(), &geom)?;
     if fracture.is_some() {
         particles.grad_u = vec![D::mat_zero(); particles.len()];
+        particles.grad_v = vec![D::mat_zero(); particles.len()];
     }
     let min_mass = particles.mass.iter().copied().fold(f64::INFINITY, f64::min);
     let world = World {

@@ -230,10 +230,12 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     p.mass = r.column("particles.mass", n)?;
     p.volume = r.column("particles.volume", n)?;
     p.stress = r.column("particles.stress", n)?;
-    p.grad_v = r.column("particles.grad_v", n)?;
     p.material = r.column("particles.material", n)?;
     p.half = r.column("particles.half", if p.half.is_empty() { 0 } else { n })?;
-    p.grad_u = r.column("particles.grad_u", if p.grad_u.is_empty() { 0 } else { n })?;
+    if !p.grad_u.is_empty() {
+        p.grad_u = r.column("particles.grad_u", n)?;
+        p.grad_v = r.column("particles.grad_v", n)?;
+    }
     let nm = w.materials.len();
     let youngs: Vec<f64> = r.column("materials.youngs", nm)?;
     let poisson: Vec<f64> = r.column("materials.poisson", nm)?;

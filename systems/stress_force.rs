@@ -1,0 +1,87 @@
+//! `stress_force`: the stress update that opens a USF or USAVG step and the scatter of the
+//! internal forces it gives, fused in one pass over the tiles so each particle's stencil is
+//! read once (the particles near a crack afterwards, field by field).
+
+use crate::dim::Dim;
+use crate::disjoint::Disjoint;
+use crate::grid::Grid;
+use crate::particles::Particles;
+use crate::shape::Stencil;
+use crate::systems::p2g::{add_internal_force, scatter_coded};
+use crate::systems::stress::{apply, node_velocities, update_coded, velocity_gradient};
+use crate::with_nodes;
+use crate::world::World;
+
+/// Updates every particle's stress over `fraction` of the step from grad v gathered off
+/// p/m (as [`stress::run`](crate::systems::stress::run)), then adds its internal force
+/// -V sigma . grad S to the loads already in the force column (Guo & Nairn 2D (2004)
+/// Eq. 6), tile by tile in colour classes.
+pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
+    node_velocities(world);
+    let dt = world.settings.dt * fraction;
+    let (shape, plane) = (world.settings.shape, world.settings.plane);
+    let Grid {
+        geom,
+        velocity,
+        force,
+        ..
+    } = &mut world.grid;
+    let (velocity, stride) = (&*velocity, &geom.stride);
+    let force_w = Disjoint::new(force);
+    let Particles {
+        stress,
+        grad_v,
+        grad_u,
+        volume,
+        material,
+        ..
+    } = &mut world.particles;
+    let keep = !grad_u.is_empty();
+    let (stress_w, grad_v_w, grad_u_w) = (
+        Disjoint::new(stress),
+        Disjoint::new(grad_v),
+        Disjoint::new(grad_u),
+    );
+    let (tiles, materials) = (&world.tiles, &world.materials);
+    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    tiles.for_each_coloured(|t| {
+        with_nodes!(shape, N => for &i in tiles.particles(t) {
+            let i = i as usize;
+            // Particles near a crack are updated and scattered field by field afterwards.
+            if fields.is_some_and(|f| f.is_coded(i)) {
+                continue;
+            }
+            let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
+            let l = velocity_gradient::<D, N>(&st, velocity, stride);
+            let m = &materials[material[i] as usize];
+            // SAFETY: every particle is in exactly one tile and each tile is handled by one
+            // thread, so no other thread touches particle i's entries; tiles of one colour
+            // class touch disjoint nodes (tiles.rs).
+            unsafe {
+                let mut s = stress_w.get(i);
+                if keep {
+                    let (mut gv, mut gu) = (grad_v_w.get(i), grad_u_w.get(i));
+                    apply::<D>(l, dt, plane, m, &mut s, Some((&mut gv, &mut gu)));
+                    grad_v_w.set(i, gv);
+                    grad_u_w.set(i, gu);
+                } else {
+                    apply::<D>(l, dt, plane, m, &mut s, None);
+                }
+                stress_w.set(i, s);
+                add_internal_force::<D, N>(&st, stride, &s, volume[i], &force_w);
+            }
+        })
+    });
+    if world.cracks.is_some() {
+        update_coded(world, dt);
+        let f = &world.cracks.as_ref().expect("cracks").fields;
+        let stencils = &world.tiles.stencils;
+        scatter_coded::<D, false, false, true>(
+            f,
+            &world.particles,
+            shape,
+            stencils,
+            &mut world.grid,
+        );
+    }
+}
