@@ -148,21 +148,28 @@ impl<const N: usize> Stencil<N> {
         }
     }
 
-    /// Calls `f(first_node, q, g_yz)` for each row of `N` nodes along x, where node `i` of the
-    /// row has weight `w[0][i] * q` and gradient `dw[0][i] * q * x̂ + w[0][i] * g_yz`. Hot
-    /// loops factor their per-row work out of the per-node work this way.
+    /// The stencil's rows of `N` nodes along x (see [`Rows`]), y fastest.
     #[inline(always)]
-    pub fn for_each_row<D: Dim>(&self, stride: &[usize; 3], mut f: impl FnMut(usize, f64, D::Vec)) {
-        for r in 0..Self::rows::<D>() {
-            let (row, q, gyz) = self.row::<D>(stride, r);
-            f(row, q, gyz);
+    pub fn rows<D: Dim>(&self, stride: &[usize; 3]) -> Rows<D> {
+        let nk = if D::D == 3 { N } else { 1 };
+        let mut rows = Rows {
+            len: N * nk,
+            first: [0; 9],
+            q: [0.0; 9],
+            gyz: [D::zero(); 9],
+        };
+        let mut layer = self.first_node::<D>(stride, 0, 0);
+        for k in 0..nk {
+            let (w2, dw2) = (self.w[2][k], self.dw[2][k]);
+            for j in 0..N {
+                let (r, w1) = (k * N + j, self.w[1][j]);
+                rows.first[r] = layer + j * stride[1];
+                rows.q[r] = w1 * w2;
+                rows.gyz[r] = D::yz(self.dw[1][j] * w2, w1 * dw2);
+            }
+            layer += stride[2];
         }
-    }
-
-    /// Number of rows of `N` nodes along x: `N` in 2D, `N * N` in 3D.
-    #[inline(always)]
-    pub fn rows<D: Dim>() -> usize {
-        if D::D == 3 { N * N } else { N }
+        rows
     }
 
     /// Index of the first node of the row at offsets `j` (y) and `k` (z) from the base; in 2D
@@ -176,20 +183,22 @@ impl<const N: usize> Stencil<N> {
             first
         }
     }
+}
 
-    /// Row `r` as [`for_each_row`](Self::for_each_row) passes it: (first node, q, g_yz).
-    /// Loops over `0..rows()` calling this compile to straight code where a closure called
-    /// from many unrolled sites may be left out of line (found in 3D uGIMP).
-    #[inline(always)]
-    pub fn row<D: Dim>(&self, stride: &[usize; 3], r: usize) -> (usize, f64, D::Vec) {
-        let (j, k) = (r % N, r / N);
-        let (w1, w2) = (self.w[1][j], self.w[2][k]);
-        (
-            self.first_node::<D>(stride, j, k),
-            w1 * w2,
-            D::yz(self.dw[1][j] * w2, w1 * self.dw[2][k]),
-        )
-    }
+/// A stencil's rows of nodes along x: node `i` of row `r` is `first[r] + i`, with weight
+/// `w[0][i] * q[r]` and gradient `dw[0][i] * q[r] * x̂ + w[0][i] * gyz[r]`. Hot loops factor
+/// their per-row work out of the per-node work this way; the table is built once per
+/// particle so those loops index it without dividing a row number into (j, k).
+#[derive(Clone, Copy, Debug)]
+pub struct Rows<D: Dim> {
+    /// Number of rows: `N` in 2D, `N * N` in 3D.
+    pub len: usize,
+    /// First node of each row.
+    pub first: [usize; 9],
+    /// Weight factor of each row, w_y w_z.
+    pub q: [f64; 9],
+    /// Gradient factor of each row, (0, dw_y w_z, w_y dw_z).
+    pub gyz: [D::Vec; 9],
 }
 
 /// Every particle's stencil, evaluated once after the particles move and read by each

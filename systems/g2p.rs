@@ -97,10 +97,11 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
                 x_w.set(i, x_w.get(i) + vn * dt);
                 u_w.set(i, u_w.get(i) + vn * dt);
                 let mv = v * pmass[i];
-                for r in 0..Stencil::<N>::rows::<D>() {
-                    let (row, q, _) = st.row::<D>(stride, r);
-                    let mvq = mv * q;
-                    momentum_w.add_run(row, std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a]));
+                let rows = st.rows::<D>(stride);
+                for r in 0..rows.len {
+                    let mvq = mv * rows.q[r];
+                    let m = std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a]);
+                    momentum_w.add_run(rows.first[r], m);
                 }
             }
             if track {
@@ -132,8 +133,9 @@ fn gather<D: Dim, const N: usize>(
     stride: &[usize; 3],
 ) -> (D::Vec, D::Vec) {
     let (mut dv, mut vn) = (D::zero(), D::zero());
-    for r in 0..Stencil::<N>::rows::<D>() {
-        let (row, q, _) = st.row::<D>(stride, r);
+    let rows = st.rows::<D>(stride);
+    for r in 0..rows.len {
+        let row = rows.first[r];
         let (mut da, mut dn) = (D::zero(), D::zero());
         // One bounds check per row and column: each slice has N nodes.
         let (acc, vel) = (&accel[row..row + N], &velocity[row..row + N]);
@@ -142,8 +144,8 @@ fn gather<D: Dim, const N: usize>(
             da += acc[a] * w;
             dn += vel[a] * w;
         }
-        dv += da * q;
-        vn += dn * q;
+        dv += da * rows.q[r];
+        vn += dn * rows.q[r];
     }
     (dv, vn)
 }

@@ -50,7 +50,9 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
             }
             let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
-            st.for_each_row::<D>(&geom.stride, |row, q, _| {
+            let rows = st.rows::<D>(&geom.stride);
+            for r in 0..rows.len {
+                let (row, q) = (rows.first[r], rows.q[r]);
                 let (mq, mvq) = (m * q, mv * q);
                 // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
                 // tile is handled by one thread.
@@ -58,7 +60,7 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
                     mass_w.add_run(row, std::array::from_fn::<_, N, _>(|a| mq * st.w[0][a]));
                     momentum_w.add_run(row, std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a]));
                 }
-            });
+            }
             if FORCE {
                 // SAFETY: as above.
                 unsafe { add_internal_force::<D, N>(&st, &geom.stride, &p.stress[i], p.volume[i], &force_w) };
@@ -85,13 +87,13 @@ pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
 ) {
     let vol = -volume;
     let sx = D::stress_dot(s, D::unit_x()) * vol;
-    for r in 0..Stencil::<N>::rows::<D>() {
-        let (row, q, gyz) = st.row::<D>(stride, r);
-        let sxq = sx * q;
-        let syz = D::stress_dot(s, gyz) * vol;
+    let rows = st.rows::<D>(stride);
+    for r in 0..rows.len {
+        let sxq = sx * rows.q[r];
+        let syz = D::stress_dot(s, rows.gyz[r]) * vol;
         let f = std::array::from_fn::<_, N, _>(|a| sxq * st.dw[0][a] + syz * st.w[0][a]);
         // SAFETY: the caller guarantees exclusive access to these nodes.
-        unsafe { force.add_run(row, f) };
+        unsafe { force.add_run(rows.first[r], f) };
     }
 }
 

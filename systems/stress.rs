@@ -120,15 +120,16 @@ pub(crate) fn velocity_gradient<D: Dim, const N: usize>(
     stride: &[usize; 3],
 ) -> D::Mat {
     let mut l = D::mat_zero();
-    for r in 0..Stencil::<N>::rows::<D>() {
-        let (row, q, gyz) = st.row::<D>(stride, r);
+    let rows = st.rows::<D>(stride);
+    for r in 0..rows.len {
+        let row = rows.first[r];
         let (mut vd, mut vw) = (D::zero(), D::zero());
         // One bounds check per row: the slice has N nodes.
         for (a, &v) in velocity[row..row + N].iter().enumerate() {
             vd += v * st.dw[0][a];
             vw += v * st.w[0][a];
         }
-        l = D::add_row(l, vd, q, vw, gyz);
+        l = D::add_row(l, vd, rows.q[r], vw, rows.gyz[r]);
     }
     l
 }
