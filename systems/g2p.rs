@@ -4,7 +4,7 @@
 use crate::dim::Dim;
 use crate::disjoint::Disjoint;
 use crate::particles::Particles;
-use crate::shape::Stencil;
+use crate::shape::{Rows, Stencil};
 use crate::systems::p2g::scatter_coded;
 use crate::with_nodes;
 use crate::world::{CHUNK, World};
@@ -38,7 +38,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                     continue;
                 }
                 let st = Stencil::<N>::cached::<D>(stencils, i);
-                let (dv, vn) = gather::<D, N>(&st, nodal, &grid.geom.stride);
+                let (dv, vn) = gather::<D, N>(&st, &st.rows::<D>(&grid.geom.stride), nodal);
                 v[k] += dv * dt;
                 x[k] += vn * dt;
                 u[k] += vn * dt;
@@ -87,7 +87,8 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
                 continue;
             }
             let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
-            let (dv, vn) = gather::<D, N>(&st, nodal, stride);
+            let rows = st.rows::<D>(stride);
+            let (dv, vn) = gather::<D, N>(&st, &rows, nodal);
             // SAFETY: every particle is in exactly one tile and each tile is handled by one
             // thread, so no other thread touches particle i's entries; tiles of one colour
             // class touch disjoint nodes (tiles.rs).
@@ -97,7 +98,6 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
                 x_w.set(i, x_w.get(i) + vn * dt);
                 u_w.set(i, u_w.get(i) + vn * dt);
                 let mv = v * pmass[i];
-                let rows = st.rows::<D>(stride);
                 for r in 0..rows.len {
                     let mvq = mv * rows.q[r];
                     let m = std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a]);
@@ -129,11 +129,10 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
 #[inline(always)]
 fn gather<D: Dim, const N: usize>(
     st: &Stencil<N>,
+    rows: &Rows<D>,
     (accel, velocity): (&[D::Vec], &[D::Vec]),
-    stride: &[usize; 3],
 ) -> (D::Vec, D::Vec) {
     let (mut dv, mut vn) = (D::zero(), D::zero());
-    let rows = st.rows::<D>(stride);
     for r in 0..rows.len {
         let row = rows.first[r];
         let (mut da, mut dn) = (D::zero(), D::zero());

@@ -6,7 +6,7 @@ use crate::dim::Dim;
 use crate::disjoint::Disjoint;
 use crate::grid::Grid;
 use crate::particles::Particles;
-use crate::shape::{ShapeKind, Stencil, StencilCache};
+use crate::shape::{Rows, ShapeKind, Stencil, StencilCache};
 use crate::sym::Sym3;
 use crate::with_nodes;
 use crate::world::World;
@@ -63,7 +63,7 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
             }
             if FORCE {
                 // SAFETY: as above.
-                unsafe { add_internal_force::<D, N>(&st, &geom.stride, &p.stress[i], p.volume[i], &force_w) };
+                unsafe { add_internal_force::<D, N>(&st, &rows, &p.stress[i], p.volume[i], &force_w) };
             }
         })
     });
@@ -80,14 +80,13 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
 #[inline(always)]
 pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
     st: &Stencil<N>,
-    stride: &[usize; 3],
+    rows: &Rows<D>,
     s: &Sym3,
     volume: f64,
     force: &Disjoint<D::Vec>,
 ) {
     let vol = -volume;
     let sx = D::stress_dot(s, D::unit_x()) * vol;
-    let rows = st.rows::<D>(stride);
     for r in 0..rows.len {
         let sxq = sx * rows.q[r];
         let syz = D::stress_dot(s, rows.gyz[r]) * vol;

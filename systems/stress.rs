@@ -5,7 +5,7 @@
 use crate::dim::Dim;
 use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
-use crate::shape::Stencil;
+use crate::shape::{Rows, Stencil};
 use crate::sym::Sym3;
 use crate::with_nodes;
 use crate::world::{CHUNK, World};
@@ -40,7 +40,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
                 continue;
             }
             let st = Stencil::<N>::cached::<D>(stencils, i);
-            let l = velocity_gradient::<D, N>(&st, &grid.velocity, stride);
+            let l = velocity_gradient::<D, N>(&st, &st.rows::<D>(stride), &grid.velocity);
             let m = &materials[material[i] as usize];
             let grads = grads.as_mut().map(|(gv, gu)| (&mut gv[k], &mut gu[k]));
             apply::<D>(l, dt, plane, m, &mut s[k], grads);
@@ -116,11 +116,10 @@ pub(crate) fn apply<D: Dim>(
 #[inline(always)]
 pub(crate) fn velocity_gradient<D: Dim, const N: usize>(
     st: &Stencil<N>,
+    rows: &Rows<D>,
     velocity: &[D::Vec],
-    stride: &[usize; 3],
 ) -> D::Mat {
     let mut l = D::mat_zero();
-    let rows = st.rows::<D>(stride);
     for r in 0..rows.len {
         let row = rows.first[r];
         let (mut vd, mut vw) = (D::zero(), D::zero());

@@ -48,7 +48,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) -> Result<(), Unstable> 
         }
         with_nodes!(shape, N => {
             let st = Stencil::<N>::from_cache::<D>(b, w);
-            let l = velocity_gradient::<D, N>(&st, velocity, stride);
+            let l = velocity_gradient::<D, N>(&st, &st.rows::<D>(stride), velocity);
             let m = &materials[material[i] as usize];
             // SAFETY: `place` visits every particle once, on one thread.
             unsafe {

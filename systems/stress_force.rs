@@ -52,7 +52,8 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
                 continue;
             }
             let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
-            let l = velocity_gradient::<D, N>(&st, velocity, stride);
+            let rows = st.rows::<D>(stride);
+            let l = velocity_gradient::<D, N>(&st, &rows, velocity);
             let m = &materials[material[i] as usize];
             // SAFETY: every particle is in exactly one tile and each tile is handled by one
             // thread, so no other thread touches particle i's entries; tiles of one colour
@@ -68,7 +69,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
                     apply::<D>(l, dt, plane, m, &mut s, None);
                 }
                 stress_w.set(i, s);
-                add_internal_force::<D, N>(&st, stride, &s, volume[i], &force_w);
+                add_internal_force::<D, N>(&st, &rows, &s, volume[i], &force_w);
             }
         })
     });
