@@ -49,32 +49,34 @@ impl ShapeKind {
     /// 1D weights on one axis: first node index, weights and d/dx for the stencil's nodes.
     /// `xi` is the position in cell units from the grid origin, `l` the half-width in cell
     /// units, `inv_h` the inverse cell size. Callers ensure the stencil [`fits`](Self::fits),
-    /// so every floor below is of a non-negative number and truncation computes it cheaply.
+    /// so every floor below is of a non-negative number and truncation computes it cheaply
+    /// (through i64, whose conversions to and from f64 are single instructions on x86-64
+    /// where usize's are not).
     #[inline(always)]
     pub fn axis(self, xi: f64, l: f64, inv_h: f64) -> (usize, [f64; 3], [f64; 3]) {
         match self {
             ShapeKind::Linear => {
-                let base = xi as usize;
+                let base = xi as i64;
                 let f = xi - base as f64;
-                (base, [1.0 - f, f, 0.0], [-inv_h, inv_h, 0.0])
+                (base as usize, [1.0 - f, f, 0.0], [-inv_h, inv_h, 0.0])
             }
             ShapeKind::Ugimp => {
-                let base = (xi - l) as usize;
+                let base = (xi - l) as i64;
                 let r = xi - base as f64;
                 // The middle node by partition of unity (weights sum to 1, derivatives to 0).
                 let ((s0, g0), (s2, g2)) = (gimp_1d(r, l), gimp_1d(r - 2.0, l));
                 (
-                    base,
+                    base as usize,
                     [s0, 1.0 - s0 - s2, s2],
                     [g0 * inv_h, -(g0 + g2) * inv_h, g2 * inv_h],
                 )
             }
             ShapeKind::Bspline => {
-                let base = (xi - 0.5) as usize;
+                let base = (xi - 0.5) as i64;
                 let f = xi - base as f64;
                 let (a, b, c) = (1.5 - f, f - 1.0, f - 0.5);
                 (
-                    base,
+                    base as usize,
                     [0.5 * a * a, 0.75 - b * b, 0.5 * c * c],
                     [-a * inv_h, -2.0 * b * inv_h, c * inv_h],
                 )

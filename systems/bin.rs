@@ -69,7 +69,9 @@ pub(crate) fn place<D: Dim>(
                         if !S.fits(xi, l, geom.cells[a]) {
                             return (Some(i), true);
                         }
-                        tile += cell_part[a][xi as usize];
+                        // A non-negative cell index (fits), converted through i64 (see
+                        // ShapeKind::axis).
+                        tile += cell_part[a][xi as i64 as usize];
                         let (first, sw, sdw) = S.axis(xi, l, geom.inv_h[a]);
                         b[a] = first as u32;
                         w[6 * a..6 * a + 3].copy_from_slice(&sw);
