@@ -5,6 +5,8 @@
 //! scatter systems use this to write grid and particle columns from several threads
 //! without atomics or locks, in a fixed order.
 
+use crate::dim::Dim;
+use crate::shape::Rows;
 use std::marker::PhantomData;
 use std::ops::AddAssign;
 
@@ -54,21 +56,28 @@ impl<'a, T: Copy> Disjoint<'a, T> {
         unsafe { *self.ptr.add(i) = value };
     }
 
-    /// Adds `values[a]` to entry `start + a` for every `a`: one bounds check for the run
-    /// (a stencil row's nodes are consecutive entries).
+    /// Adds `value(r)[a]` to entry `rows.first[r] + a` for every row `r` of a stencil's
+    /// [`Rows`] and every `a < N` (a row's nodes are consecutive entries), with one bounds
+    /// check for the whole stencil: its last row ends highest.
     ///
     /// # Safety
-    /// No other thread may access entries `start..start + N` during the call.
+    /// No other thread may access the stencil's entries during the call.
     #[inline(always)]
-    pub unsafe fn add_run<const N: usize>(&self, start: usize, values: [T; N])
-    where
+    pub unsafe fn add_rows<D: Dim, const N: usize>(
+        &self,
+        rows: &Rows<D>,
+        mut value: impl FnMut(usize) -> [T; N],
+    ) where
         T: AddAssign,
     {
-        assert!(start < self.len && N <= self.len - start);
-        for (a, v) in values.into_iter().enumerate() {
-            // SAFETY: start + a < start + N <= len (checked above); the caller guarantees
-            // exclusive access.
-            unsafe { *self.ptr.add(start + a) += v };
+        assert!(rows.end(N) <= self.len);
+        for r in 0..rows.len {
+            debug_assert!(r == 0 || rows.first[r] >= rows.first[r - 1] + N);
+            for (a, v) in value(r).into_iter().enumerate() {
+                // SAFETY: first[r] + a < first[r] + N <= end(N) <= len (checked above); the
+                // caller guarantees exclusive access.
+                unsafe { *self.ptr.add(rows.first[r] + a) += v };
+            }
         }
     }
 }

@@ -203,6 +203,15 @@ pub struct Rows<D: Dim> {
     pub gyz: [D::Vec; 9],
 }
 
+impl<D: Dim> Rows<D> {
+    /// One past the last node of the stencil, whose rows of `n` nodes come in increasing
+    /// node order.
+    #[inline(always)]
+    pub fn end(&self, n: usize) -> usize {
+        self.first[self.len - 1] + n
+    }
+}
+
 /// Every particle's stencil, evaluated once after the particles move and read by each
 /// system that needs it until they move again (up to four times a step).
 #[derive(Clone, Debug, Default)]

@@ -98,11 +98,10 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
                 x_w.set(i, x_w.get(i) + vn * dt);
                 u_w.set(i, u_w.get(i) + vn * dt);
                 let mv = v * pmass[i];
-                for r in 0..rows.len {
+                momentum_w.add_rows(&rows, |r| {
                     let mvq = mv * rows.q[r];
-                    let m = std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a]);
-                    momentum_w.add_run(rows.first[r], m);
-                }
+                    std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a])
+                });
             }
             if track {
                 fastest = fastest.max(D::dot(vn, vn));

@@ -51,15 +51,17 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
             let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
             let rows = st.rows::<D>(&geom.stride);
-            for r in 0..rows.len {
-                let (row, q) = (rows.first[r], rows.q[r]);
-                let (mq, mvq) = (m * q, mv * q);
-                // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
-                // tile is handled by one thread.
-                unsafe {
-                    mass_w.add_run(row, std::array::from_fn::<_, N, _>(|a| mq * st.w[0][a]));
-                    momentum_w.add_run(row, std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a]));
-                }
+            // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
+            // tile is handled by one thread.
+            unsafe {
+                mass_w.add_rows(&rows, |r| {
+                    let mq = m * rows.q[r];
+                    std::array::from_fn::<_, N, _>(|a| mq * st.w[0][a])
+                });
+                momentum_w.add_rows(&rows, |r| {
+                    let mvq = mv * rows.q[r];
+                    std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a])
+                });
             }
             if FORCE {
                 // SAFETY: as above.
@@ -87,13 +89,14 @@ pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
 ) {
     let vol = -volume;
     let sx = D::stress_dot(s, D::unit_x()) * vol;
-    for r in 0..rows.len {
-        let sxq = sx * rows.q[r];
-        let syz = D::stress_dot(s, rows.gyz[r]) * vol;
-        let f = std::array::from_fn::<_, N, _>(|a| sxq * st.dw[0][a] + syz * st.w[0][a]);
-        // SAFETY: the caller guarantees exclusive access to these nodes.
-        unsafe { force.add_run(rows.first[r], f) };
-    }
+    // SAFETY: the caller guarantees exclusive access to these nodes.
+    unsafe {
+        force.add_rows(rows, |r| {
+            let sxq = sx * rows.q[r];
+            let syz = D::stress_dot(s, rows.gyz[r]) * vol;
+            std::array::from_fn::<_, N, _>(|a| sxq * st.dw[0][a] + syz * st.w[0][a])
+        })
+    };
 }
 
 /// The scatter of the particles near a crack, each pair into its field's grid entry
