@@ -21,7 +21,7 @@ pub enum ShapeKind {
 
 impl ShapeKind {
     /// Nodes per axis in a stencil.
-    pub fn nodes(self) -> usize {
+    pub const fn nodes(self) -> usize {
         match self {
             ShapeKind::Linear => 2,
             ShapeKind::Ugimp | ShapeKind::Bspline => 3,
@@ -46,37 +46,72 @@ impl ShapeKind {
         lo >= 0.0 && lo < (cells + 2 - self.nodes()) as f64
     }
 
-    /// 1D weights on one axis: first node index, weights and d/dx for the stencil's nodes.
-    /// `xi` is the position in cell units from the grid origin, `l` the half-width in cell
-    /// units, `inv_h` the inverse cell size. Callers ensure the stencil [`fits`](Self::fits),
-    /// so every floor below is of a non-negative number and truncation computes it cheaply
-    /// (through i64, whose conversions to and from f64 are single instructions on x86-64
-    /// where usize's are not).
+    /// Values per axis the [`StencilCache`] keeps: what [`expand`](Self::expand) rebuilds
+    /// the weights and derivatives from, exactly (a quarter to a sixth of storing them).
+    pub const fn params(self) -> usize {
+        match self {
+            ShapeKind::Linear | ShapeKind::Bspline => 1,
+            ShapeKind::Ugimp => 4,
+        }
+    }
+
+    /// The stencil on one axis: its first node and the parameters its weights follow from
+    /// (the fraction of a cell for linear and B-spline; the two outer weights and their
+    /// derivatives per cell unit for uGIMP). `xi` is the position in cell units from the
+    /// grid origin, `l` the half-width in cell units. Callers ensure the stencil
+    /// [`fits`](Self::fits), so every floor below is of a non-negative number and
+    /// truncation computes it cheaply (through i64, whose conversions to and from f64 are
+    /// single instructions on x86-64 where usize's are not).
     #[inline(always)]
-    pub fn axis(self, xi: f64, l: f64, inv_h: f64) -> (usize, [f64; 3], [f64; 3]) {
+    pub fn locate(self, xi: f64, l: f64) -> (usize, [f64; 4]) {
         match self {
             ShapeKind::Linear => {
                 let base = xi as i64;
-                let f = xi - base as f64;
-                (base as usize, [1.0 - f, f, 0.0], [-inv_h, inv_h, 0.0])
+                (base as usize, [xi - base as f64, 0.0, 0.0, 0.0])
             }
             ShapeKind::Ugimp => {
                 let base = (xi - l) as i64;
                 let r = xi - base as f64;
-                // The middle node by partition of unity (weights sum to 1, derivatives to 0).
                 let ((s0, g0), (s2, g2)) = (gimp_1d(r, l), gimp_1d(r - 2.0, l));
+                (base as usize, [s0, s2, g0, g2])
+            }
+            ShapeKind::Bspline => {
+                let base = (xi - 0.5) as i64;
+                (base as usize, [xi - base as f64, 0.0, 0.0, 0.0])
+            }
+        }
+    }
+
+    /// First node, 1D weights and d/dx of the stencil on one axis ([`locate`](Self::locate)
+    /// then [`expand`](Self::expand)).
+    #[inline(always)]
+    pub fn axis(self, xi: f64, l: f64, inv_h: f64) -> (usize, [f64; 3], [f64; 3]) {
+        let (base, p) = self.locate(xi, l);
+        let (w, dw) = self.expand(&p, inv_h);
+        (base, w, dw)
+    }
+
+    /// 1D weights and d/dx (`inv_h` the inverse cell size) of the stencil's nodes on one
+    /// axis from the parameters of [`locate`](Self::locate).
+    #[inline(always)]
+    pub fn expand(self, p: &[f64], inv_h: f64) -> ([f64; 3], [f64; 3]) {
+        match self {
+            ShapeKind::Linear => {
+                let f = p[0];
+                ([1.0 - f, f, 0.0], [-inv_h, inv_h, 0.0])
+            }
+            ShapeKind::Ugimp => {
+                let (s0, s2, g0, g2) = (p[0], p[1], p[2], p[3]);
+                // The middle node by partition of unity (weights sum to 1, derivatives to 0).
                 (
-                    base as usize,
                     [s0, 1.0 - s0 - s2, s2],
                     [g0 * inv_h, -(g0 + g2) * inv_h, g2 * inv_h],
                 )
             }
             ShapeKind::Bspline => {
-                let base = (xi - 0.5) as i64;
-                let f = xi - base as f64;
+                let f = p[0];
                 let (a, b, c) = (1.5 - f, f - 1.0, f - 0.5);
                 (
-                    base as usize,
                     [0.5 * a * a, 0.75 - b * b, 0.5 * c * c],
                     [-a * inv_h, -2.0 * b * inv_h, c * inv_h],
                 )
@@ -213,76 +248,85 @@ impl<D: Dim> Rows<D> {
 }
 
 /// Every particle's stencil, evaluated once after the particles move and read by each
-/// system that needs it until they move again (up to four times a step).
+/// system that needs it until they move again (up to four times a step): per axis the
+/// first node and the shape's [`params`](ShapeKind::params), from which the weights and
+/// derivatives are rebuilt on reading. Keeping the parameters instead of the weights
+/// shrinks what the passes over the particles stream from memory.
 #[derive(Clone, Debug, Default)]
 pub struct StencilCache {
     /// First node per axis of each particle.
     pub base: Vec<[u32; 3]>,
-    /// Per particle and axis: three weights then three derivatives (1/m).
-    pub weights: Vec<f64>,
+    /// Per particle and axis: the shape's parameters.
+    pub params: Vec<f64>,
+    /// Inverse cell size per axis (1/m).
+    pub inv_h: [f64; 3],
 }
 
 impl StencilCache {
-    /// Cached values per particle: three weights and three derivatives per axis.
-    pub fn per<D: Dim>() -> usize {
-        6 * D::D
+    /// Cached parameters per particle for `shape` in `D` dimensions.
+    pub const fn per<D: Dim>(shape: ShapeKind) -> usize {
+        shape.params() * D::D
     }
 
-    /// Sizes the cache for `n` particles and lends its columns for `bin` to fill.
-    pub fn resize<D: Dim>(&mut self, n: usize) -> (&mut [[u32; 3]], &mut [f64]) {
+    /// Sizes the cache for `n` particles of `shape` on a grid of inverse cell size `inv_h`
+    /// and lends its columns for `bin` to fill.
+    pub fn resize<D: Dim>(
+        &mut self,
+        n: usize,
+        shape: ShapeKind,
+        inv_h: D::Vec,
+    ) -> (&mut [[u32; 3]], &mut [f64]) {
+        for a in 0..D::D {
+            self.inv_h[a] = inv_h[a];
+        }
         self.base.resize(n, [0; 3]);
-        self.weights.resize(n * Self::per::<D>(), 0.0);
-        (&mut self.base, &mut self.weights)
+        self.params.resize(n * Self::per::<D>(shape), 0.0);
+        (&mut self.base, &mut self.params)
     }
 }
 
 impl<const N: usize> Stencil<N> {
-    /// The cached stencil of particle `i`.
+    /// The cached stencil of particle `i` for shape `s` (whose nodes per axis are `N`).
     #[inline(always)]
-    pub fn cached<D: Dim>(cache: &StencilCache, i: usize) -> Self {
-        let per = StencilCache::per::<D>();
-        Self::from_cache::<D>(cache.base[i], &cache.weights[i * per..(i + 1) * per])
+    pub fn cached<D: Dim>(s: ShapeKind, cache: &StencilCache, i: usize) -> Self {
+        let per = StencilCache::per::<D>(s);
+        Self::from_cache::<D>(
+            s,
+            cache.base[i],
+            &cache.params[i * per..(i + 1) * per],
+            &cache.inv_h,
+        )
     }
 
-    /// A stencil from one particle's cache entries: its first nodes and its
-    /// [`per`](StencilCache::per) weights and derivatives.
+    /// A stencil of shape `s` from one particle's cache entries: its first nodes and its
+    /// [`per`](StencilCache::per) parameters, on a grid of inverse cell size `inv_h`.
     #[inline(always)]
-    pub fn from_cache<D: Dim>(b: [u32; 3], src: &[f64]) -> Self {
+    pub fn from_cache<D: Dim>(s: ShapeKind, b: [u32; 3], src: &[f64], inv_h: &[f64; 3]) -> Self {
+        debug_assert_eq!(s.nodes(), N);
         let mut st = Stencil {
             base: [b[0] as usize, b[1] as usize, b[2] as usize],
             w: [[1.0, 0.0, 0.0]; 3],
             dw: [[0.0; 3]; 3],
         };
+        let p = s.params();
         for a in 0..D::D {
-            st.w[a].copy_from_slice(&src[6 * a..6 * a + 3]);
-            st.dw[a].copy_from_slice(&src[6 * a + 3..6 * a + 6]);
+            (st.w[a], st.dw[a]) = s.expand(&src[p * a..p * (a + 1)], inv_h[a]);
         }
         st
     }
 }
 
-/// Calls `$body` with the const `$n` bound to the shape's nodes per axis (2 or 3), so
-/// stencil loops are unrolled for each shape function.
-#[macro_export]
-macro_rules! with_nodes {
-    ($shape:expr, $n:ident => $body:expr) => {
-        match $shape.nodes() {
-            2 => {
-                const $n: usize = 2;
-                $body
-            }
-            _ => {
-                const $n: usize = 3;
-                $body
-            }
-        }
-    };
-}
-
-/// Evaluates `$body` with the const `$s` bound to the shape function, so the compiler
-/// specialises per-particle shape code (no match on the kind inside a particle loop).
+/// Evaluates `$body` with the const `$s` bound to the shape function (and `$n` to its nodes
+/// per axis), so the compiler specialises per-particle shape code and unrolls stencil
+/// loops (no match on the kind inside a particle loop).
 #[macro_export]
 macro_rules! with_shape {
+    ($shape:expr, $s:ident, $n:ident => $body:expr) => {
+        $crate::with_shape!($shape, $s => {
+            const $n: usize = $s.nodes();
+            $body
+        })
+    };
     ($shape:expr, $s:ident => $body:expr) => {
         match $shape {
             $crate::shape::ShapeKind::Linear => {

@@ -6,7 +6,7 @@ use crate::grid::Grid;
 use crate::loads::{Load, VelocityBc};
 use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
-use crate::shape::ShapeKind;
+use crate::shape::{ShapeKind, StencilCache};
 use crate::tiles::Tiles;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -128,9 +128,10 @@ impl<D: Dim> World<D> {
     }
 
     /// Bytes held per particle: the particle columns plus the bins (tile and order, 4 bytes
-    /// each) and the cached stencil (12 bytes of base plus 48 per axis).
+    /// each) and the cached stencil (12 bytes of base plus the shape's parameters).
     pub fn bytes_per_particle(&self) -> usize {
-        self.particles.bytes_per_particle() + 8 + 12 + 48 * D::D
+        let params = StencilCache::per::<D>(self.settings.shape);
+        self.particles.bytes_per_particle() + 8 + 12 + 8 * params
     }
 
     /// Total linear momentum (kg m/s).

@@ -26,7 +26,7 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
 }
 
 /// Evaluates every particle's stencil and tile in one pass over particle chunks, calling
-/// `before(i, base, weights)` with particle `i`'s cached stencil just before it is
+/// `before(i, base, params)` with particle `i`'s cached stencil just before it is
 /// overwritten (so a system can fuse its last use of the old stencils into the binning),
 /// then sorts the tiles if any particle changed tile. Returns the first particle whose
 /// stencil leaves the grid (the bins are then left stale).
@@ -41,22 +41,22 @@ pub(crate) fn place<D: Dim>(
     let mut tile_of = std::mem::take(&mut tiles.tile_of);
     let sorted = tile_of.len() == x.len();
     tile_of.resize(x.len(), u32::MAX);
-    let per = StencilCache::per::<D>();
+    let per = StencilCache::per::<D>(shape);
     let cell_part = &tiles.cell_part;
-    let (base, weights) = tiles.stencils.resize::<D>(x.len());
+    let (base, params) = tiles.stencils.resize::<D>(x.len(), shape, geom.inv_h);
     // Per chunk: the first particle whose stencil leaves the grid, and whether any particle
     // changed tile.
     let chunks: Vec<(Option<usize>, bool)> = (
         tile_of.par_chunks_mut(CHUNK),
         base.par_chunks_mut(CHUNK),
-        weights.par_chunks_mut(CHUNK * per),
+        params.par_chunks_mut(CHUNK * per),
     )
         .into_par_iter()
         .enumerate()
-        .map(|(c, (out, base, weights))| {
+        .map(|(c, (out, base, params))| {
             with_shape!(shape, S => {
-                let mut moved = false;
-                let rows = base.iter_mut().zip(weights.chunks_exact_mut(per));
+                let (mut moved, p) = (false, S.params());
+                let rows = base.iter_mut().zip(params.chunks_exact_mut(per));
                 for (k, (t, (b, w))) in out.iter_mut().zip(rows).enumerate() {
                     let i = c * CHUNK + k;
                     before(i, *b, w);
@@ -72,10 +72,9 @@ pub(crate) fn place<D: Dim>(
                         // A non-negative cell index (fits), converted through i64 (see
                         // ShapeKind::axis).
                         tile += cell_part[a][xi as i64 as usize];
-                        let (first, sw, sdw) = S.axis(xi, l, geom.inv_h[a]);
+                        let (first, sp) = S.locate(xi, l);
                         b[a] = first as u32;
-                        w[6 * a..6 * a + 3].copy_from_slice(&sw);
-                        w[6 * a + 3..6 * a + 6].copy_from_slice(&sdw);
+                        w[p * a..p * (a + 1)].copy_from_slice(&sp[..p]);
                     }
                     moved |= tile != *t;
                     *t = tile;

@@ -14,7 +14,7 @@ use crate::dim::Dim;
 use crate::grid::GridGeom;
 use crate::shape::{ShapeKind, Stencil, StencilCache};
 use crate::tiles::Tiles;
-use crate::with_nodes;
+use crate::with_shape;
 use crate::world::World;
 use std::collections::HashMap;
 
@@ -338,8 +338,8 @@ impl<D: Dim> Pass<'_, D> {
         let i = rec.watched[j] as usize;
         let masks = &mut rec.masks[j * per..(j + 1) * per];
         let clear = rec.budget[j] > f64::NEG_INFINITY || self.stencils.base[i] != rec.base[j];
-        let clearance = with_nodes!(self.shape, N => {
-            let st = Stencil::<N>::cached::<D>(self.stencils, i);
+        let clearance = with_shape!(self.shape, S, N => {
+            let st = Stencil::<N>::cached::<D>(S, self.stencils, i);
             self.classify_one(xp, &st, clear, s, masks)
         });
         rec.crosses[j] = masks.iter().any(|&m| m != 0);
@@ -434,8 +434,8 @@ impl<D: Dim> Pass<'_, D> {
             }
             let masks = &rec.masks[j * per..(j + 1) * per];
             let mut any = false;
-            with_nodes!(self.shape, N => {
-                let st = Stencil::<N>::cached::<D>(self.stencils, i as usize);
+            with_shape!(self.shape, S, N => {
+                let st = Stencil::<N>::cached::<D>(S, self.stencils, i as usize);
                 let mut l = 0;
                 st.for_each::<D>(&geom.stride, |n, w, _| {
                     let m = if w != 0.0 { masks[l] } else { 0 };

@@ -7,7 +7,7 @@
 use crate::crack::Law;
 use crate::dim::Dim;
 use crate::shape::Stencil;
-use crate::with_nodes;
+use crate::with_shape;
 use crate::world::World;
 use std::collections::HashMap;
 
@@ -78,8 +78,8 @@ fn nodal_displacements<D: Dim>(world: &World<D>) -> HashMap<usize, D::Vec> {
                             *d += mu * w;
                         }
                     };
-                    with_nodes!(shape, N => {
-                        let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
+                    with_shape!(shape, S, N => {
+                        let st = Stencil::<N>::cached::<D>(S, &tiles.stencils, i);
                         match f.targets_of(i) {
                             Some(ts) => st.for_each_target::<D>(&geom.stride, ts, |n, w, _| add(n, w)),
                             None => st.for_each::<D>(&geom.stride, |n, w, _| add(n, w)),

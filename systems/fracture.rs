@@ -7,7 +7,7 @@ use crate::crack::{Crack, Cracks};
 use crate::dim::Dim;
 use crate::fracture::{FracturePlan, PathResult, TipResult, k_from_g};
 use crate::shape::Stencil;
-use crate::with_nodes;
+use crate::with_shape;
 use crate::world::World;
 use std::collections::HashMap;
 
@@ -293,8 +293,8 @@ fn contour_j<D: Dim>(
         // Only the area term needs the particles inside the contour.
         let inside = area_term && x[0] > lo[0] && x[0] < hi[0] && x[1] > lo[1] && x[1] < hi[1];
         let mut accel = [0.0; 2];
-        with_nodes!(shape, N => {
-            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
+        with_shape!(shape, S, N => {
+            let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
             let mut visit = |entry: usize, w: f64| {
                 if let Some(a) = acc.get_mut(&entry) {
                     for (a, f) in a.iter_mut().zip(&f) {

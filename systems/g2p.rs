@@ -6,7 +6,7 @@ use crate::disjoint::Disjoint;
 use crate::particles::Particles;
 use crate::shape::{Rows, Stencil};
 use crate::systems::p2g::scatter_coded;
-use crate::with_nodes;
+use crate::with_shape;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
@@ -31,13 +31,13 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         .enumerate()
         .map(|(c, (x, v, u))| {
             let mut fastest = 0.0f64;
-            with_nodes!(shape, N => for k in 0..x.len() {
+            with_shape!(shape, S, N => for k in 0..x.len() {
                 let i = c * CHUNK + k;
                 // Particles near a crack move afterwards.
                 if fields.is_some_and(|f| f.is_coded(i)) {
                     continue;
                 }
-                let st = Stencil::<N>::cached::<D>(stencils, i);
+                let st = Stencil::<N>::cached::<D>(S, stencils, i);
                 let (dv, vn) = gather::<D, N>(&st, &st.rows::<D>(&grid.geom.stride), nodal);
                 v[k] += dv * dt;
                 x[k] += vn * dt;
@@ -80,13 +80,13 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
     let stride = &grid.geom.stride;
     let fastest = tiles.max_coloured(|t| {
         let mut fastest = 0.0f64;
-        with_nodes!(shape, N => for &i in tiles.particles(t) {
+        with_shape!(shape, S, N => for &i in tiles.particles(t) {
             let i = i as usize;
             // Particles near a crack move, and are scattered field by field, afterwards.
             if fields.is_some_and(|f| f.is_coded(i)) {
                 continue;
             }
-            let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
+            let st = Stencil::<N>::cached::<D>(S, &tiles.stencils, i);
             let rows = st.rows::<D>(stride);
             let (dv, vn) = gather::<D, N>(&st, &rows, nodal);
             // SAFETY: every particle is in exactly one tile and each tile is handled by one
@@ -162,8 +162,8 @@ fn move_coded<D: Dim>(world: &mut World<D>) -> f64 {
         let i = i as usize;
         let targets = c.fields.targets_of(i).expect("coded particle");
         let (mut dv, mut vn) = (D::zero(), D::zero());
-        with_nodes!(shape, N => {
-            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
+        with_shape!(shape, S, N => {
+            let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
             st.for_each_target::<D>(&grid.geom.stride, targets, |n, w, _| {
                 dv += grid.accel[n] * w;
                 vn += grid.velocity[n] * w;

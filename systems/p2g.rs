@@ -8,7 +8,7 @@ use crate::grid::Grid;
 use crate::particles::Particles;
 use crate::shape::{Rows, ShapeKind, Stencil, StencilCache};
 use crate::sym::Sym3;
-use crate::with_nodes;
+use crate::with_shape;
 use crate::world::World;
 use rayon::prelude::*;
 
@@ -42,13 +42,13 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
     let geom = &grid.geom;
     let fields = world.cracks.as_ref().map(|c| &c.fields);
     world.tiles.for_each_coloured(|t| {
-        with_nodes!(shape, N => for &i in world.tiles.particles(t) {
+        with_shape!(shape, S, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
             // Particles near a crack are scattered field by field afterwards.
             if fields.is_some_and(|f| f.is_coded(i)) {
                 continue;
             }
-            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
+            let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
             let rows = st.rows::<D>(&geom.stride);
             // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
@@ -119,8 +119,8 @@ pub(crate) fn scatter_coded<D: Dim, const MASS: bool, const MOMENTUM: bool, cons
         let i = i as usize;
         let targets = fields.targets_of(i).expect("coded particle");
         let (m, mv, s, vol) = (p.mass[i], p.v[i] * p.mass[i], p.stress[i], p.volume[i]);
-        with_nodes!(shape, N => {
-            let st = Stencil::<N>::cached::<D>(stencils, i);
+        with_shape!(shape, S, N => {
+            let st = Stencil::<N>::cached::<D>(S, stencils, i);
             st.for_each_target::<D>(&geom.stride, targets, |n, w, g| {
                 if MASS {
                     mass[n] += m * w;
@@ -149,8 +149,8 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
         for (&i, &f) in load.particles.iter().zip(&load.forces) {
             let (i, f) = (i as usize, f * scale);
             let targets = world.cracks.as_ref().and_then(|c| c.fields.targets_of(i));
-            with_nodes!(shape, N => {
-                let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
+            with_shape!(shape, S, N => {
+                let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
                 match targets {
                     Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, w, _| {
                         world.grid.force[n] += f * w

@@ -7,7 +7,7 @@ use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
 use crate::shape::{Rows, Stencil};
 use crate::sym::Sym3;
-use crate::with_nodes;
+use crate::with_shape;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
@@ -33,13 +33,13 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let material = &*material;
     let stride = &grid.geom.stride;
     let body = |c: usize, s: &mut [Sym3], mut grads: Grads<D>| {
-        with_nodes!(shape, N => for k in 0..s.len() {
+        with_shape!(shape, S, N => for k in 0..s.len() {
             let i = c * CHUNK + k;
             // Particles near a crack are updated from their fields' entries afterwards.
             if fields.is_some_and(|f| f.is_coded(i)) {
                 continue;
             }
-            let st = Stencil::<N>::cached::<D>(stencils, i);
+            let st = Stencil::<N>::cached::<D>(S, stencils, i);
             let l = velocity_gradient::<D, N>(&st, &st.rows::<D>(stride), &grid.velocity);
             let m = &materials[material[i] as usize];
             let grads = grads.as_mut().map(|(gv, gu)| (&mut gv[k], &mut gu[k]));
@@ -81,8 +81,8 @@ pub(crate) fn update_coded<D: Dim>(world: &mut World<D>, dt: f64) {
         let i = i as usize;
         let targets = f.targets_of(i).expect("coded particle");
         let mut l = D::mat_zero();
-        with_nodes!(shape, N => {
-            let st = Stencil::<N>::cached::<D>(&world.tiles.stencils, i);
+        with_shape!(shape, S, N => {
+            let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
             st.for_each_target::<D>(&grid.geom.stride, targets, |n, _, g| {
                 l = l + D::outer(grid.velocity[n], g);
             });

@@ -10,7 +10,7 @@ use crate::particles::Particles;
 use crate::shape::Stencil;
 use crate::systems::bin::{outside, place};
 use crate::systems::stress::{apply, node_velocities, update_coded, velocity_gradient};
-use crate::with_nodes;
+use crate::with_shape;
 use crate::world::World;
 
 /// Updates every particle's stress over `fraction` of the step (as
@@ -42,12 +42,13 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) -> Result<(), Unstable> 
     );
     let (material, materials) = (&*material, &world.materials);
     let fields = world.cracks.as_ref().map(|c| &c.fields);
-    let update = |i: usize, b: [u32; 3], w: &[f64]| {
+    let inv_h = &world.tiles.stencils.inv_h.clone();
+    let update = |i: usize, b: [u32; 3], params: &[f64]| {
         if fields.is_some_and(|f| f.is_coded(i)) {
             return;
         }
-        with_nodes!(shape, N => {
-            let st = Stencil::<N>::from_cache::<D>(b, w);
+        with_shape!(shape, S, N => {
+            let st = Stencil::<N>::from_cache::<D>(S, b, params, inv_h);
             let l = velocity_gradient::<D, N>(&st, &st.rows::<D>(stride), velocity);
             let m = &materials[material[i] as usize];
             // SAFETY: `place` visits every particle once, on one thread.

@@ -9,7 +9,7 @@ use crate::particles::Particles;
 use crate::shape::Stencil;
 use crate::systems::p2g::{add_internal_force, scatter_coded};
 use crate::systems::stress::{apply, node_velocities, update_coded, velocity_gradient};
-use crate::with_nodes;
+use crate::with_shape;
 use crate::world::World;
 
 /// Updates every particle's stress over `fraction` of the step from grad v gathered off
@@ -45,13 +45,13 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let (tiles, materials) = (&world.tiles, &world.materials);
     let fields = world.cracks.as_ref().map(|c| &c.fields);
     tiles.for_each_coloured(|t| {
-        with_nodes!(shape, N => for &i in tiles.particles(t) {
+        with_shape!(shape, S, N => for &i in tiles.particles(t) {
             let i = i as usize;
             // Particles near a crack are updated and scattered field by field afterwards.
             if fields.is_some_and(|f| f.is_coded(i)) {
                 continue;
             }
-            let st = Stencil::<N>::cached::<D>(&tiles.stencils, i);
+            let st = Stencil::<N>::cached::<D>(S, &tiles.stencils, i);
             let rows = st.rows::<D>(stride);
             let l = velocity_gradient::<D, N>(&st, &rows, velocity);
             let m = &materials[material[i] as usize];

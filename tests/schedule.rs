@@ -84,7 +84,7 @@ fn fused_stress_bin_matches_stress_then_bin() {
                 w.particles.x,
                 w.tiles.order,
                 w.tiles.stencils.base,
-                w.tiles.stencils.weights
+                w.tiles.stencils.params
             )
         };
         assert!(bits(&fused) == bits(&apart), "{shape} {update}");
