@@ -45,7 +45,7 @@ impl Probe {
         for &i in &self.particles {
             let i = i as usize;
             sum += match self.qty {
-                ProbeQty::Displacement => p.u[i][self.comp],
+                ProbeQty::Displacement => p.displacement(i)[self.comp],
                 ProbeQty::Velocity => p.v[i][self.comp],
                 ProbeQty::Position => p.x[i][self.comp],
                 ProbeQty::Stress => p.stress[i].to_array()[self.comp],

@@ -10,8 +10,9 @@ pub struct Particles<D: Dim> {
     pub x: Vec<D::Vec>,
     /// Velocity (m/s).
     pub v: Vec<D::Vec>,
-    /// Displacement from the initial position (m).
-    pub u: Vec<D::Vec>,
+    /// Initial position (m); the displacement is `x - x0` (see
+    /// [`displacement`](Self::displacement)), so no step has to integrate it.
+    pub x0: Vec<D::Vec>,
     /// Mass (kg).
     pub mass: Vec<f64>,
     /// Initial volume (m^3; in 2D area times thickness).
@@ -35,7 +36,7 @@ impl<D: Dim> Default for Particles<D> {
         Particles {
             x: Vec::new(),
             v: Vec::new(),
-            u: Vec::new(),
+            x0: Vec::new(),
             mass: Vec::new(),
             volume: Vec::new(),
             stress: Vec::new(),
@@ -62,7 +63,7 @@ impl<D: Dim> Particles<D> {
     pub fn push(&mut self, x: D::Vec, v: D::Vec, mass: f64, volume: f64, material: u16) {
         self.x.push(x);
         self.v.push(v);
-        self.u.push(D::zero());
+        self.x0.push(x);
         self.mass.push(mass);
         self.volume.push(volume);
         self.stress.push(Sym3::default());
@@ -90,7 +91,7 @@ impl<D: Dim> Particles<D> {
         }
         apply(&mut self.x, order);
         apply(&mut self.v, order);
-        apply(&mut self.u, order);
+        apply(&mut self.x0, order);
         apply(&mut self.mass, order);
         apply(&mut self.volume, order);
         apply(&mut self.stress, order);
@@ -98,6 +99,12 @@ impl<D: Dim> Particles<D> {
         apply(&mut self.material, order);
         apply(&mut self.half, order);
         apply(&mut self.grad_u, order);
+    }
+
+    /// Displacement of particle `p` from its initial position (m).
+    #[inline(always)]
+    pub fn displacement(&self, p: usize) -> D::Vec {
+        self.x[p] - self.x0[p]
     }
 
     /// Half-width of particle `p` (zero when the scene's shape function does not use one).

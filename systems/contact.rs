@@ -72,7 +72,7 @@ fn nodal_displacements<D: Dim>(world: &World<D>) -> HashMap<usize, D::Vec> {
                 let t = ti + tiles.counts[0] * (tj + tiles.counts[1] * tk);
                 for &i in tiles.particles(t as u32) {
                     let i = i as usize;
-                    let mu = p.u[i] * p.mass[i];
+                    let mu = p.displacement(i) * p.mass[i];
                     let mut add = |entry: usize, w: f64| {
                         if let Some(d) = disp.get_mut(&entry) {
                             *d += mu * w;

@@ -1,5 +1,5 @@
-//! `g2p`: grid-to-particle gather (FLIP velocity update, position and displacement update),
-//! and `g2p_remap`, the same followed by the momentum remap of USL and USAVG.
+//! `g2p`: grid-to-particle gather (FLIP velocity update, position update), and
+//! `g2p_remap`, the same followed by the momentum remap of USL and USAVG.
 
 use crate::dim::Dim;
 use crate::disjoint::Disjoint;
@@ -10,8 +10,8 @@ use crate::with_shape;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
-/// Updates particle velocities (v += dt sum S a_i), positions and displacements
-/// (x += dt sum S v_i'), in parallel over particle chunks (USF), the particles near a crack
+/// Updates particle velocities (v += dt sum S a_i) and positions (x += dt sum S v_i'), in
+/// parallel over particle chunks (USF), the particles near a crack
 /// afterwards from their fields' entries; the particles' bins are stale afterwards.
 pub fn run<D: Dim>(world: &mut World<D>) {
     let dt = world.settings.dt;
@@ -21,15 +21,11 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let fields = world.cracks.as_ref().map(|c| &c.fields);
     let track = fields.is_some();
     let nodal = (&grid.accel[..], &grid.velocity[..]);
-    let Particles { x, v, u, .. } = &mut world.particles;
-    let fastest = (
-        x.par_chunks_mut(CHUNK),
-        v.par_chunks_mut(CHUNK),
-        u.par_chunks_mut(CHUNK),
-    )
+    let Particles { x, v, .. } = &mut world.particles;
+    let fastest = (x.par_chunks_mut(CHUNK), v.par_chunks_mut(CHUNK))
         .into_par_iter()
         .enumerate()
-        .map(|(c, (x, v, u))| {
+        .map(|(c, (x, v))| {
             let mut fastest = 0.0f64;
             with_shape!(shape, S, N => for k in 0..x.len() {
                 let i = c * CHUNK + k;
@@ -41,7 +37,6 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 let (dv, vn) = gather::<D, N>(&st, &st.rows::<D>(&grid.geom.stride), nodal);
                 v[k] += dv * dt;
                 x[k] += vn * dt;
-                u[k] += vn * dt;
                 if track {
                     fastest = fastest.max(D::dot(vn, vn));
                 }
@@ -71,10 +66,9 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
     let track = fields.is_some();
     let p = &mut world.particles;
     let pmass = &p.mass;
-    let (x_w, v_w, u_w, momentum_w) = (
+    let (x_w, v_w, momentum_w) = (
         Disjoint::new(&mut p.x),
         Disjoint::new(&mut p.v),
-        Disjoint::new(&mut p.u),
         Disjoint::new(&mut grid.momentum),
     );
     let stride = &grid.geom.stride;
@@ -96,7 +90,6 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
                 let v = v_w.get(i) + dv * dt;
                 v_w.set(i, v);
                 x_w.set(i, x_w.get(i) + vn * dt);
-                u_w.set(i, u_w.get(i) + vn * dt);
                 let mv = v * pmass[i];
                 momentum_w.add_rows(&rows, |r| {
                     let mvq = mv * rows.q[r];
@@ -149,7 +142,7 @@ fn gather<D: Dim, const N: usize>(
 }
 
 /// Moves the particles near a crack, each from its own field's entries (v += dt sum S a_i,
-/// x and u += dt sum S v_i'), sequentially; returns the largest squared velocity moving
+/// x += dt sum S v_i'), sequentially; returns the largest squared velocity moving
 /// one of them (zero without cracks).
 fn move_coded<D: Dim>(world: &mut World<D>) -> f64 {
     let Some(c) = world.cracks.as_ref() else {
@@ -171,7 +164,6 @@ fn move_coded<D: Dim>(world: &mut World<D>) -> f64 {
         });
         p.v[i] += dv * dt;
         p.x[i] += vn * dt;
-        p.u[i] += vn * dt;
         fastest = fastest.max(D::dot(vn, vn));
     }
     fastest

@@ -105,7 +105,7 @@ velocity = {vel}
             .iter()
             .map(|s| s.max_abs())
             .fold(0.0, f64::max);
-        (s, (w.particles.u[0].x, w.time))
+        (s, (w.particles.displacement(0).x, w.time))
     } else {
         let w = final_world::<D3>(&text, 2);
         let s = w
@@ -114,7 +114,7 @@ velocity = {vel}
             .iter()
             .map(|s| s.max_abs())
             .fold(0.0, f64::max);
-        (s, (w.particles.u[0].x, w.time))
+        (s, (w.particles.displacement(0).x, w.time))
     };
     // Round-off only: a strain of 1e-13 would be 1e-4 Pa here.
     assert!(

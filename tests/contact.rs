@@ -76,9 +76,9 @@ fn momentum_of(w: &World<D2>, upper: bool, horizontal: bool) -> DVec2 {
     (0..p.len())
         .filter(|&i| {
             let c = if horizontal {
-                p.x[i].y - w.particles.u[i].y > 0.006
+                p.x0[i].y > 0.006
             } else {
-                p.x[i].x - p.u[i].x > 0.02
+                p.x0[i].x > 0.02
             };
             c == upper
         })

@@ -10,8 +10,8 @@ fn bits<D: Dim>(w: &World<D>) -> Vec<u64> {
     let p = &w.particles;
     let mut out = Vec::new();
     for i in 0..p.len() {
-        let (x, v, u) = (D::to_xyz(p.x[i]), D::to_xyz(p.v[i]), D::to_xyz(p.u[i]));
-        out.extend(x.iter().chain(&v).chain(&u).map(|c| c.to_bits()));
+        let (x, v) = (D::to_xyz(p.x[i]), D::to_xyz(p.v[i]));
+        out.extend(x.iter().chain(&v).map(|c| c.to_bits()));
         out.extend(p.stress[i].to_array().iter().map(|c| c.to_bits()));
     }
     out.push(w.work.external.to_bits());

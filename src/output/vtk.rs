@@ -29,7 +29,7 @@ pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result
         },
         Array {
             attrs: r#"type="Float64" Name="displacement" NumberOfComponents="3""#.into(),
-            bytes: vec3(&p.u),
+            bytes: f64s((0..n).flat_map(|i| D::to_xyz(p.displacement(i)))),
         },
         Array {
             attrs: r#"type="Float64" Name="stress" NumberOfComponents="6""#.into(),

@@ -112,7 +112,7 @@ pub fn write<D: Dim>(
     c.add("scenario.file", src.file.as_bytes());
     c.add("particles.x", &p.x);
     c.add("particles.v", &p.v);
-    c.add("particles.u", &p.u);
+    c.add("particles.x0", &p.x0);
     c.add("particles.mass", &p.mass);
     c.add("particles.volume", &p.volume);
     c.add("particles.stress", &p.stress);
@@ -226,7 +226,7 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     let p = &mut w.particles;
     p.x = r.column("particles.x", n)?;
     p.v = r.column("particles.v", n)?;
-    p.u = r.column("particles.u", n)?;
+    p.x0 = r.column("particles.x0", n)?;
     p.mass = r.column("particles.mass", n)?;
     p.volume = r.column("particles.volume", n)?;
     p.stress = r.column("particles.stress", n)?;
