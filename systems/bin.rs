@@ -19,24 +19,37 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
     }
     let p = &world.particles;
     let (geom, shape) = (&world.grid.geom, world.settings.shape);
-    match place(&p.x, &p.half, geom, shape, &mut world.tiles, |_, _, _| {}) {
+    match place(&p.x, &p.half, geom, shape, &mut world.tiles, &()) {
         Ok(()) => Ok(()),
         Err(i) => Err(outside(world, i, world.step, world.time)),
     }
 }
 
+/// Work fused into the binning: a system's last use of each particle's old stencil.
+pub(crate) trait BeforeBin: Sync {
+    /// Called with particle `i`'s cached stencil (shape `s` of `N` nodes per axis: first
+    /// nodes `base`, parameters `params`) just before the new one overwrites it.
+    fn before<const N: usize>(&self, s: ShapeKind, i: usize, base: [u32; 3], params: &[f64]);
+}
+
+/// Plain binning: nothing before.
+impl BeforeBin for () {
+    #[inline(always)]
+    fn before<const N: usize>(&self, _: ShapeKind, _: usize, _: [u32; 3], _: &[f64]) {}
+}
+
 /// Evaluates every particle's stencil and tile in one pass over particle chunks, calling
-/// `before(i, base, params)` with particle `i`'s cached stencil just before it is
-/// overwritten (so a system can fuse its last use of the old stencils into the binning),
-/// then sorts the tiles if any particle changed tile. Returns the first particle whose
-/// stencil leaves the grid (the bins are then left stale).
+/// `work.before` with particle `i`'s cached stencil just before it is overwritten (so a
+/// system can fuse its last use of the old stencils into the binning), then sorts the
+/// tiles if any particle changed tile. Returns the first particle whose stencil leaves the
+/// grid (the bins are then left stale).
 pub(crate) fn place<D: Dim>(
     x: &[D::Vec],
     half: &[D::Vec],
     geom: &GridGeom<D>,
     shape: ShapeKind,
     tiles: &mut Tiles,
-    before: impl Fn(usize, [u32; 3], &[f64]) + Sync,
+    work: &impl BeforeBin,
 ) -> Result<(), usize> {
     let mut tile_of = std::mem::take(&mut tiles.tile_of);
     let sorted = tile_of.len() == x.len();
@@ -54,12 +67,12 @@ pub(crate) fn place<D: Dim>(
         .into_par_iter()
         .enumerate()
         .map(|(c, (out, base, params))| {
-            with_shape!(shape, S => {
+            with_shape!(shape, S, N => {
                 let (mut moved, p) = (false, S.params());
                 let rows = base.iter_mut().zip(params.chunks_exact_mut(per));
                 for (k, (t, (b, w))) in out.iter_mut().zip(rows).enumerate() {
                     let i = c * CHUNK + k;
-                    before(i, *b, w);
+                    work.before::<N>(S, i, *b, w);
                     let half = if half.is_empty() { D::zero() } else { half[i] };
                     let mut tile = 0;
                     for a in 0..D::D {

@@ -3,14 +3,16 @@
 //! particle's old stencil is read for its velocity gradient just before its new one is
 //! written in its place.
 
+use crate::crack::Fields;
 use crate::dim::Dim;
 use crate::disjoint::Disjoint;
 use crate::error::Unstable;
+use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
-use crate::shape::Stencil;
-use crate::systems::bin::{outside, place};
+use crate::shape::{ShapeKind, Stencil};
+use crate::sym::Sym3;
+use crate::systems::bin::{BeforeBin, outside, place};
 use crate::systems::stress::{apply, node_velocities, update_coded, velocity_gradient};
-use crate::with_shape;
 use crate::world::World;
 
 /// Updates every particle's stress over `fraction` of the step (as
@@ -22,9 +24,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) -> Result<(), Unstable> 
     let dt = world.settings.dt * fraction;
     // The particles near a crack first, while the cached stencils match their fields.
     update_coded(world, dt);
-    let (shape, plane) = (world.settings.shape, world.settings.plane);
     let grid = &world.grid;
-    let (velocity, stride) = (&grid.velocity[..], &grid.geom.stride);
     let Particles {
         x,
         half,
@@ -34,43 +34,69 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) -> Result<(), Unstable> 
         material,
         ..
     } = &mut world.particles;
-    let keep = !grad_u.is_empty();
-    let (stress_w, grad_v_w, grad_u_w) = (
-        Disjoint::new(stress),
-        Disjoint::new(grad_v),
-        Disjoint::new(grad_u),
-    );
-    let (material, materials) = (&*material, &world.materials);
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
-    let inv_h = &world.tiles.stencils.inv_h.clone();
-    let update = |i: usize, b: [u32; 3], params: &[f64]| {
-        if fields.is_some_and(|f| f.is_coded(i)) {
-            return;
-        }
-        with_shape!(shape, S, N => {
-            let st = Stencil::<N>::from_cache::<D>(S, b, params, inv_h);
-            let l = velocity_gradient::<D, N>(&st, &st.rows::<D>(stride), velocity);
-            let m = &materials[material[i] as usize];
-            // SAFETY: `place` visits every particle once, on one thread.
-            unsafe {
-                let mut s = stress_w.get(i);
-                if keep {
-                    let (mut gv, mut gu) = (grad_v_w.get(i), grad_u_w.get(i));
-                    apply::<D>(l, dt, plane, m, &mut s, Some((&mut gv, &mut gu)));
-                    grad_v_w.set(i, gv);
-                    grad_u_w.set(i, gu);
-                } else {
-                    apply::<D>(l, dt, plane, m, &mut s, None);
-                }
-                stress_w.set(i, s);
-            }
-        })
+    let work = ClosingStress::<D> {
+        dt,
+        plane: world.settings.plane,
+        keep: !grad_u.is_empty(),
+        velocity: &grid.velocity,
+        stride: grid.geom.stride,
+        inv_h: world.tiles.stencils.inv_h,
+        material,
+        materials: &world.materials,
+        fields: world.cracks.as_ref().map(|c| &c.fields),
+        stress: Disjoint::new(stress),
+        grad_v: Disjoint::new(grad_v),
+        grad_u: Disjoint::new(grad_u),
     };
-    match place(x, half, &grid.geom, shape, &mut world.tiles, update) {
+    let shape = world.settings.shape;
+    match place(x, half, &grid.geom, shape, &mut world.tiles, &work) {
         Ok(()) => Ok(()),
         Err(i) => {
             let step = world.step + 1;
             Err(outside(world, i, step, step as f64 * world.settings.dt))
+        }
+    }
+}
+
+/// The stress update `place` runs on each particle's old stencil.
+struct ClosingStress<'a, D: Dim> {
+    dt: f64,
+    plane: Plane,
+    keep: bool,
+    velocity: &'a [D::Vec],
+    stride: [usize; 3],
+    inv_h: [f64; 3],
+    material: &'a [u16],
+    materials: &'a [Elastic],
+    fields: Option<&'a Fields>,
+    stress: Disjoint<'a, Sym3>,
+    grad_v: Disjoint<'a, D::Mat>,
+    grad_u: Disjoint<'a, D::Mat>,
+}
+
+impl<D: Dim> BeforeBin for ClosingStress<'_, D> {
+    #[inline(always)]
+    fn before<const N: usize>(&self, s: ShapeKind, i: usize, base: [u32; 3], params: &[f64]) {
+        // Particles near a crack were updated from their fields' entries already.
+        if self.fields.is_some_and(|f| f.is_coded(i)) {
+            return;
+        }
+        let st = Stencil::<N>::from_cache::<D>(s, base, params, &self.inv_h);
+        let l = velocity_gradient::<D, N>(&st, &st.rows::<D>(&self.stride), self.velocity);
+        let (dt, plane) = (self.dt, self.plane);
+        let m = &self.materials[self.material[i] as usize];
+        // SAFETY: `place` visits every particle once, on one thread.
+        unsafe {
+            let mut sigma = self.stress.get(i);
+            if self.keep {
+                let (mut gv, mut gu) = (self.grad_v.get(i), self.grad_u.get(i));
+                apply::<D>(l, dt, plane, m, &mut sigma, Some((&mut gv, &mut gu)));
+                self.grad_v.set(i, gv);
+                self.grad_u.set(i, gu);
+            } else {
+                apply::<D>(l, dt, plane, m, &mut sigma, None);
+            }
+            self.stress.set(i, sigma);
         }
     }
 }
