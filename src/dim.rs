@@ -55,21 +55,21 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     fn dot(a: Self::Vec, b: Self::Vec) -> f64;
     /// Outer product `a ⊗ b` (entry (i, j) = a_i b_j).
     fn outer(a: Self::Vec, b: Self::Vec) -> Self::Mat;
-    /// `l + a ⊗ (q x̂) + b ⊗ g_yz` for `g_yz` = (0, gy[, gz]): one stencil row's share of a
-    /// velocity gradient, without the products by the zero entries.
-    fn add_row(l: Self::Mat, a: Self::Vec, q: f64, b: Self::Vec, g_yz: Self::Vec) -> Self::Mat;
+    /// `l + a ⊗ (q x̂) + b ⊗ (0, gy[, gz])`: one stencil row's share of a velocity gradient,
+    /// without the products by the zero entries (`gz` unused in 2D).
+    fn add_row(l: Self::Mat, a: Self::Vec, q: f64, b: Self::Vec, gy: f64, gz: f64) -> Self::Mat;
     /// Matrix entry (i, j).
     fn entry(m: &Self::Mat, i: usize, j: usize) -> f64;
     /// Symmetric part of a velocity gradient embedded in 3x3 (zz = yz = xz = 0 in 2D).
     fn sym_part(l: &Self::Mat) -> Sym3;
     /// In-plane part of `sigma · g` (the traction-like product in the internal force).
     fn stress_dot(s: &Sym3, g: Self::Vec) -> Self::Vec;
+    /// `sigma · (0, gy[, gz])`, without the products by the zero entry (`gz` unused in 2D).
+    fn stress_dot_yz(s: &Sym3, gy: f64, gz: f64) -> Self::Vec;
     /// Cross product of position and momentum, padded to 3 components (z only in 2D).
     fn cross(r: Self::Vec, p: Self::Vec) -> [f64; 3];
     /// The unit vector along x.
     fn unit_x() -> Self::Vec;
-    /// The vector (0, gy) in 2D or (0, gy, gz) in 3D.
-    fn yz(gy: f64, gz: f64) -> Self::Vec;
     /// Gradient of the tensor-product shape function for stencil offsets (i, j, k).
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, k: usize) -> Self::Vec;
     /// Whether the line from `p` to `q` crosses crack element `e` of vertices `v` (2D: the
@@ -149,8 +149,8 @@ impl Dim for D2 {
         DMat2::from_cols(a * b.x, a * b.y)
     }
     #[inline(always)]
-    fn add_row(l: DMat2, a: DVec2, q: f64, b: DVec2, g_yz: DVec2) -> DMat2 {
-        DMat2::from_cols(l.x_axis + a * q, l.y_axis + b * g_yz.y)
+    fn add_row(l: DMat2, a: DVec2, q: f64, b: DVec2, gy: f64, _gz: f64) -> DMat2 {
+        DMat2::from_cols(l.x_axis + a * q, l.y_axis + b * gy)
     }
     #[inline(always)]
     fn entry(m: &DMat2, i: usize, j: usize) -> f64 {
@@ -171,16 +171,16 @@ impl Dim for D2 {
     fn stress_dot(s: &Sym3, g: DVec2) -> DVec2 {
         DVec2::new(s.xx * g.x + s.xy * g.y, s.xy * g.x + s.yy * g.y)
     }
+    #[inline(always)]
+    fn stress_dot_yz(s: &Sym3, gy: f64, _gz: f64) -> DVec2 {
+        DVec2::new(s.xy * gy, s.yy * gy)
+    }
     fn cross(r: DVec2, p: DVec2) -> [f64; 3] {
         [0.0, 0.0, r.perp_dot(p)]
     }
     #[inline(always)]
     fn unit_x() -> DVec2 {
         DVec2::X
-    }
-    #[inline(always)]
-    fn yz(gy: f64, _gz: f64) -> DVec2 {
-        DVec2::new(0.0, gy)
     }
     #[inline(always)]
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, _k: usize) -> DVec2 {
@@ -258,12 +258,8 @@ impl Dim for D3 {
         DMat3::from_cols(a * b.x, a * b.y, a * b.z)
     }
     #[inline(always)]
-    fn add_row(l: DMat3, a: DVec3, q: f64, b: DVec3, g_yz: DVec3) -> DMat3 {
-        DMat3::from_cols(
-            l.x_axis + a * q,
-            l.y_axis + b * g_yz.y,
-            l.z_axis + b * g_yz.z,
-        )
+    fn add_row(l: DMat3, a: DVec3, q: f64, b: DVec3, gy: f64, gz: f64) -> DMat3 {
+        DMat3::from_cols(l.x_axis + a * q, l.y_axis + b * gy, l.z_axis + b * gz)
     }
     #[inline(always)]
     fn entry(m: &DMat3, i: usize, j: usize) -> f64 {
@@ -288,16 +284,20 @@ impl Dim for D3 {
             s.xz * g.x + s.yz * g.y + s.zz * g.z,
         )
     }
+    #[inline(always)]
+    fn stress_dot_yz(s: &Sym3, gy: f64, gz: f64) -> DVec3 {
+        DVec3::new(
+            s.xy * gy + s.xz * gz,
+            s.yy * gy + s.yz * gz,
+            s.yz * gy + s.zz * gz,
+        )
+    }
     fn cross(r: DVec3, p: DVec3) -> [f64; 3] {
         r.cross(p).to_array()
     }
     #[inline(always)]
     fn unit_x() -> DVec3 {
         DVec3::X
-    }
-    #[inline(always)]
-    fn yz(gy: f64, gz: f64) -> DVec3 {
-        DVec3::new(0.0, gy, gz)
     }
     #[inline(always)]
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, k: usize) -> DVec3 {

@@ -5,7 +5,6 @@
 //! scatter systems use this to write grid and particle columns from several threads
 //! without atomics or locks, in a fixed order.
 
-use crate::dim::Dim;
 use crate::shape::Rows;
 use std::marker::PhantomData;
 use std::ops::AddAssign;
@@ -63,9 +62,9 @@ impl<'a, T: Copy> Disjoint<'a, T> {
     /// # Safety
     /// No other thread may access the stencil's entries during the call.
     #[inline(always)]
-    pub unsafe fn add_rows<D: Dim, const N: usize>(
+    pub unsafe fn add_rows<const N: usize>(
         &self,
-        rows: &Rows<D>,
+        rows: &Rows,
         mut value: impl FnMut(usize) -> [T; N],
     ) where
         T: AddAssign,

@@ -187,13 +187,14 @@ impl<const N: usize> Stencil<N> {
 
     /// The stencil's rows of `N` nodes along x (see [`Rows`]), y fastest.
     #[inline(always)]
-    pub fn rows<D: Dim>(&self, stride: &[usize; 3]) -> Rows<D> {
+    pub fn rows<D: Dim>(&self, stride: &[usize; 3]) -> Rows {
         let nk = if D::D == 3 { N } else { 1 };
         let mut rows = Rows {
             len: N * nk,
             first: [0; 9],
             q: [0.0; 9],
-            gyz: [D::zero(); 9],
+            gy: [0.0; 9],
+            gz: [0.0; 9],
         };
         let mut layer = self.first_node::<D>(stride, 0, 0);
         for k in 0..nk {
@@ -202,7 +203,7 @@ impl<const N: usize> Stencil<N> {
                 let (r, w1) = (k * N + j, self.w[1][j]);
                 rows.first[r] = layer + j * stride[1];
                 rows.q[r] = w1 * w2;
-                rows.gyz[r] = D::yz(self.dw[1][j] * w2, w1 * dw2);
+                (rows.gy[r], rows.gz[r]) = (self.dw[1][j] * w2, w1 * dw2);
             }
             layer += stride[2];
         }
@@ -223,22 +224,24 @@ impl<const N: usize> Stencil<N> {
 }
 
 /// A stencil's rows of nodes along x: node `i` of row `r` is `first[r] + i`, with weight
-/// `w[0][i] * q[r]` and gradient `dw[0][i] * q[r] * x̂ + w[0][i] * gyz[r]`. Hot loops factor
+/// `w[0][i] * q[r]` and gradient `dw[0][i] * q[r] * x̂ + w[0][i] * (0, gy[r], gz[r])`. Hot loops factor
 /// their per-row work out of the per-node work this way; the table is built once per
 /// particle so those loops index it without dividing a row number into (j, k).
 #[derive(Clone, Copy, Debug)]
-pub struct Rows<D: Dim> {
+pub struct Rows {
     /// Number of rows: `N` in 2D, `N * N` in 3D.
     pub len: usize,
     /// First node of each row.
     pub first: [usize; 9],
     /// Weight factor of each row, w_y w_z.
     pub q: [f64; 9],
-    /// Gradient factor of each row, (0, dw_y w_z, w_y dw_z).
-    pub gyz: [D::Vec; 9],
+    /// y component of each row's gradient factor, dw_y w_z.
+    pub gy: [f64; 9],
+    /// z component of each row's gradient factor, w_y dw_z (in 2D dw_z = 0).
+    pub gz: [f64; 9],
 }
 
-impl<D: Dim> Rows<D> {
+impl Rows {
     /// One past the last node of the stencil, whose rows of `n` nodes come in increasing
     /// node order.
     #[inline(always)]

@@ -121,7 +121,7 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
 #[inline(always)]
 fn gather<D: Dim, const N: usize>(
     st: &Stencil<N>,
-    rows: &Rows<D>,
+    rows: &Rows,
     (accel, velocity): (&[D::Vec], &[D::Vec]),
 ) -> (D::Vec, D::Vec) {
     let (mut dv, mut vn) = (D::zero(), D::zero());

@@ -82,7 +82,7 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
 #[inline(always)]
 pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
     st: &Stencil<N>,
-    rows: &Rows<D>,
+    rows: &Rows,
     s: &Sym3,
     volume: f64,
     force: &Disjoint<D::Vec>,
@@ -93,7 +93,7 @@ pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
     unsafe {
         force.add_rows(rows, |r| {
             let sxq = sx * rows.q[r];
-            let syz = D::stress_dot(s, rows.gyz[r]) * vol;
+            let syz = D::stress_dot_yz(s, rows.gy[r], rows.gz[r]) * vol;
             std::array::from_fn::<_, N, _>(|a| sxq * st.dw[0][a] + syz * st.w[0][a])
         })
     };

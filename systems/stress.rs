@@ -116,7 +116,7 @@ pub(crate) fn apply<D: Dim>(
 #[inline(always)]
 pub(crate) fn velocity_gradient<D: Dim, const N: usize>(
     st: &Stencil<N>,
-    rows: &Rows<D>,
+    rows: &Rows,
     velocity: &[D::Vec],
 ) -> D::Mat {
     let mut l = D::mat_zero();
@@ -128,7 +128,7 @@ pub(crate) fn velocity_gradient<D: Dim, const N: usize>(
             vd += v * st.dw[0][a];
             vw += v * st.w[0][a];
         }
-        l = D::add_row(l, vd, rows.q[r], vw, rows.gyz[r]);
+        l = D::add_row(l, vd, rows.q[r], vw, rows.gy[r], rows.gz[r]);
     }
     l
 }
