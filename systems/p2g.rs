@@ -9,13 +9,25 @@ use crate::particles::Particles;
 use crate::shape::{Rows, ShapeKind, Stencil, StencilCache};
 use crate::sym::Sym3;
 use crate::with_shape;
-use crate::world::World;
+use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Scatters mass and momentum (and, when `internal`, the internal force -V sigma . grad S)
 /// to a zeroed grid, then adds the external particle loads.
 pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
-    world.grid.force.par_iter_mut().for_each(|f| *f = D::zero());
+    let g = &mut world.grid;
+    // One pass zeroes the three scattered columns (they have one entry per grid entry).
+    (
+        g.mass.par_chunks_mut(CHUNK),
+        g.momentum.par_chunks_mut(CHUNK),
+        g.force.par_chunks_mut(CHUNK),
+    )
+        .into_par_iter()
+        .for_each(|(m, p, f)| {
+            m.fill(0.0);
+            p.fill(D::zero());
+            f.fill(D::zero());
+        });
     if internal {
         scatter::<D, true>(world);
     } else {
@@ -25,13 +37,11 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
 }
 
 /// One scatter pass over the tiles, colour class by colour class (Guo & Nairn 2D (2004)
-/// Eqs. 3 and 6, single velocity field): mass and momentum (each zeroed first), and the
+/// Eqs. 3 and 6, single velocity field) onto zeroed columns: mass and momentum, and the
 /// internal force -V sigma . grad S when `FORCE` (a compile-time flag keeps the hot loop
 /// free of branches).
 fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
     let grid = &mut world.grid;
-    grid.mass.par_iter_mut().for_each(|m| *m = 0.0);
-    grid.momentum.par_iter_mut().for_each(|m| *m = D::zero());
     let (mass_w, momentum_w, force_w) = (
         Disjoint::new(&mut grid.mass),
         Disjoint::new(&mut grid.momentum),
