@@ -131,10 +131,11 @@ impl Schedule {
                 s.push(MomentumBc { end: true });
             }
             let fraction = if update == Update::Usl { 1.0 } else { 0.5 };
-            // Without cracks the closing update also bins the particles for the next step;
-            // with cracks the J-integral between steps reads the start-of-step stencils
-            // that match the fields, so binning waits for the next step.
-            s.push(if cracks {
+            // The closing update also bins the particles for the next step, except where
+            // J-integrals are measured (they keep grad u): J, between steps, reads the
+            // start-of-step stencils that match the crack fields, so binning waits.
+            let measures_j = !world.particles.grad_u.is_empty();
+            s.push(if measures_j {
                 Stress { fraction }
             } else {
                 StressBin { fraction }
