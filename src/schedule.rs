@@ -131,15 +131,9 @@ impl Schedule {
                 s.push(MomentumBc { end: true });
             }
             let fraction = if update == Update::Usl { 1.0 } else { 0.5 };
-            // The closing update also bins the particles for the next step, except where
-            // J-integrals are measured (they keep grad u): J, between steps, reads the
-            // start-of-step stencils that match the crack fields, so binning waits.
-            let measures_j = !world.particles.grad_u.is_empty();
-            s.push(if measures_j {
-                Stress { fraction }
-            } else {
-                StressBin { fraction }
-            });
+            // The closing update also bins the particles for the next step (see
+            // `step_keeping` for the steps after which J is measured).
+            s.push(StressBin { fraction });
         }
         let seconds = vec![0.0; s.len()];
         Schedule {
@@ -148,10 +142,22 @@ impl Schedule {
         }
     }
 
-    /// Advances the world one time step. Kept out of line (one call per step costs nothing)
-    /// so that profiles count the step's instructions apart from the run's outputs.
-    #[inline(never)]
+    /// Advances the world one time step.
     pub fn step<D: Dim>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
+        self.step_keeping(world, false)
+    }
+
+    /// Advances the world one time step; with `keep_stencils` the closing stress update
+    /// leaves the binning to the next step, so that between steps the particles' stencils
+    /// are the step's own, matching the crack fields, as the J-integral reads them (the
+    /// results are bitwise the same either way). Kept out of line (one call per step costs
+    /// nothing) so that profiles count the step's instructions apart from the run's outputs.
+    #[inline(never)]
+    pub fn step_keeping<D: Dim>(
+        &mut self,
+        world: &mut World<D>,
+        keep_stencils: bool,
+    ) -> Result<(), Unstable> {
         for (k, sys) in self.systems.iter().enumerate() {
             let t0 = Instant::now();
             match *sys {
@@ -163,6 +169,7 @@ impl Schedule {
                 System::MomentumBc { end } => grid_update::momentum_bc(world, end),
                 System::Stress { fraction } => stress::run(world, fraction),
                 System::StressForce { fraction } => stress_force::run(world, fraction),
+                System::StressBin { fraction } if keep_stencils => stress::run(world, fraction),
                 System::StressBin { fraction } => stress_bin::run(world, fraction)?,
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),

@@ -236,7 +236,12 @@ fn drive<D: Dim>(
     let mut stop = Stop::Completed;
     let t0 = Instant::now();
     while world.step < steps {
-        if let Err(e) = schedule.step(&mut world) {
+        // A step that ends at a history row with J to measure keeps its own stencils (the
+        // same test as after the step, on the time the step ends at).
+        let next = world.step + 1;
+        let ends_at_row =
+            (next as f64 * world.settings.dt) >= state.next_history * (1.0 - 1e-9) || next == steps;
+        if let Err(e) = schedule.step_keeping(&mut world, fracture.is_some() && ends_at_row) {
             stop = Stop::Unstable(e);
             break;
         }
