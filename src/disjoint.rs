@@ -57,7 +57,8 @@ impl<'a, T: Copy> Disjoint<'a, T> {
 
     /// Adds `value(r)[a]` to entry `rows.first[r] + a` for every row `r` of a stencil's
     /// [`Rows`] and every `a < N` (a row's nodes are consecutive entries), with one bounds
-    /// check for the whole stencil: its last row ends highest.
+    /// check for the whole stencil: its last row ends highest (an invariant of `Rows`,
+    /// which only `Stencil::rows` builds).
     ///
     /// # Safety
     /// No other thread may access the stencil's entries during the call.

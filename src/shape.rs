@@ -224,21 +224,23 @@ impl<const N: usize> Stencil<N> {
 }
 
 /// A stencil's rows of nodes along x: node `i` of row `r` is `first[r] + i`, with weight
-/// `w[0][i] * q[r]` and gradient `dw[0][i] * q[r] * x̂ + w[0][i] * (0, gy[r], gz[r])`. Hot loops factor
-/// their per-row work out of the per-node work this way; the table is built once per
-/// particle so those loops index it without dividing a row number into (j, k).
+/// `w[0][i] * q[r]` and gradient `dw[0][i] * q[r] * x̂ + w[0][i] * (0, gy[r], gz[r])`. Hot
+/// loops factor their per-row work out of the per-node work this way; the table is built
+/// once per particle so those loops index it without dividing a row number into (j, k). Only
+/// [`Stencil::rows`] builds one, so the rows' first nodes increase and the last row ends
+/// highest (the scatters' single bounds check relies on it).
 #[derive(Clone, Copy, Debug)]
 pub struct Rows {
     /// Number of rows: `N` in 2D, `N * N` in 3D.
-    pub len: usize,
+    pub(crate) len: usize,
     /// First node of each row.
-    pub first: [usize; 9],
+    pub(crate) first: [usize; 9],
     /// Weight factor of each row, w_y w_z.
-    pub q: [f64; 9],
+    pub(crate) q: [f64; 9],
     /// y component of each row's gradient factor, dw_y w_z.
-    pub gy: [f64; 9],
+    pub(crate) gy: [f64; 9],
     /// z component of each row's gradient factor, w_y dw_z (in 2D dw_z = 0).
-    pub gz: [f64; 9],
+    pub(crate) gz: [f64; 9],
 }
 
 impl Rows {

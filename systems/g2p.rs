@@ -11,8 +11,8 @@ use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Updates particle velocities (v += dt sum S a_i) and positions (x += dt sum S v_i'), in
-/// parallel over particle chunks (USF), the particles near a crack
-/// afterwards from their fields' entries; the particles' bins are stale afterwards.
+/// parallel over particle chunks (USF), the particles near a crack afterwards from their
+/// fields' entries; the particles' bins are stale afterwards.
 pub fn run<D: Dim>(world: &mut World<D>) {
     let dt = world.settings.dt;
     let shape = world.settings.shape;
