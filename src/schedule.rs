@@ -32,11 +32,6 @@ pub enum System {
         /// Use end-of-step values (after a remap).
         end: bool,
     },
-    /// Constitutive update over `fraction` of the step, from grad v gathered off the grid.
-    Stress {
-        /// Fraction of the step.
-        fraction: f64,
-    },
     /// The closing stress update of USL and USAVG fused with the binning for the next step.
     StressBin {
         /// Fraction of the step.
@@ -66,7 +61,6 @@ impl System {
             System::Contact { .. } => "contact",
             System::P2g { .. } => "p2g",
             System::MomentumBc { .. } => "grid_bc",
-            System::Stress { .. } => "stress",
             System::StressForce { .. } => "stress_force",
             System::StressBin { .. } => "stress_bin",
             System::GridUpdate => "grid_update",
@@ -167,7 +161,6 @@ impl Schedule {
                 System::Contact { update } => contact::run(world, update),
                 System::P2g { internal } => p2g::run(world, internal),
                 System::MomentumBc { end } => grid_update::momentum_bc(world, end),
-                System::Stress { fraction } => stress::run(world, fraction),
                 System::StressForce { fraction } => stress_force::run(world, fraction),
                 System::StressBin { fraction } if keep_stencils => stress::run(world, fraction),
                 System::StressBin { fraction } => stress_bin::run(world, fraction)?,

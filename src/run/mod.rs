@@ -90,6 +90,12 @@ pub fn resume(path: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
     })
 }
 
+/// Whether a step ending at `time` records a history row: the next row is due (to
+/// round-off) or it is the last step.
+fn row_due(time: f64, next_history: f64, last: bool) -> bool {
+    time >= next_history * (1.0 - 1e-9) || last
+}
+
 /// Checks the energies `e` for NaN and names the first particle with a non-finite state.
 fn check_finite<D: Dim>(world: &World<D>, e: &Energies) -> Result<(), Unstable> {
     if (e.kinetic + e.strain).is_finite() {
@@ -236,18 +242,20 @@ fn drive<D: Dim>(
     let mut stop = Stop::Completed;
     let t0 = Instant::now();
     while world.step < steps {
-        // A step that ends at a history row with J to measure keeps its own stencils (the
-        // same test as after the step, on the time the step ends at).
+        // A step that ends at a history row with J to measure keeps its own stencils.
         let next = world.step + 1;
-        let ends_at_row =
-            (next as f64 * world.settings.dt) >= state.next_history * (1.0 - 1e-9) || next == steps;
+        let ends_at_row = row_due(
+            next as f64 * world.settings.dt,
+            state.next_history,
+            next == steps,
+        );
         if let Err(e) = schedule.step_keeping(&mut world, fracture.is_some() && ends_at_row) {
             stop = Stop::Unstable(e);
             break;
         }
         state.sample(&world, &probes);
         let last = world.step == steps;
-        if world.time >= state.next_history * (1.0 - 1e-9) || last {
+        if row_due(world.time, state.next_history, last) {
             state.next_history += output.history_interval;
             let energies = world.energies();
             if let Err(e) = check_finite(&world, &energies) {
