@@ -7,7 +7,7 @@
 
 use crate::geometry::{point_segment, point_triangle, segment_segment};
 use crate::snapshot::Columnar;
-use crate::sym::Sym3;
+use crate::sym::{Sym2, Sym3, SymTensor};
 use glam::{DMat2, DMat3, DVec2, DVec3};
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, Index, IndexMut, Mul, MulAssign, Neg, Sub, SubAssign};
@@ -42,6 +42,8 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
         + Add<Output = Self::Mat>
         + Mul<f64, Output = Self::Mat>
         + Columnar;
+    /// Stress as stored on particles: [`Sym2`] in 2D, [`Sym3`] in 3D.
+    type Sym: SymTensor;
 
     /// The zero vector.
     fn zero() -> Self::Vec;
@@ -63,9 +65,9 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     /// Symmetric part of a velocity gradient embedded in 3x3 (zz = yz = xz = 0 in 2D).
     fn sym_part(l: &Self::Mat) -> Sym3;
     /// In-plane part of `sigma · g` (the traction-like product in the internal force).
-    fn stress_dot(s: &Sym3, g: Self::Vec) -> Self::Vec;
+    fn stress_dot(s: &Self::Sym, g: Self::Vec) -> Self::Vec;
     /// `sigma · (0, gy[, gz])`, without the products by the zero entry (`gz` unused in 2D).
-    fn stress_dot_yz(s: &Sym3, gy: f64, gz: f64) -> Self::Vec;
+    fn stress_dot_yz(s: &Self::Sym, gy: f64, gz: f64) -> Self::Vec;
     /// Cross product of position and momentum, padded to 3 components (z only in 2D).
     fn cross(r: Self::Vec, p: Self::Vec) -> [f64; 3];
     /// The unit vector along x.
@@ -125,6 +127,7 @@ impl Dim for D2 {
     const SHARED_FEATURE_SAFE: bool = true;
     type Vec = DVec2;
     type Mat = DMat2;
+    type Sym = Sym2;
 
     #[inline(always)]
     fn zero() -> DVec2 {
@@ -168,11 +171,11 @@ impl Dim for D2 {
         }
     }
     #[inline(always)]
-    fn stress_dot(s: &Sym3, g: DVec2) -> DVec2 {
+    fn stress_dot(s: &Sym2, g: DVec2) -> DVec2 {
         DVec2::new(s.xx * g.x + s.xy * g.y, s.xy * g.x + s.yy * g.y)
     }
     #[inline(always)]
-    fn stress_dot_yz(s: &Sym3, gy: f64, _gz: f64) -> DVec2 {
+    fn stress_dot_yz(s: &Sym2, gy: f64, _gz: f64) -> DVec2 {
         DVec2::new(s.xy * gy, s.yy * gy)
     }
     fn cross(r: DVec2, p: DVec2) -> [f64; 3] {
@@ -234,6 +237,7 @@ impl Dim for D3 {
     const SHARED_FEATURE_SAFE: bool = false;
     type Vec = DVec3;
     type Mat = DMat3;
+    type Sym = Sym3;
 
     #[inline(always)]
     fn zero() -> DVec3 {

@@ -4,6 +4,7 @@ use crate::dim::Dim;
 use crate::fracture::{PathResult, TipResult};
 use crate::material::Elastic;
 use crate::particles::Particles;
+use crate::sym::SymTensor;
 use crate::world::Energies;
 use serde::Serialize;
 use std::collections::HashMap;
@@ -48,9 +49,9 @@ impl Probe {
                 ProbeQty::Displacement => p.displacement(i)[self.comp],
                 ProbeQty::Velocity => p.v[i][self.comp],
                 ProbeQty::Position => p.x[i][self.comp],
-                ProbeQty::Stress => p.stress[i].to_array()[self.comp],
+                ProbeQty::Stress => p.stress[i].to_sym3().to_array()[self.comp],
                 ProbeQty::Strain => materials[p.material[i] as usize]
-                    .strain(&p.stress[i])
+                    .strain(&p.stress[i].to_sym3())
                     .to_array()[self.comp],
             };
         }

@@ -1,7 +1,6 @@
 //! Particle component store: one column per component (struct of arrays).
 
 use crate::dim::Dim;
-use crate::sym::Sym3;
 
 /// Material points. Columns a scene does not need stay empty (e.g. `half` unless uGIMP).
 #[derive(Clone, Debug)]
@@ -18,7 +17,7 @@ pub struct Particles<D: Dim> {
     /// Initial volume (m^3; in 2D area times thickness).
     pub volume: Vec<f64>,
     /// Cauchy stress (Pa), small strain.
-    pub stress: Vec<Sym3>,
+    pub stress: Vec<D::Sym>,
     /// Velocity gradient dv_i/dx_j (1/s) from the most recent gather; only allocated when
     /// J-integrals are measured (their area term reads it).
     pub grad_v: Vec<D::Mat>,
@@ -66,7 +65,7 @@ impl<D: Dim> Particles<D> {
         self.x0.push(x);
         self.mass.push(mass);
         self.volume.push(volume);
-        self.stress.push(Sym3::default());
+        self.stress.push(D::Sym::default());
         self.material.push(material);
     }
 
@@ -75,7 +74,7 @@ impl<D: Dim> Particles<D> {
         let vec = std::mem::size_of::<D::Vec>();
         let base = 3 * vec
             + 2 * std::mem::size_of::<f64>()
-            + std::mem::size_of::<Sym3>()
+            + std::mem::size_of::<D::Sym>()
             + std::mem::size_of::<u16>();
         let mat = std::mem::size_of::<D::Mat>();
         base + if self.half.is_empty() { 0 } else { vec }

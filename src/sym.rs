@@ -1,8 +1,74 @@
-//! Symmetric 3x3 tensors (stress, strain), stored as six components in 2D and 3D alike.
+//! Symmetric 3x3 tensors (stress, strain): [`Sym3`] holds all six components; the particle
+//! stress column holds [`SymTensor`]s sized to the dimension ([`Sym2`] in 2D, four
+//! components, since yz and xz are zero in plane strain and plane stress).
 
+use crate::snapshot::Columnar;
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
+use std::fmt::Debug;
 use std::ops::{Add, AddAssign, Mul};
+
+/// A symmetric tensor stored with only the components its dimension can have, converted to
+/// and from the full [`Sym3`] where it is computed with.
+pub trait SymTensor: Copy + Default + Debug + PartialEq + Send + Sync + Columnar {
+    /// The full tensor.
+    fn to_sym3(&self) -> Sym3;
+    /// The stored components of `s` (the others must be zero).
+    fn from_sym3(s: Sym3) -> Self;
+    /// Largest absolute component.
+    fn max_abs(&self) -> f64 {
+        self.to_sym3().max_abs()
+    }
+}
+
+/// A 2D symmetric tensor: the in-plane components and zz (non-zero in plane strain stress
+/// and plane stress strain); yz = xz = 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, Pod, Zeroable)]
+#[repr(C)]
+pub struct Sym2 {
+    /// xx component.
+    pub xx: f64,
+    /// yy component.
+    pub yy: f64,
+    /// zz component.
+    pub zz: f64,
+    /// xy component.
+    pub xy: f64,
+}
+
+impl SymTensor for Sym2 {
+    #[inline(always)]
+    fn to_sym3(&self) -> Sym3 {
+        Sym3 {
+            xx: self.xx,
+            yy: self.yy,
+            zz: self.zz,
+            yz: 0.0,
+            xz: 0.0,
+            xy: self.xy,
+        }
+    }
+    #[inline(always)]
+    fn from_sym3(s: Sym3) -> Sym2 {
+        Sym2 {
+            xx: s.xx,
+            yy: s.yy,
+            zz: s.zz,
+            xy: s.xy,
+        }
+    }
+}
+
+impl SymTensor for Sym3 {
+    #[inline(always)]
+    fn to_sym3(&self) -> Sym3 {
+        *self
+    }
+    #[inline(always)]
+    fn from_sym3(s: Sym3) -> Sym3 {
+        s
+    }
+}
 
 /// A symmetric 3x3 tensor; shear entries are tensor (not engineering) components.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, Pod, Zeroable)]

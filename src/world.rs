@@ -7,6 +7,7 @@ use crate::loads::{Load, VelocityBc};
 use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
 use crate::shape::{ShapeKind, StencilCache};
+use crate::sym::SymTensor;
 use crate::tiles::Tiles;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -113,7 +114,8 @@ impl<D: Dim> World<D> {
                 let (mut k, mut w) = (0.0, 0.0);
                 for i in c * CHUNK..((c + 1) * CHUNK).min(p.len()) {
                     k += 0.5 * p.mass[i] * D::dot(p.v[i], p.v[i]);
-                    w += p.volume[i] * mats[p.material[i] as usize].energy_density(&p.stress[i]);
+                    w += p.volume[i]
+                        * mats[p.material[i] as usize].energy_density(&p.stress[i].to_sym3());
                 }
                 (k, w)
             })

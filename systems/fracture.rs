@@ -7,6 +7,7 @@ use crate::crack::{Crack, Cracks};
 use crate::dim::Dim;
 use crate::fracture::{FracturePlan, PathResult, TipResult, k_from_g};
 use crate::shape::Stencil;
+use crate::sym::SymTensor;
 use crate::with_shape;
 use crate::world::World;
 use std::collections::HashMap;
@@ -268,7 +269,7 @@ fn contour_j<D: Dim>(
         }
         let m = p.mass[i];
         let mat = &world.materials[p.material[i] as usize];
-        let st = p.stress[i];
+        let st = p.stress[i].to_sym3();
         let gu = p.grad_u[i];
         let gu = [
             D::entry(&gu, 0, 0),

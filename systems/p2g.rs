@@ -7,7 +7,6 @@ use crate::disjoint::Disjoint;
 use crate::grid::Grid;
 use crate::particles::Particles;
 use crate::shape::{Rows, ShapeKind, Stencil, StencilCache};
-use crate::sym::Sym3;
 use crate::with_shape;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
@@ -93,7 +92,7 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
 pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
     st: &Stencil<N>,
     rows: &Rows,
-    s: &Sym3,
+    s: &D::Sym,
     volume: f64,
     force: &Disjoint<D::Vec>,
 ) {

@@ -6,7 +6,7 @@ use crate::dim::Dim;
 use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
 use crate::shape::{Rows, Stencil};
-use crate::sym::Sym3;
+use crate::sym::SymTensor;
 use crate::with_shape;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
@@ -32,7 +32,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     } = &mut world.particles;
     let material = &*material;
     let stride = &grid.geom.stride;
-    let body = |c: usize, s: &mut [Sym3], mut grads: Grads<D>| {
+    let body = |c: usize, s: &mut [D::Sym], mut grads: Grads<D>| {
         with_shape!(shape, S, N => for k in 0..s.len() {
             let i = c * CHUNK + k;
             // Particles near a crack are updated from their fields' entries afterwards.
@@ -101,14 +101,16 @@ pub(crate) fn apply<D: Dim>(
     dt: f64,
     plane: Plane,
     m: &Elastic,
-    s: &mut Sym3,
+    s: &mut D::Sym,
     grads: Option<(&mut D::Mat, &mut D::Mat)>,
 ) {
     if let Some((gv, gu)) = grads {
         *gv = l;
         *gu = *gu + l * dt;
     }
-    m.update(plane, D::sym_part(&l) * dt, s);
+    let mut sigma = s.to_sym3();
+    m.update(plane, D::sym_part(&l) * dt, &mut sigma);
+    *s = D::Sym::from_sym3(sigma);
 }
 
 /// grad v of one particle away from cracks: sum over its stencil of v_i ⊗ grad S_i, row by

@@ -10,7 +10,6 @@ use crate::error::Unstable;
 use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
 use crate::shape::{ShapeKind, Stencil};
-use crate::sym::Sym3;
 use crate::systems::bin::{BeforeBin, outside, place};
 use crate::systems::stress::{apply, node_velocities, update_coded, velocity_gradient};
 use crate::world::World;
@@ -69,7 +68,7 @@ struct ClosingStress<'a, D: Dim> {
     material: &'a [u16],
     materials: &'a [Elastic],
     fields: Option<&'a Fields>,
-    stress: Disjoint<'a, Sym3>,
+    stress: Disjoint<'a, D::Sym>,
     grad_v: Disjoint<'a, D::Mat>,
     grad_u: Disjoint<'a, D::Mat>,
 }

@@ -3,6 +3,7 @@
 mod common;
 use common::{final_world, history};
 use fissure::dim::{D2, D3};
+use fissure::sym::SymTensor;
 
 const DISKS: &str = r#"
 [simulation]

@@ -3,6 +3,7 @@
 mod common;
 use common::{final_world, mixed_scene};
 use fissure::dim::{D2, D3, Dim};
+use fissure::sym::SymTensor;
 use fissure::world::World;
 
 /// Every bit of the particle state that the next step depends on.
@@ -12,7 +13,7 @@ fn bits<D: Dim>(w: &World<D>) -> Vec<u64> {
     for i in 0..p.len() {
         let (x, v) = (D::to_xyz(p.x[i]), D::to_xyz(p.v[i]));
         out.extend(x.iter().chain(&v).map(|c| c.to_bits()));
-        out.extend(p.stress[i].to_array().iter().map(|c| c.to_bits()));
+        out.extend(p.stress[i].to_sym3().to_array().iter().map(|c| c.to_bits()));
     }
     out.push(w.work.external.to_bits());
     out.push(w.work.damping.to_bits());

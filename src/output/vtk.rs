@@ -4,6 +4,7 @@
 use crate::crack::Cracks;
 use crate::dim::Dim;
 use crate::particles::Particles;
+use crate::sym::SymTensor;
 use std::io::Write;
 use std::path::Path;
 
@@ -36,6 +37,7 @@ pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result
             bytes: f64s(
                 p.stress
                     .iter()
+                    .map(|s| s.to_sym3())
                     .flat_map(|s| [s.xx, s.yy, s.zz, s.xy, s.yz, s.xz]),
             ),
         },

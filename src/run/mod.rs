@@ -15,6 +15,7 @@ use crate::scenario::{Scene, Source, build};
 use crate::schedule::Schedule;
 use crate::snapshot::Reader;
 use crate::snapshot::state::restore;
+use crate::sym::SymTensor;
 use crate::systems::{bin, classify, fracture};
 use crate::world::{Energies, World};
 use anyhow::Context;
