@@ -6,51 +6,17 @@
 //! 40 x 40 x 40 cells (512,000 particles); the `-16k` and `-27k` scenes (2D 64 x 64, 3D
 //! 15 x 15 x 15 cells) fit in the caches, as the validation scenarios do.
 
+mod common;
+
+use common::{SCENES, block};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use fissure::dim::{D2, D3, Dim};
-use fissure::scenario::{Source, build};
 use fissure::schedule::Schedule;
 use fissure::systems::{bin, g2p, grid_update, p2g, stress, stress_bin, stress_force};
 use std::time::Duration;
 
-fn scene_text(dim: usize, n: usize, shape: &str, update: &str) -> String {
-    let h = 1e-3;
-    let v = |x: f64| vec![format!("{x}"); dim].join(", ");
-    let len = n as f64 * h;
-    format!(
-        r#"
-[simulation]
-dimension = {dim}
-shape = "{shape}"
-update = "{update}"
-duration = 1.0
-[grid]
-min = [{lo}]
-max = [{hi}]
-cell = [{cell}]
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 7800.0
-[[body]]
-material = "steel"
-box = {{ min = [{bmin}], max = [{bmax}] }}
-velocity = [{vel}]
-"#,
-        lo = v(-2.0 * h),
-        hi = v(len + 2.0 * h),
-        cell = v(h),
-        bmin = v(0.0),
-        bmax = v(len),
-        vel = v(1e-3),
-    )
-}
-
 fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, n: usize, shape: &str, update: &str) {
-    let text = scene_text(D::D, n, shape, update);
-    let src = Source::parse(label, &text, &[]).expect("bench scene parses");
-    let mut world = build::<D>(&src).expect("bench scene builds").world;
+    let mut world = block::<D>(label, n, shape, update);
     let mut schedule = Schedule::for_world(&world);
     schedule.step(&mut world).expect("stable");
     let mut g = c.benchmark_group(label);
@@ -88,13 +54,13 @@ fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, n: usize, shape: &str, up
 }
 
 fn systems(c: &mut Criterion) {
-    bench_scene::<D2>(c, "2d-linear", 256, "linear", "usavg");
-    bench_scene::<D2>(c, "2d-linear-16k", 64, "linear", "usavg");
-    bench_scene::<D2>(c, "2d-linear-usl", 256, "linear", "usl");
-    bench_scene::<D2>(c, "2d-ugimp", 256, "ugimp", "usavg");
-    bench_scene::<D3>(c, "3d-ugimp", 40, "ugimp", "usavg");
-    bench_scene::<D3>(c, "3d-ugimp-27k", 15, "ugimp", "usavg");
-    bench_scene::<D3>(c, "3d-bspline", 40, "bspline", "usavg");
+    for (label, dim, n, shape, update) in SCENES {
+        if dim == 2 {
+            bench_scene::<D2>(c, label, n, shape, update);
+        } else {
+            bench_scene::<D3>(c, label, n, shape, update);
+        }
+    }
 }
 
 criterion_group!(benches, systems);
