@@ -26,6 +26,7 @@ pub mod snapshot;
 pub mod sym;
 pub mod tiles;
 pub mod timefn;
+mod warm;
 pub mod world;
 
 #[path = "../systems/mod.rs"]

@@ -5,6 +5,7 @@ use crate::error::Unstable;
 use crate::systems::{
     bin, classify, contact, crack_advect, g2p, grid_update, p2g, stress, stress_bin, stress_force,
 };
+use crate::warm::with_warm_workers;
 use crate::world::{Update, World};
 use std::time::Instant;
 
@@ -146,8 +147,22 @@ impl Schedule {
     /// are the step's own, matching the crack fields, as the J-integral reads them (the
     /// results are bitwise the same either way). Kept out of line (one call per step costs
     /// nothing) so that profiles count the step's instructions apart from the run's outputs.
+    /// The pool's other workers wait for work spinning through the step, not sleeping
+    /// (`warm.rs`).
     #[inline(never)]
     pub fn step_keeping<D: Dim>(
+        &mut self,
+        world: &mut World<D>,
+        keep_stencils: bool,
+    ) -> Result<(), Unstable> {
+        with_warm_workers(|| self.run_systems(world, keep_stencils))?;
+        world.step += 1;
+        world.time = world.step as f64 * world.settings.dt;
+        Ok(())
+    }
+
+    /// Runs every system once, in order, timing each.
+    fn run_systems<D: Dim>(
         &mut self,
         world: &mut World<D>,
         keep_stencils: bool,
@@ -170,8 +185,6 @@ impl Schedule {
             }
             self.seconds[k] += t0.elapsed().as_secs_f64();
         }
-        world.step += 1;
-        world.time = world.step as f64 * world.settings.dt;
         Ok(())
     }
 
