@@ -13,7 +13,8 @@ use std::ops::{Add, AddAssign, Mul};
 pub trait SymTensor: Copy + Default + Debug + PartialEq + Send + Sync + Columnar {
     /// The full tensor.
     fn to_sym3(&self) -> Sym3;
-    /// The stored components of `s` (the others must be zero).
+    /// The components of `s` this type stores (in 2D, yz and xz are dropped: they are zero
+    /// in plane strain and plane stress).
     fn from_sym3(s: Sym3) -> Self;
     /// Largest absolute component.
     fn max_abs(&self) -> f64 {
@@ -21,8 +22,8 @@ pub trait SymTensor: Copy + Default + Debug + PartialEq + Send + Sync + Columnar
     }
 }
 
-/// A 2D symmetric tensor: the in-plane components and zz (non-zero in plane strain stress
-/// and plane stress strain); yz = xz = 0.
+/// A 2D stress: the in-plane components and zz (sigma_zz is non-zero in plane strain);
+/// yz = xz = 0.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, Pod, Zeroable)]
 #[repr(C)]
 pub struct Sym2 {

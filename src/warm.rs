@@ -4,9 +4,10 @@
 //! systems' set-up). An idle rayon worker soon goes to sleep, and waking it costs tens of
 //! microseconds on a virtual machine, which on scenes of ten thousand particles is as long
 //! as the region it was woken for. While `f` runs, each other worker instead polls the pool
-//! for work (`rayon::yield_now`), so it picks up the next region's work at once. This spends
-//! the idle workers' time spinning during the serial parts of a step and nothing else; which
-//! thread runs which piece of work does not change any result.
+//! for work (`rayon::yield_now`, then the OS's `sched_yield` when there is none), so it picks
+//! up the next region's work at once. This spends the idle workers' time spinning during the
+//! serial parts of a step and nothing else; which thread runs which piece of work does not
+//! change any result.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -31,8 +32,10 @@ pub(crate) fn with_warm_workers<R: Send>(f: impl FnOnce() -> R + Send) -> R {
                     return;
                 }
                 while !done.load(Ordering::Acquire) {
+                    // With nothing to run, let the OS run another thread, should there be
+                    // more threads than cores.
                     if rayon::yield_now() != Some(rayon::Yield::Executed) {
-                        std::hint::spin_loop();
+                        std::thread::yield_now();
                     }
                 }
             });
