@@ -7,7 +7,7 @@
 
 use crate::shape::Rows;
 use std::marker::PhantomData;
-use std::ops::AddAssign;
+use std::ops::{AddAssign, Mul};
 
 /// A column borrowed for writes at indices that no two threads touch at once.
 pub struct Disjoint<'a, T> {
@@ -78,6 +78,26 @@ impl<'a, T: Copy> Disjoint<'a, T> {
                 // caller guarantees exclusive access.
                 unsafe { *self.ptr.add(rows.first[r] + a) += v };
             }
+        }
+    }
+
+    /// Adds `value` times each node's weight, `(value q[r]) w_x[a]`, to the entries of a
+    /// stencil of `N` nodes per axis (`w_x`: its x weights; the mass or momentum scatter), as
+    /// [`add_rows`](Self::add_rows).
+    ///
+    /// # Safety
+    /// No other thread may access the stencil's entries during the call.
+    #[inline(always)]
+    pub unsafe fn add_weighted<const N: usize>(&self, rows: &Rows, w_x: &[f64; 3], value: T)
+    where
+        T: AddAssign + Mul<f64, Output = T>,
+    {
+        // SAFETY: the caller's guarantee, passed on.
+        unsafe {
+            self.add_rows(rows, |r| {
+                let vq = value * rows.q[r];
+                std::array::from_fn::<_, N, _>(|a| vq * w_x[a])
+            })
         }
     }
 }

@@ -83,7 +83,7 @@ pub(crate) fn place<D: Dim>(
                             return (Some(i), true);
                         }
                         // A non-negative cell index (fits), converted through i64 (see
-                        // ShapeKind::axis).
+                        // ShapeKind::locate).
                         tile += cell_part[a][xi as i64 as usize];
                         let (first, sp) = S.locate(xi, l);
                         b[a] = first as u32;

@@ -91,10 +91,7 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
                 v_w.set(i, v);
                 x_w.set(i, x_w.get(i) + vn * dt);
                 let mv = v * pmass[i];
-                momentum_w.add_rows(&rows, |r| {
-                    let mvq = mv * rows.q[r];
-                    std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a])
-                });
+                momentum_w.add_weighted::<N>(&rows, &st.w[0], mv);
             }
             if track {
                 fastest = fastest.max(D::dot(vn, vn));

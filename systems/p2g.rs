@@ -63,14 +63,8 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
             // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
             // tile is handled by one thread.
             unsafe {
-                mass_w.add_rows(&rows, |r| {
-                    let mq = m * rows.q[r];
-                    std::array::from_fn::<_, N, _>(|a| mq * st.w[0][a])
-                });
-                momentum_w.add_rows(&rows, |r| {
-                    let mvq = mv * rows.q[r];
-                    std::array::from_fn::<_, N, _>(|a| mvq * st.w[0][a])
-                });
+                mass_w.add_weighted::<N>(&rows, &st.w[0], m);
+                momentum_w.add_weighted::<N>(&rows, &st.w[0], mv);
             }
             if FORCE {
                 // SAFETY: as above.

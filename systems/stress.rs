@@ -3,6 +3,7 @@
 //! crack afterwards, from their fields' entries).
 
 use crate::dim::Dim;
+use crate::disjoint::Disjoint;
 use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
 use crate::shape::{Rows, Stencil};
@@ -96,7 +97,7 @@ pub(crate) fn update_coded<D: Dim>(world: &mut World<D>, dt: f64) {
 /// One particle's update from its velocity gradient `l`: the stress over `dt`, and grad v
 /// and grad u when they are kept.
 #[inline(always)]
-pub(crate) fn apply<D: Dim>(
+fn apply<D: Dim>(
     l: D::Mat,
     dt: f64,
     plane: Plane,
@@ -111,6 +112,61 @@ pub(crate) fn apply<D: Dim>(
     let mut sigma = s.to_sym3();
     m.update(plane, D::sym_part(&l) * dt, &mut sigma);
     *s = D::Sym::from_sym3(sigma);
+}
+
+/// The particle columns a stress update writes, borrowed for writes from the threads of a
+/// fused pass: the stress, and grad v and grad u when J-integrals keep them.
+pub(crate) struct StressColumns<'a, D: Dim> {
+    stress: Disjoint<'a, D::Sym>,
+    grad_v: Disjoint<'a, D::Mat>,
+    grad_u: Disjoint<'a, D::Mat>,
+    keep: bool,
+}
+
+impl<'a, D: Dim> StressColumns<'a, D> {
+    /// Borrows the columns (grad v and grad u are empty unless J-integrals keep them).
+    pub(crate) fn new(
+        stress: &'a mut [D::Sym],
+        grad_v: &'a mut [D::Mat],
+        grad_u: &'a mut [D::Mat],
+    ) -> Self {
+        StressColumns {
+            keep: !grad_u.is_empty(),
+            stress: Disjoint::new(stress),
+            grad_v: Disjoint::new(grad_v),
+            grad_u: Disjoint::new(grad_u),
+        }
+    }
+
+    /// Particle `i`'s update from its velocity gradient `l` (as [`apply`]); returns its new
+    /// stress.
+    ///
+    /// # Safety
+    /// No other thread may access particle `i`'s entries during the call.
+    #[inline(always)]
+    pub(crate) unsafe fn update(
+        &self,
+        i: usize,
+        l: D::Mat,
+        dt: f64,
+        plane: Plane,
+        m: &Elastic,
+    ) -> D::Sym {
+        // SAFETY: the caller's guarantee, passed on.
+        unsafe {
+            let mut s = self.stress.get(i);
+            if self.keep {
+                let (mut gv, mut gu) = (self.grad_v.get(i), self.grad_u.get(i));
+                apply::<D>(l, dt, plane, m, &mut s, Some((&mut gv, &mut gu)));
+                self.grad_v.set(i, gv);
+                self.grad_u.set(i, gu);
+            } else {
+                apply::<D>(l, dt, plane, m, &mut s, None);
+            }
+            self.stress.set(i, s);
+            s
+        }
+    }
 }
 
 /// grad v of one particle away from cracks: sum over its stencil of v_i ⊗ grad S_i, row by

@@ -5,13 +5,12 @@
 
 use crate::crack::Fields;
 use crate::dim::Dim;
-use crate::disjoint::Disjoint;
 use crate::error::Unstable;
 use crate::material::{Elastic, Plane};
 use crate::particles::Particles;
 use crate::shape::{ShapeKind, Stencil};
 use crate::systems::bin::{BeforeBin, outside, place};
-use crate::systems::stress::{apply, node_velocities, update_coded, velocity_gradient};
+use crate::systems::stress::{StressColumns, node_velocities, update_coded, velocity_gradient};
 use crate::world::World;
 
 /// Updates every particle's stress over `fraction` of the step (as
@@ -36,16 +35,13 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) -> Result<(), Unstable> 
     let work = ClosingStress::<D> {
         dt,
         plane: world.settings.plane,
-        keep: !grad_u.is_empty(),
         velocity: &grid.velocity,
         stride: grid.geom.stride,
         inv_h: world.tiles.stencils.inv_h,
         material,
         materials: &world.materials,
         fields: world.cracks.as_ref().map(|c| &c.fields),
-        stress: Disjoint::new(stress),
-        grad_v: Disjoint::new(grad_v),
-        grad_u: Disjoint::new(grad_u),
+        columns: StressColumns::new(stress, grad_v, grad_u),
     };
     let shape = world.settings.shape;
     match place(x, half, &grid.geom, shape, &mut world.tiles, &work) {
@@ -61,16 +57,13 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) -> Result<(), Unstable> 
 struct ClosingStress<'a, D: Dim> {
     dt: f64,
     plane: Plane,
-    keep: bool,
     velocity: &'a [D::Vec],
     stride: [usize; 3],
     inv_h: [f64; 3],
     material: &'a [u16],
     materials: &'a [Elastic],
     fields: Option<&'a Fields>,
-    stress: Disjoint<'a, D::Sym>,
-    grad_v: Disjoint<'a, D::Mat>,
-    grad_u: Disjoint<'a, D::Mat>,
+    columns: StressColumns<'a, D>,
 }
 
 impl<D: Dim> BeforeBin for ClosingStress<'_, D> {
@@ -85,17 +78,6 @@ impl<D: Dim> BeforeBin for ClosingStress<'_, D> {
         let (dt, plane) = (self.dt, self.plane);
         let m = &self.materials[self.material[i] as usize];
         // SAFETY: `place` visits every particle once, on one thread.
-        unsafe {
-            let mut sigma = self.stress.get(i);
-            if self.keep {
-                let (mut gv, mut gu) = (self.grad_v.get(i), self.grad_u.get(i));
-                apply::<D>(l, dt, plane, m, &mut sigma, Some((&mut gv, &mut gu)));
-                self.grad_v.set(i, gv);
-                self.grad_u.set(i, gu);
-            } else {
-                apply::<D>(l, dt, plane, m, &mut sigma, None);
-            }
-            self.stress.set(i, sigma);
-        }
+        unsafe { self.columns.update(i, l, dt, plane, m) };
     }
 }

@@ -8,7 +8,7 @@ use crate::grid::Grid;
 use crate::particles::Particles;
 use crate::shape::Stencil;
 use crate::systems::p2g::{add_internal_force, scatter_coded};
-use crate::systems::stress::{apply, node_velocities, update_coded, velocity_gradient};
+use crate::systems::stress::{StressColumns, node_velocities, update_coded, velocity_gradient};
 use crate::with_shape;
 use crate::world::World;
 
@@ -36,12 +36,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
         material,
         ..
     } = &mut world.particles;
-    let keep = !grad_u.is_empty();
-    let (stress_w, grad_v_w, grad_u_w) = (
-        Disjoint::new(stress),
-        Disjoint::new(grad_v),
-        Disjoint::new(grad_u),
-    );
+    let columns = StressColumns::<D>::new(stress, grad_v, grad_u);
     let (tiles, materials) = (&world.tiles, &world.materials);
     let fields = world.cracks.as_ref().map(|c| &c.fields);
     tiles.for_each_coloured(|t| {
@@ -59,16 +54,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
             // thread, so no other thread touches particle i's entries; tiles of one colour
             // class touch disjoint nodes (tiles.rs).
             unsafe {
-                let mut s = stress_w.get(i);
-                if keep {
-                    let (mut gv, mut gu) = (grad_v_w.get(i), grad_u_w.get(i));
-                    apply::<D>(l, dt, plane, m, &mut s, Some((&mut gv, &mut gu)));
-                    grad_v_w.set(i, gv);
-                    grad_u_w.set(i, gu);
-                } else {
-                    apply::<D>(l, dt, plane, m, &mut s, None);
-                }
-                stress_w.set(i, s);
+                let s = columns.update(i, l, dt, plane, m);
                 add_internal_force::<D, N>(&st, &rows, &s, volume[i], &force_w);
             }
         })

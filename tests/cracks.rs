@@ -5,7 +5,7 @@ mod common;
 use common::{final_world, source};
 use fissure::dim::D2;
 use fissure::scenario::build;
-use fissure::schedule::{Schedule, System};
+use fissure::schedule::Schedule;
 
 /// A 32 x 4 mm bar of 1 mm cells whose left half moves at -1 m/s and right half at +1 m/s,
 /// with `crack` appended (may be empty).
@@ -147,21 +147,7 @@ fn crack_systems_only_in_scenes_with_cracks() {
 fn fused_closing_stress_matches_unfused_with_a_crack() {
     let text = pulled_apart("ugimp", "usavg", ON_GRID_LINE)
         .replace("velocity = [1.0, 0.0]", "velocity = [0.3, 0.2]");
-    let mut fused = build::<D2>(&source(&text)).unwrap().world;
-    let mut apart = fused.clone();
-    let mut fused_schedule = Schedule::for_world(&fused);
-    let mut apart_schedule = fused_schedule.clone();
-    assert!(
-        fused_schedule
-            .systems
-            .iter()
-            .any(|s| matches!(s, System::StressBin { .. }))
-    );
-    // Keeping the stencils runs the closing update unfused.
-    for _ in 0..40 {
-        fused_schedule.step(&mut fused).unwrap();
-        apart_schedule.step_keeping(&mut apart, true).unwrap();
-    }
+    let (fused, apart) = common::fused_and_unfused::<D2>(&text, 40);
     let bits = |w: &fissure::world::World<D2>| {
         format!(
             "{:?} {:?} {:?}",

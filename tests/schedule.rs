@@ -4,7 +4,7 @@ mod common;
 use common::source;
 use fissure::dim::D2;
 use fissure::scenario::build;
-use fissure::schedule::{Schedule, System};
+use fissure::schedule::Schedule;
 use fissure::systems::bin;
 use fissure::world::World;
 
@@ -61,21 +61,7 @@ fn boundaries_add_grid_bc_after_each_momentum_scatter() {
 fn fused_stress_bin_matches_stress_then_bin() {
     for (shape, update) in [("ugimp", "usavg"), ("linear", "usl")] {
         let text = common::mixed_scene(2, shape, update);
-        let mut fused = build::<D2>(&source(&text)).unwrap().world;
-        let mut apart = fused.clone();
-        let mut fused_schedule = Schedule::for_world(&fused);
-        let mut apart_schedule = fused_schedule.clone();
-        assert!(
-            fused_schedule
-                .systems
-                .iter()
-                .any(|s| matches!(s, System::StressBin { .. }))
-        );
-        // Keeping the stencils runs the closing update unfused and leaves binning to `bin`.
-        for _ in 0..30 {
-            fused_schedule.step(&mut fused).unwrap();
-            apart_schedule.step_keeping(&mut apart, true).unwrap();
-        }
+        let (fused, mut apart) = common::fused_and_unfused::<D2>(&text, 30);
         assert!(fused.tiles.fresh && !apart.tiles.fresh);
         bin::run(&mut apart).unwrap();
         let bits = |w: &World<D2>| {

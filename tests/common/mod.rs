@@ -5,7 +5,7 @@ use fissure::dim::Dim;
 use fissure::measure::History;
 use fissure::run::{Outcome, RunOptions, run};
 use fissure::scenario::{Source, build};
-use fissure::schedule::Schedule;
+use fissure::schedule::{Schedule, System};
 use fissure::world::World;
 
 /// Parses scenario text (panics with the located error if it does not parse).
@@ -180,6 +180,28 @@ history_interval = {hist:e}
             extra = self.extra,
         )
     }
+}
+
+/// The world of `text` after `steps` steps run twice: on its schedule, whose closing stress
+/// update is fused with the binning (checked), and keeping the stencils every step, which
+/// runs that update unfused (binning waits for the next step). Returns (fused, unfused).
+pub fn fused_and_unfused<D: Dim>(text: &str, steps: usize) -> (World<D>, World<D>) {
+    let mut fused = build::<D>(&source(text)).unwrap().world;
+    let mut apart = fused.clone();
+    let mut fused_schedule = Schedule::for_world(&fused);
+    let mut apart_schedule = fused_schedule.clone();
+    assert!(
+        fused_schedule
+            .systems
+            .iter()
+            .any(|s| matches!(s, System::StressBin { .. }))
+    );
+    // Keeping the stencils runs the closing update unfused and leaves binning to `bin`.
+    for _ in 0..steps {
+        fused_schedule.step(&mut fused).unwrap();
+        apart_schedule.step_keeping(&mut apart, true).unwrap();
+    }
+    (fused, apart)
 }
 
 /// A box with an initial velocity, gravity, damping, a clamp and a ramped load, and a
