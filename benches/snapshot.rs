@@ -4,38 +4,20 @@
 //! `cargo bench --bench snapshot`. All three include an fsync: the snapshot writer syncs
 //! before its rename, so the copy is synced too for a like-for-like comparison.
 
+mod common;
+
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use fissure::dim::D3;
 use fissure::run::state::RunState;
-use fissure::scenario::{Source, build};
+use fissure::scenario::build;
 use fissure::snapshot::Reader;
 use fissure::snapshot::state::write;
 use std::fs::File;
 use std::time::Duration;
 
-/// 50 x 50 x 50 cells at 2 particles per cell per axis: 1,000,000 particles.
-const SCENE: &str = r#"
-[simulation]
-dimension = 3
-shape = "ugimp"
-duration = 1.0
-[grid]
-min = [-0.002, -0.002, -0.002]
-max = [0.052, 0.052, 0.052]
-cell = [0.001, 0.001, 0.001]
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 7800.0
-[[body]]
-material = "steel"
-box = { min = [0.0, 0.0, 0.0], max = [0.05, 0.05, 0.05] }
-velocity = [1e-3, 0.0, 0.0]
-"#;
-
 fn snapshot(c: &mut Criterion) {
-    let src = Source::parse("snapshot_bench.toml", SCENE, &[]).expect("bench scene parses");
+    // 50 x 50 x 50 cells at 2 particles per cell per axis: 1,000,000 particles.
+    let src = common::block_source("snapshot_bench", 3, 50, "ugimp", "usavg");
     let world = build::<D3>(&src).expect("bench scene builds").world;
     assert_eq!(world.particles.len(), 1_000_000);
     let state = RunState::start(&world, 0, 1, 1.0, 1.0, None);

@@ -1,5 +1,6 @@
-//! The benchmark scene shared by the kernel benches: a steel block filling a regular grid
-//! of 1 mm cells at 2 particles per cell per axis, moving at 1 mm/s.
+//! The benchmark scene shared by the benches: a steel block filling a regular grid of 1 mm
+//! cells at 2 particles per cell per axis, moving at 1 mm/s.
+#![allow(dead_code)]
 
 use fissure::dim::Dim;
 use fissure::scenario::{Source, build};
@@ -41,10 +42,15 @@ velocity = [{vel}]
     )
 }
 
+/// The parsed scenario of [`scene_text`]'s block, named `label` in errors.
+pub fn block_source(label: &str, dim: usize, n: usize, shape: &str, update: &str) -> Source {
+    let text = scene_text(dim, n, shape, update);
+    Source::parse(label, &text, &[]).expect("bench scene parses")
+}
+
 /// The built world of [`scene_text`]'s block, named `label` in errors.
 pub fn block<D: Dim>(label: &str, n: usize, shape: &str, update: &str) -> World<D> {
-    let text = scene_text(D::D, n, shape, update);
-    let src = Source::parse(label, &text, &[]).expect("bench scene parses");
+    let src = block_source(label, D::D, n, shape, update);
     build::<D>(&src).expect("bench scene builds").world
 }
 
