@@ -114,6 +114,18 @@ fn main() {
         .skip(1)
         .filter(|a| !a.starts_with("--"))
         .collect();
+    let chosen: Vec<_> = SCENES
+        .into_iter()
+        .filter(|s| filters.is_empty() || filters.iter().any(|f| s.0.contains(f.as_str())))
+        .collect();
+    if chosen.is_empty() {
+        let labels: Vec<_> = SCENES.iter().map(|s| s.0).collect();
+        eprintln!(
+            "no scene label contains any of {filters:?}; the scenes are {}",
+            labels.join(", ")
+        );
+        std::process::exit(2);
+    }
     let pool = |n| {
         ThreadPoolBuilder::new()
             .num_threads(n)
@@ -130,10 +142,7 @@ fn main() {
         "{:14} {:>9} {:>9} {:>9} {:>11} {:>9} {:>9}",
         "scene", "1 thread", "2 threads", "speed-up", "range", "ceiling", "of ceil."
     );
-    for (label, dim, n, shape, update) in SCENES {
-        if !filters.is_empty() && !filters.iter().any(|f| label.contains(f.as_str())) {
-            continue;
-        }
+    for (label, dim, n, shape, update) in chosen {
         if dim == 2 {
             scene::<D2>(label, n, shape, update, &pools);
         } else {
