@@ -99,8 +99,8 @@ pub struct World<D: Dim> {
     pub cracks: Option<Cracks<D>>,
 }
 
-/// Particles per chunk in parallel particle loops; fixed so reductions do not depend on
-/// the thread count.
+/// Particles (or grid nodes) per chunk in parallel loops; fixed so reductions do not
+/// depend on the thread count.
 pub const CHUNK: usize = 1024;
 
 impl<D: Dim> World<D> {

@@ -4,11 +4,8 @@
 use crate::crack::Fields;
 use crate::dim::Dim;
 use crate::grid::Grid;
-use crate::world::World;
+use crate::world::{CHUNK, World};
 use rayon::prelude::*;
-
-/// Nodes per chunk in parallel node loops (fixed, so reductions are thread-count independent).
-const NODE_CHUNK: usize = 4096;
 
 /// Overwrites prescribed components of the extrapolated momenta so that p/m equals the
 /// prescribed velocity at the start of the step, or at its end when `end` (after a remap).
@@ -43,16 +40,13 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         ..
     } = &mut world.grid;
     let (mass, momentum, force) = (&*mass, &*momentum, &*force);
-    let sums: Vec<(f64, f64)> = (
-        velocity.par_chunks_mut(NODE_CHUNK),
-        accel.par_chunks_mut(NODE_CHUNK),
-    )
+    let sums: Vec<(f64, f64)> = (velocity.par_chunks_mut(CHUNK), accel.par_chunks_mut(CHUNK))
         .into_par_iter()
         .enumerate()
         .map(|(c, (vel, acc))| {
             let (mut damp, mut grav) = (0.0, 0.0);
             for k in 0..vel.len() {
-                let n = c * NODE_CHUNK + k;
+                let n = c * CHUNK + k;
                 let m = mass[n];
                 if m > tol {
                     let v0 = momentum[n] * (1.0 / m);
