@@ -13,7 +13,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use fissure::dim::{D2, D3, Dim};
 use fissure::schedule::Schedule;
 use fissure::systems::{bin, g2p, grid_update, p2g, stress, stress_bin, stress_force};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, n: usize, shape: &str, update: &str) {
     let mut world = block::<D>(label, n, shape, update);
@@ -42,13 +42,22 @@ fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, n: usize, shape: &str, up
     g.bench_function("stress_force", |b| {
         b.iter(|| stress_force::run(&mut world, 1.0))
     });
-    // As the launcher does, the step runs inside the pool, so its parallel loops are not
-    // each handed over from an outside thread.
+    // As in the launcher, the steps run inside the pool: a sample's steps are one hand-over
+    // from this thread, not one each (which on small scenes costs a worker's wake-up per
+    // step).
     let pool = rayon::ThreadPoolBuilder::new()
         .build()
         .expect("thread pool");
     g.bench_function("step", |b| {
-        b.iter(|| pool.install(|| schedule.step(&mut world).expect("stable")))
+        b.iter_custom(|iters| {
+            pool.install(|| {
+                let t0 = Instant::now();
+                for _ in 0..iters {
+                    schedule.step(&mut world).expect("stable");
+                }
+                t0.elapsed()
+            })
+        })
     });
     g.finish();
 }
