@@ -173,8 +173,8 @@ pub struct Classified<D: Dim> {
     pub drift: f64,
     /// Particles within reach of a crack at the last full pass, in increasing order.
     pub watched: Vec<u32>,
-    /// Stencil base of each watched particle when it was classified.
-    pub base: Vec<[u32; 3]>,
+    /// First stencil node of each watched particle when it was classified.
+    pub first: Vec<u32>,
     /// A watched particle's record stands while `drift` plus the cracks' movement since the
     /// full pass stays below this (m).
     pub budget: Vec<f64>,
@@ -205,7 +205,7 @@ impl<D: Dim> Default for Classified<D> {
             x0: Vec::new(),
             drift: 0.0,
             watched: Vec::new(),
-            base: Vec::new(),
+            first: Vec::new(),
             budget: Vec::new(),
             crosses: Vec::new(),
             masks: Vec::new(),

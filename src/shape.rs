@@ -141,8 +141,8 @@ fn gimp_1d(r: f64, l: f64) -> (f64, f64) {
 /// Shape-function values and gradients of one particle on its `N` nodes per axis.
 #[derive(Clone, Copy, Debug)]
 pub struct Stencil<const N: usize> {
-    /// First node index per axis.
-    pub base: [usize; 3],
+    /// Linear index of the stencil's first node (lowest on every axis).
+    pub first: usize,
     /// 1D weights per axis (the unused third axis in 2D has weight 1 on its only node).
     pub w: [[f64; 3]; 3],
     /// 1D derivatives per axis (1/m).
@@ -210,16 +210,12 @@ impl<const N: usize> Stencil<N> {
         rows
     }
 
-    /// Index of the first node of the row at offsets `j` (y) and `k` (z) from the base; in 2D
-    /// the z term is left out at compile time.
+    /// Index of the first node of the row at offsets `j` (y) and `k` (z) from the stencil's
+    /// first node; in 2D the z term is left out at compile time.
     #[inline(always)]
     fn first_node<D: Dim>(&self, stride: &[usize; 3], j: usize, k: usize) -> usize {
-        let first = self.base[0] + stride[1] * (self.base[1] + j);
-        if D::D == 3 {
-            first + stride[2] * (self.base[2] + k)
-        } else {
-            first
-        }
+        let row = self.first + stride[1] * j;
+        if D::D == 3 { row + stride[2] * k } else { row }
     }
 }
 
@@ -253,14 +249,15 @@ impl Rows {
 }
 
 /// Every particle's stencil, evaluated once after the particles move and read by each
-/// system that needs it until they move again (up to four times a step): per axis the
-/// first node and the shape's [`params`](ShapeKind::params), from which the weights and
-/// derivatives are rebuilt on reading. Keeping the parameters instead of the weights
-/// shrinks what the passes over the particles stream from memory.
+/// system that needs it until they move again (up to four times a step): the linear index
+/// of its first node and per axis the shape's [`params`](ShapeKind::params), from which the
+/// weights and derivatives are rebuilt on reading. Keeping the parameters instead of the
+/// weights, and one node index instead of one per axis, shrinks what the passes over the
+/// particles stream from memory.
 #[derive(Clone, Debug, Default)]
 pub struct StencilCache {
-    /// First node per axis of each particle.
-    pub base: Vec<[u32; 3]>,
+    /// Linear index of each particle's first stencil node.
+    pub first: Vec<u32>,
     /// Per particle and axis: the shape's parameters.
     pub params: Vec<f64>,
     /// Inverse cell size per axis (1/m).
@@ -280,13 +277,13 @@ impl StencilCache {
         n: usize,
         shape: ShapeKind,
         inv_h: D::Vec,
-    ) -> (&mut [[u32; 3]], &mut [f64]) {
+    ) -> (&mut [u32], &mut [f64]) {
         for a in 0..D::D {
             self.inv_h[a] = inv_h[a];
         }
-        self.base.resize(n, [0; 3]);
+        self.first.resize(n, 0);
         self.params.resize(n * Self::per::<D>(shape), 0.0);
-        (&mut self.base, &mut self.params)
+        (&mut self.first, &mut self.params)
     }
 }
 
@@ -297,19 +294,19 @@ impl<const N: usize> Stencil<N> {
         let per = StencilCache::per::<D>(s);
         Self::from_cache::<D>(
             s,
-            cache.base[i],
+            cache.first[i],
             &cache.params[i * per..(i + 1) * per],
             &cache.inv_h,
         )
     }
 
-    /// A stencil of shape `s` from one particle's cache entries: its first nodes and its
+    /// A stencil of shape `s` from one particle's cache entries: its first node and its
     /// [`per`](StencilCache::per) parameters, on a grid of inverse cell size `inv_h`.
     #[inline(always)]
-    pub fn from_cache<D: Dim>(s: ShapeKind, b: [u32; 3], src: &[f64], inv_h: &[f64; 3]) -> Self {
+    pub fn from_cache<D: Dim>(s: ShapeKind, first: u32, src: &[f64], inv_h: &[f64; 3]) -> Self {
         debug_assert_eq!(s.nodes(), N);
         let mut st = Stencil {
-            base: [b[0] as usize, b[1] as usize, b[2] as usize],
+            first: first as usize,
             w: [[1.0, 0.0, 0.0]; 3],
             dw: [[0.0; 3]; 3],
         };

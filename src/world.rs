@@ -130,10 +130,10 @@ impl<D: Dim> World<D> {
     }
 
     /// Bytes held per particle: the particle columns plus the bins (tile and order, 4 bytes
-    /// each) and the cached stencil (12 bytes of base plus the shape's parameters).
+    /// each) and the cached stencil (a 4-byte first node plus the shape's parameters).
     pub fn bytes_per_particle(&self) -> usize {
         let params = StencilCache::per::<D>(self.settings.shape);
-        self.particles.bytes_per_particle() + 8 + 12 + 8 * params
+        self.particles.bytes_per_particle() + 8 + 4 + 8 * params
     }
 
     /// Total linear momentum (kg m/s).

@@ -28,14 +28,14 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
 /// Work fused into the binning: a system's last use of each particle's old stencil.
 pub(crate) trait BeforeBin: Sync {
     /// Called with particle `i`'s cached stencil (shape `s` of `N` nodes per axis: first
-    /// nodes `base`, parameters `params`) just before the new one overwrites it.
-    fn before<const N: usize>(&self, s: ShapeKind, i: usize, base: [u32; 3], params: &[f64]);
+    /// node `first`, parameters `params`) just before the new one overwrites it.
+    fn before<const N: usize>(&self, s: ShapeKind, i: usize, first: u32, params: &[f64]);
 }
 
 /// Plain binning: nothing before.
 impl BeforeBin for () {
     #[inline(always)]
-    fn before<const N: usize>(&self, _: ShapeKind, _: usize, _: [u32; 3], _: &[f64]) {}
+    fn before<const N: usize>(&self, _: ShapeKind, _: usize, _: u32, _: &[f64]) {}
 }
 
 /// Evaluates every particle's stencil and tile in one pass over particle chunks, calling
@@ -56,25 +56,25 @@ pub(crate) fn place<D: Dim>(
     tile_of.resize(x.len(), u32::MAX);
     let per = StencilCache::per::<D>(shape);
     let cell_part = &tiles.cell_part;
-    let (base, params) = tiles.stencils.resize::<D>(x.len(), shape, geom.inv_h);
+    let (first, params) = tiles.stencils.resize::<D>(x.len(), shape, geom.inv_h);
     // Per chunk: the first particle whose stencil leaves the grid, and whether any particle
     // changed tile.
     let chunks: Vec<(Option<usize>, bool)> = (
         tile_of.par_chunks_mut(CHUNK),
-        base.par_chunks_mut(CHUNK),
+        first.par_chunks_mut(CHUNK),
         params.par_chunks_mut(CHUNK * per),
     )
         .into_par_iter()
         .enumerate()
-        .map(|(c, (out, base, params))| {
+        .map(|(c, (out, first, params))| {
             with_shape!(shape, S, N => {
                 let (mut moved, p) = (false, S.params());
-                let rows = base.iter_mut().zip(params.chunks_exact_mut(per));
-                for (k, (t, (b, w))) in out.iter_mut().zip(rows).enumerate() {
+                let rows = first.iter_mut().zip(params.chunks_exact_mut(per));
+                for (k, (t, (f, w))) in out.iter_mut().zip(rows).enumerate() {
                     let i = c * CHUNK + k;
-                    work.before::<N>(S, i, *b, w);
+                    work.before::<N>(S, i, *f, w);
                     let half = if half.is_empty() { D::zero() } else { half[i] };
-                    let mut tile = 0;
+                    let (mut tile, mut node) = (0, 0);
                     for a in 0..D::D {
                         let xi = (x[i][a] - geom.origin[a]) * geom.inv_h[a];
                         let l = half[a] * geom.inv_h[a];
@@ -85,10 +85,13 @@ pub(crate) fn place<D: Dim>(
                         // A non-negative cell index (fits), converted through i64 (see
                         // ShapeKind::locate).
                         tile += cell_part[a][xi as i64 as usize];
-                        let (first, sp) = S.locate(xi, l);
-                        b[a] = first as u32;
+                        let (base, sp) = S.locate(xi, l);
+                        node += base * geom.stride[a];
                         w[p * a..p * (a + 1)].copy_from_slice(&sp[..p]);
                     }
+                    // Below the node count (the stencil fits), which scenarios cap at 2e8,
+                    // so it fits in u32.
+                    *f = node as u32;
                     moved |= tile != *t;
                     *t = tile;
                 }

@@ -240,11 +240,12 @@ impl<D: Dim> Pass<'_, D> {
         let (geom, elements) = (self.geom, &self.elements);
         // Every line from the particle to a node of its stencil lies in the stencil's node
         // box (which holds the particle).
+        let base = geom.node_ijk(st.first);
         let mut corners = [D::zero(); 8];
         for (k, c) in corners.iter_mut().enumerate().take(1 << D::D) {
             *c = geom.origin;
             for a in 0..D::D {
-                let i = st.base[a] + (N - 1) * (k >> a & 1);
+                let i = base[a] + (N - 1) * (k >> a & 1);
                 c[a] += i as f64 * geom.h[a];
             }
         }
@@ -262,7 +263,7 @@ impl<D: Dim> Pass<'_, D> {
                     for i in 0..N {
                         let mut xn = geom.origin;
                         for (a, o) in [i, j, k].into_iter().enumerate().take(D::D) {
-                            xn[a] += (st.base[a] + o) as f64 * geom.h[a];
+                            xn[a] += (base[a] + o) as f64 * geom.h[a];
                         }
                         s.nodes.push(xn);
                     }
@@ -328,7 +329,7 @@ impl<D: Dim> Pass<'_, D> {
         clearance
     }
 
-    /// Classifies watched particle `j` at `xp`: its masks, stencil base and budget, with
+    /// Classifies watched particle `j` at `xp`: its masks, first stencil node and budget, with
     /// `used` the movement since the full pass that the budget no longer has to absorb. A
     /// particle whose clearance was zero with the same stencil keeps a zero one until the
     /// next full pass (a node on a crack line, a line through a crack tip): it is redone
@@ -337,13 +338,13 @@ impl<D: Dim> Pass<'_, D> {
         let per = self.per();
         let i = rec.watched[j] as usize;
         let masks = &mut rec.masks[j * per..(j + 1) * per];
-        let clear = rec.budget[j] > f64::NEG_INFINITY || self.stencils.base[i] != rec.base[j];
+        let clear = rec.budget[j] > f64::NEG_INFINITY || self.stencils.first[i] != rec.first[j];
         let clearance = with_shape!(self.shape, S, N => {
             let st = Stencil::<N>::cached::<D>(S, self.stencils, i);
             self.classify_one(xp, &st, clear, s, masks)
         });
         rec.crosses[j] = masks.iter().any(|&m| m != 0);
-        rec.base[j] = self.stencils.base[i];
+        rec.first[j] = self.stencils.first[i];
         rec.budget[j] = if clearance > self.slack {
             clearance - self.slack + used
         } else {
@@ -383,7 +384,7 @@ impl<D: Dim> Pass<'_, D> {
         }
         rec.watched.sort_unstable();
         let n = rec.watched.len();
-        rec.base.resize(n, [0; 3]);
+        rec.first.resize(n, 0);
         rec.budget.clear();
         rec.budget.resize(n, f64::INFINITY);
         rec.crosses.resize(n, false);
@@ -402,7 +403,7 @@ impl<D: Dim> Pass<'_, D> {
         let mut s = Scratch::new();
         for j in 0..rec.watched.len() {
             let i = rec.watched[j] as usize;
-            if self.stencils.base[i] == rec.base[j] && rec.drift + moved < rec.budget[j] {
+            if self.stencils.first[i] == rec.first[j] && rec.drift + moved < rec.budget[j] {
                 continue;
             }
             // From now on the particle moves at most the drift still to come, and the cracks

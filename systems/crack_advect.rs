@@ -63,14 +63,14 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 continue;
             }
             let mut st = Stencil::<2> {
-                base: [0; 3],
+                first: 0,
                 w: [[1.0, 0.0, 0.0]; 3],
                 dw: [[0.0; 3]; 3],
             };
             for a in 0..D::D {
                 let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
                 let (b, w, dw) = ShapeKind::Linear.axis(xi, 0.0, geom.inv_h[a]);
-                st.base[a] = b;
+                st.first += b * geom.stride[a];
                 st.w[a] = w;
                 st.dw[a] = dw;
             }

@@ -68,12 +68,12 @@ struct ClosingStress<'a, D: Dim> {
 
 impl<D: Dim> BeforeBin for ClosingStress<'_, D> {
     #[inline(always)]
-    fn before<const N: usize>(&self, s: ShapeKind, i: usize, base: [u32; 3], params: &[f64]) {
+    fn before<const N: usize>(&self, s: ShapeKind, i: usize, first: u32, params: &[f64]) {
         // Particles near a crack were updated from their fields' entries already.
         if self.fields.is_some_and(|f| f.is_coded(i)) {
             return;
         }
-        let st = Stencil::<N>::from_cache::<D>(s, base, params, &self.inv_h);
+        let st = Stencil::<N>::from_cache::<D>(s, first, params, &self.inv_h);
         let l = velocity_gradient::<D, N>(&st, &st.rows::<D>(&self.stride), self.velocity);
         let (dt, plane) = (self.dt, self.plane);
         let m = &self.materials[self.material[i] as usize];

@@ -70,7 +70,7 @@ fn fused_stress_bin_matches_stress_then_bin() {
                 w.particles.stress,
                 w.particles.x,
                 w.tiles.order,
-                w.tiles.stencils.base,
+                w.tiles.stencils.first,
                 w.tiles.stencils.params
             )
         };
