@@ -150,11 +150,11 @@ impl Tiles {
 /// returns with `fold` from `init`. The tiles are split into contiguous halves of equal
 /// particle count (`count` of a tile), recursively, until a piece holds an eighth of a
 /// thread's share or one tile; `rayon::join` runs the halves, so an idle thread steals the
-/// largest piece left. Halves of equal tile count (rayon's split) gave one of two threads
-/// twice the other's particles in the DCB's colour classes, whose tiles are unevenly
-/// filled; and contiguous halves, unlike handing out tiles one by one (measured slower),
-/// keep each thread on the same tiles, and their particles in its cache, from system to
-/// system. Which thread runs a tile changes no result: tiles of one class write disjoint
+/// largest piece left. Halves of equal tile count, where rayon's own split starts, give one
+/// of two threads twice the other's particles in the DCB's colour classes, whose tiles are
+/// unevenly filled; and contiguous halves, unlike handing out tiles one by one (measured
+/// slower), keep each thread on the same tiles, and their particles in its cache, from
+/// system to system. Which thread runs a tile changes no result: tiles of one class write disjoint
 /// entries, and `fold` must not depend on the order of its values.
 fn weighted_join<T: Send + Sync + Copy>(
     class: &[u32],

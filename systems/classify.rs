@@ -329,11 +329,11 @@ impl<D: Dim> Pass<'_, D> {
         clearance
     }
 
-    /// Classifies watched particle `j` at `xp`: its masks, first stencil node and budget, with
-    /// `used` the movement since the full pass that the budget no longer has to absorb. A
-    /// particle whose clearance was zero with the same stencil keeps a zero one until the
-    /// next full pass (a node on a crack line, a line through a crack tip): it is redone
-    /// every step, and its clearance is not worth measuring each time.
+    /// Classifies watched particle `j` at `xp`: its masks, first stencil node and budget,
+    /// with `used` the movement since the full pass that the budget no longer has to
+    /// absorb. A particle whose clearance was zero with the same stencil keeps a zero one
+    /// until the next full pass (a node on a crack line, a line through a crack tip): it is
+    /// redone every step, and its clearance is not worth measuring each time.
     fn one(&self, rec: &mut Classified<D>, j: usize, xp: D::Vec, used: f64, s: &mut Scratch<D>) {
         let per = self.per();
         let i = rec.watched[j] as usize;
