@@ -196,7 +196,7 @@ impl<const N: usize> Stencil<N> {
             gy: [0.0; 9],
             gz: [0.0; 9],
         };
-        let mut layer = self.first_node::<D>(stride, 0, 0);
+        let mut layer = self.first;
         for k in 0..nk {
             let (w2, dw2) = (self.w[2][k], self.dw[2][k]);
             for j in 0..N {
