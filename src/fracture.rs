@@ -19,6 +19,23 @@ pub struct FracturePlan {
     pub compare_from: f64,
     /// K that fracture.png divides by (Pa sqrt(m)), e.g. s0 sqrt(pi a).
     pub k0: Option<f64>,
+    /// Which K_I, K_II are reported (both are measured and written).
+    pub k_method: KMethod,
+    /// Radius of the interaction integral's domain, in cells (of the larger cell size).
+    pub domain: f64,
+}
+
+/// How the reported K_I and K_II are obtained.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KMethod {
+    /// sqrt(E' G) with G from J, split in the ratio K_II / K_I of the interaction integral
+    /// ([`k_from_mixity`]).
+    Mixity,
+    /// The interaction integral alone (`crate::interaction`).
+    Interaction,
+    /// G split by the crack opening and sliding behind the tip (Guo & Nairn 2D (2004) Eqs.
+    /// 14-22, with the fit of `FracturePlan::opening`).
+    Opening,
 }
 
 /// J on one contour at one tip and time, its line and area parts apart (J/m^2): the
@@ -56,8 +73,15 @@ pub struct TipResult {
     pub x: [f64; 3],
     /// J components in global x and y (Eq. 7 or 8).
     pub j: [f64; 2],
-    /// Mode I, II and III stress intensity factors (KIII = 0 in 2D).
+    /// Mode I, II and III stress intensity factors as reported (KIII = 0 in 2D): those of
+    /// `FracturePlan::k_method`.
     pub k: [f64; 3],
+    /// K_I, K_II from the interaction integral.
+    pub k_interaction: [f64; 2],
+    /// K_I, K_II from G and the crack opening.
+    pub k_opening: [f64; 2],
+    /// Radius of the interaction integral's domain (m); 0 when none fitted.
+    pub domain: f64,
 }
 
 /// Crack-speed factors for a tip running at speed `c` (Nishioka 1995, as quoted in Guo &
@@ -80,6 +104,27 @@ pub fn kappa(m: &Elastic, plane: Plane) -> f64 {
         Plane::Stress => (3.0 - m.poisson) / (1.0 + m.poisson),
         Plane::Strain | Plane::None => 3.0 - 4.0 * m.poisson,
     }
+}
+
+/// E' = E in plane stress, E / (1 - nu^2) in plane strain: G = (K_I^2 + K_II^2) / E'.
+pub fn e_prime(m: &Elastic, plane: Plane) -> f64 {
+    match plane {
+        Plane::Stress => m.youngs,
+        Plane::Strain | Plane::None => m.youngs / (1.0 - m.poisson * m.poisson),
+    }
+}
+
+/// K_I and K_II of magnitude sqrt(E' g) in the ratio of `k` (a stationary tip: G = (K_I^2 +
+/// K_II^2) / E', Irwin 1957). The energy release rate `g` comes from the path-independent J
+/// and the mode mixity from the interaction integral, which is the more sensitive of the
+/// two to where the discrete crack's tip lies. NaN when `k` is NaN or zero.
+pub fn k_from_mixity(m: &Elastic, plane: Plane, g: f64, k: [f64; 2]) -> [f64; 2] {
+    let norm = k[0].hypot(k[1]);
+    if !(norm > 0.0) {
+        return [f64::NAN; 2];
+    }
+    let scale = (e_prime(m, plane) * g.max(0.0)).sqrt() / norm;
+    [k[0] * scale, k[1] * scale]
 }
 
 /// K_I and K_II from the energy release rate `g` and the opening `d_i` and sliding `d_ii`

@@ -15,20 +15,6 @@ pub struct Load<D: Dim> {
     pub time: TimeFn,
 }
 
-/// Stress (xx, yy, xy) of the leading near-tip term for a crack along theta = +-pi, at
-/// polar position (r, theta) about the tip (Williams 1957, Irwin 1957; the closed form in
-/// REFERENCE.md). Independent of the material and of plane strain or stress.
-pub fn williams_stress(k1: f64, k2: f64, r: f64, theta: f64) -> [f64; 3] {
-    let a = 1.0 / (2.0 * std::f64::consts::PI * r).sqrt();
-    let (s, c) = (0.5 * theta).sin_cos();
-    let (s3, c3) = (1.5 * theta).sin_cos();
-    [
-        a * (k1 * c * (1.0 - s * s3) - k2 * s * (2.0 + c * c3)),
-        a * (k1 * c * (1.0 + s * s3) + k2 * s * c * c3),
-        a * (k1 * s * c * c3 + k2 * c * (1.0 - s * s3)),
-    ]
-}
-
 /// Prescribed velocity components on a fixed set of grid nodes (fixed supports, symmetry
 /// planes, moving grips).
 #[derive(Clone, Debug)]
@@ -90,21 +76,6 @@ mod tests {
     use super::*;
     use std::f64::consts::PI;
 
-    /// The faces theta = +-pi carry no traction (s_yy = s_xy = 0) and, ahead of the tip,
-    /// s_yy = K_I / sqrt(2 pi r) and s_xy = K_II / sqrt(2 pi r).
-    #[test]
-    fn williams_faces_are_free_and_ligament_carries_k() {
-        let (k1, k2, r) = (2.0e6, -0.7e6, 1e-3);
-        let a = 1.0 / (2.0 * std::f64::consts::PI * r).sqrt();
-        let ahead = williams_stress(k1, k2, r, 0.0);
-        assert!((ahead[1] - k1 * a).abs() < 1e-9 * k1 * a);
-        assert!((ahead[2] - k2 * a).abs() < 1e-9 * k1 * a);
-        for t in [std::f64::consts::PI, -std::f64::consts::PI] {
-            let face = williams_stress(k1, k2, r, t);
-            assert!(face[1].abs() < 1e-9 * k1 * a && face[2].abs() < 1e-9 * k1 * a);
-        }
-    }
-
     /// Far from the crack the centre-crack field is the remote stress; the faces are free;
     /// near a tip it is the Williams field with K_I = s_yy sqrt(pi a), K_II = s_xy sqrt(pi a)
     /// (checked around the right tip, where theta is measured as for Williams).
@@ -126,7 +97,7 @@ mod tests {
         for t in [-3.0, -2.0, -1.0, 0.0, 0.5, 1.5, 2.5, 3.1] {
             let s = centre_crack_stress(remote, a, a + r * f64::cos(t), r * f64::sin(t)).unwrap();
             // Williams plus the T-stress s_xx - s_yy; the next terms vanish like sqrt(r).
-            let mut w = williams_stress(k1, k2, r, t);
+            let mut w = crate::near_tip::stress(k1, k2, r, t);
             w[0] += remote[0] - remote[1];
             for (s, w) in s.iter().zip(w) {
                 assert!(

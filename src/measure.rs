@@ -124,6 +124,16 @@ pub enum Measure {
         /// Time (s): interpolated linearly between the rows around it; None for the last row.
         at: Option<f64>,
     },
+    /// How far K at a crack tip moves once settled: the largest |K(t) - K(end)| over the
+    /// rows from `from` on, relative to |K(end)| (K as the vector (K_I, K_II)).
+    KDrift {
+        /// Crack index.
+        crack: u32,
+        /// 0 start, 1 end.
+        tip: u32,
+        /// Start of the window (s).
+        from: f64,
+    },
     /// Path dependence of J with the area term at a crack tip: the largest
     /// [`path_difference`] of the compared contours against the main one.
     PathDifference {
@@ -228,6 +238,19 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             let (a, b) = (rows[k - 1], rows[k]);
             let w = (t - a.time) / (b.time - a.time);
             finite(value(a) + w * (value(b) - value(a)))
+        }
+        Measure::KDrift { crack, tip, from } => {
+            let rows: Vec<&TipResult> = h
+                .fracture
+                .iter()
+                .filter(|r| r.crack == crack && r.tip == tip && r.time >= from)
+                .collect();
+            let last = rows.last()?.k;
+            let worst = rows
+                .iter()
+                .map(|r| (r.k[0] - last[0]).hypot(r.k[1] - last[1]))
+                .fold(0.0, f64::max);
+            finite(worst / last[0].hypot(last[1]))
         }
         Measure::PathDifference {
             crack,

@@ -5,7 +5,8 @@
 
 use crate::crack::{Crack, Cracks};
 use crate::dim::Dim;
-use crate::fracture::{FracturePlan, PathResult, TipResult, k_from_g};
+use crate::fracture::{FracturePlan, KMethod, PathResult, TipResult, k_from_g, k_from_mixity};
+use crate::interaction::{Tip, interaction_k};
 use crate::shape::Stencil;
 use crate::sym::SymTensor;
 use crate::with_shape;
@@ -119,6 +120,9 @@ fn tip<D: Dim>(
         x: D::to_xyz(cracks.x[kt]),
         j: [f64::NAN; 2],
         k: [f64::NAN, f64::NAN, 0.0],
+        k_interaction: [f64::NAN; 2],
+        k_opening: [f64::NAN; 2],
+        domain: 0.0,
     };
 
     let Some(main) = contour_j(world, cracks, c, &verts, xt, plan.contour, plan.area_term) else {
@@ -169,7 +173,21 @@ fn tip<D: Dim>(
     }
     let [d_i, d_ii] = opening_amplitudes(cracks, &verts, end, xt, dir, h, window);
     let mat = &world.materials[world.particles.material[main.nearest] as usize];
-    let [k1, k2] = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
+    res.k_opening = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
+    let at = Tip {
+        crack: c,
+        end,
+        x: xt,
+        dir,
+    };
+    let ik = interaction_k(world, cracks, at, plan.domain * h, h, 2.0 * h, mat);
+    res.k_interaction = ik.k;
+    res.domain = ik.radius;
+    let [k1, k2] = match plan.k_method {
+        KMethod::Mixity => k_from_mixity(mat, world.settings.plane, gr, ik.k),
+        KMethod::Interaction => res.k_interaction,
+        KMethod::Opening => res.k_opening,
+    };
     res.k = [k1, k2, 0.0];
     (res, paths)
 }

@@ -1,4 +1,4 @@
-//! Plain-MPM bar cases against closed forms (REFERENCE.md, "Plain MPM"), in 2D and 3D.
+//! Plain-MPM bar cases against closed forms (scenarios/reference/README.md, "Plain MPM"), in 2D and 3D.
 
 mod common;
 use common::{Bar, history};

@@ -229,6 +229,14 @@ fn bad_fracture_requests_name_the_key() {
     assert_error(&e, "expect[0].at", None, "must lie in the run");
     let e = error_with_text(&expect("quantity = \"max\"\nat = 1e-5\n"));
     assert_error(&e, "expect[0].at", None, "applies to KI");
+    let e = error_with_text(&expect("quantity = \"K_drift\"\n"));
+    assert_error(&e, "expect[0].from", None, "give its start");
+    let e = error_with_text(&expect("quantity = \"KI\"\nfrom = 1e-5\n"));
+    assert_error(&e, "expect[0].from", None, "applies to K_drift");
+    let e = error_with_text(&format!("{crack}[fracture]\nk_from = \"fit\"\n"));
+    assert_error(&e, "fracture.k_from", None, "unknown method `fit`");
+    let e = error_with_text(&format!("{crack}[fracture]\ndomain = 1.5\n"));
+    assert_error(&e, "fracture.domain", None, "at least 2");
     let e = error_with_text(&format!(
         "{crack}[fracture]\n[[expect]]\nquantity = \"KI\"\ncrack = \"crack0\"\ntip = \"start\"\nreference = 1.0\nsource = \"s\"\ntolerance = 0.1\n"
     ));

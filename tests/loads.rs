@@ -3,7 +3,7 @@
 //! is the closed-form traction times the face it carries.
 
 use fissure::dim::D2;
-use fissure::loads::williams_stress;
+use fissure::near_tip;
 use fissure::scenario::{Source, build};
 
 /// A 10 mm square at 0.5 mm cells, 2 particles per cell per axis, the four faces loaded by
@@ -72,7 +72,7 @@ fn williams_force_is_traction_times_face() {
         let x = p.x[i as usize];
         // The face point is half a particle spacing (0.125 mm) outside the particle centre.
         let (fx, fy) = (x.x + 0.000125, x.y);
-        let [sxx, _, sxy] = williams_stress(1.0e6, 0.5e6, fx.hypot(fy), fy.atan2(fx));
+        let [sxx, _, sxy] = near_tip::stress(1.0e6, 0.5e6, fx.hypot(fy), fy.atan2(fx));
         let area = 0.00025; // face length times the unit thickness of plane strain
         assert!(
             (f.x - sxx * area).abs() < 1e-12 * sxx.abs().max(1.0),

@@ -5,7 +5,7 @@ use crate::world::Energies;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
-/// The run summary (DESIGN.md's output contract).
+/// The run summary written to summary.json at the end of a run.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
     /// Scenario name.

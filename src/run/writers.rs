@@ -54,7 +54,11 @@ impl Writers {
         let fracture = match cracks {
             Some(names) => {
                 let mut f = create("fracture.csv")?;
-                writeln!(f, "step,time,crack,tip,x,y,z,J1,J2,KI,KII,KIII")?;
+                writeln!(
+                    f,
+                    "step,time,crack,tip,x,y,z,J1,J2,KI,KII,KIII,\
+                     KI_interaction,KII_interaction,KI_opening,KII_opening,domain"
+                )?;
                 Some((f, names.to_vec()))
             }
             None => None,
@@ -125,7 +129,8 @@ impl Writers {
         for t in tips {
             writeln!(
                 f,
-                "{},{:.9e},{},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
+                "{},{:.9e},{},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},\
+                 {:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
                 t.step,
                 t.time,
                 names[t.crack as usize],
@@ -137,7 +142,12 @@ impl Writers {
                 t.j[1],
                 t.k[0],
                 t.k[1],
-                t.k[2]
+                t.k[2],
+                t.k_interaction[0],
+                t.k_interaction[1],
+                t.k_opening[0],
+                t.k_opening[1],
+                t.domain
             )?;
         }
         Ok(())

@@ -474,9 +474,13 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let tip_qty = ["KI", "KII", "J1", "J2"]
             .iter()
             .position(|q| *q == e.quantity);
+        if e.from.is_some() && e.quantity != "K_drift" {
+            return Err(src.error(&key("from"), "`from` applies to K_drift"));
+        }
         let crack_measure = match tip_qty {
             Some(qty) => Some(super::cracks::tip_measure(src, i, e, qty)?),
             None if e.quantity == "J_path" => Some(super::cracks::path_measure(src, i, e)?),
+            None if e.quantity == "K_drift" => Some(super::cracks::drift_measure(src, i, e)?),
             None => None,
         };
         if let Some(measure) = crack_measure {
@@ -509,7 +513,8 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     &key("quantity"),
                     format!(
                         "unknown quantity `{other}` (final, max, min, frequency, wave_speed, \
-                         momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2)"
+                         momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2, \
+                         J_path, K_drift)"
                     ),
                 ));
             }

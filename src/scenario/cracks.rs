@@ -6,7 +6,7 @@ use super::source::Source;
 use crate::crack::{Contact, Crack, Cracks, Law, MAX_CRACKS};
 use crate::dim::Dim;
 use crate::error::ScenarioError;
-use crate::fracture::FracturePlan;
+use crate::fracture::{FracturePlan, KMethod};
 use crate::grid::GridGeom;
 use crate::measure::Measure;
 use crate::particles::Particles;
@@ -297,8 +297,30 @@ pub(super) fn fracture_plan<D: Dim>(
             "the opening is fitted from 1 cell to `opening` cells behind the tip: give at least 2",
         ));
     }
+    let k_method = match f.k_from.as_deref() {
+        None | Some("interaction") => KMethod::Interaction,
+        Some("mixity") => KMethod::Mixity,
+        Some("opening") => KMethod::Opening,
+        Some(other) => {
+            return Err(src.error(
+                "fracture.k_from",
+                format!(
+                    "unknown method `{other}`: give \"interaction\", \"mixity\" or \"opening\""
+                ),
+            ));
+        }
+    };
+    let domain = f.domain.unwrap_or(6.0);
+    if !(domain.is_finite() && domain >= 2.0) {
+        return Err(src.error(
+            "fracture.domain",
+            "the interaction integral's domain radius is in cells: give at least 2",
+        ));
+    }
     Ok(Some(FracturePlan {
         contour: n,
+        k_method,
+        domain,
         area_term: f.area_term.unwrap_or(true),
         opening,
         compare,
@@ -367,6 +389,19 @@ pub(super) fn tip_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) ->
         qty,
         at: e.at,
     })
+}
+
+/// The measure of a `K_drift` expect: how far K moves at a crack tip from `from` on.
+pub(super) fn drift_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure> {
+    let (crack, tip) = expect_tip(src, i, e)?;
+    let end = src.scenario.simulation.duration;
+    match e.from {
+        Some(from) if (0.0..end).contains(&from) => Ok(Measure::KDrift { crack, tip, from }),
+        _ => Err(src.error(
+            &format!("expect[{i}].from"),
+            format!("`K_drift` runs over a window: give its start `from`, 0 to {end:.4e} s"),
+        )),
+    }
 }
 
 /// The measure of a `J_path` expect: J with the area term on the compared contours against

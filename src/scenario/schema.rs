@@ -358,6 +358,12 @@ pub struct FractureSpec {
     /// `opening` cells behind the tip (default 8; on a crack with two tips, at most half its
     /// length).
     pub opening: Option<f64>,
+    /// Which K_I, K_II are reported in the KI, KII columns and expects: "interaction"
+    /// (default: the interaction integral), "mixity" (G from J split in the interaction
+    /// integral's ratio K_II / K_I) or "opening" (G split by the crack opening).
+    pub k_from: Option<String>,
+    /// Radius of the interaction integral's domain around the tip, in cells (default 6).
+    pub domain: Option<f64>,
 }
 
 /// `[checkpoint]`: when to write snapshots into `<out>/snapshots/` (any combination; none
@@ -382,7 +388,8 @@ pub struct ExpectSpec {
     /// One of: final, max, min, frequency, wave_speed, momentum_drift, energy_drift,
     /// angular_momentum_drift; KI, KII, J1, J2 (at a crack tip: the last value, or at `at`);
     /// J_path (largest difference of J on the `[fracture] compare` contours from the main
-    /// one, relative to the main one's largest |J|).
+    /// one, relative to the main one's largest |J|); K_drift (largest |K(t) - K(end)| from
+    /// `from` on, relative to |K(end)|).
     pub quantity: String,
     /// Probe(s) the quantity is measured on (wave_speed takes two).
     #[serde(default)]
@@ -393,6 +400,8 @@ pub struct ExpectSpec {
     pub tip: Option<String>,
     /// For KI, KII, J1, J2: the value at this time (s) instead of the last one.
     pub at: Option<f64>,
+    /// For K_drift: the start of the window (s).
+    pub from: Option<f64>,
     /// Reference value (SI).
     pub reference: f64,
     /// Where the reference comes from.

@@ -6,7 +6,8 @@ use super::schema::LoadSpec;
 use super::source::Source;
 use crate::dim::Dim;
 use crate::error::ScenarioError;
-use crate::loads::{centre_crack_stress, rotate_stress, williams_stress};
+use crate::loads::{centre_crack_stress, rotate_stress};
+use crate::near_tip;
 use crate::particles::Particles;
 
 type R<T> = Result<T, ScenarioError>;
@@ -93,7 +94,7 @@ impl Field {
                 let [xl, yl] = local(tip, *angle);
                 let r = xl.hypot(yl);
                 (r > 0.0)
-                    .then(|| rotate_stress(williams_stress(k[0], k[1], r, yl.atan2(xl)), *angle))
+                    .then(|| rotate_stress(near_tip::stress(k[0], k[1], r, yl.atan2(xl)), *angle))
             }
             Field::CentreCrack {
                 remote,

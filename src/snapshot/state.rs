@@ -36,11 +36,24 @@ fn row_data(r: &Row) -> [f64; ROW_WIDTH] {
 }
 
 /// Scalars per crack-tip result in the `history.fracture.data` column.
-const TIP_WIDTH: usize = 9;
+const TIP_WIDTH: usize = 14;
 
 fn tip_data(t: &TipResult) -> [f64; TIP_WIDTH] {
     [
-        t.time, t.x[0], t.x[1], t.x[2], t.j[0], t.j[1], t.k[0], t.k[1], t.k[2],
+        t.time,
+        t.x[0],
+        t.x[1],
+        t.x[2],
+        t.j[0],
+        t.j[1],
+        t.k[0],
+        t.k[1],
+        t.k[2],
+        t.k_interaction[0],
+        t.k_interaction[1],
+        t.k_opening[0],
+        t.k_opening[1],
+        t.domain,
     ]
 }
 
@@ -293,6 +306,9 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
             x: [d[1], d[2], d[3]],
             j: [d[4], d[5]],
             k: [d[6], d[7], d[8]],
+            k_interaction: [d[9], d[10]],
+            k_opening: [d[11], d[12]],
+            domain: d[13],
         })
         .collect();
     let path_steps: Vec<u64> = r.column_any("history.paths.step")?;
