@@ -120,7 +120,7 @@ pub fn e_prime(m: &Elastic, plane: Plane) -> f64 {
 /// two to where the discrete crack's tip lies. NaN when `k` is NaN or zero.
 pub fn k_from_mixity(m: &Elastic, plane: Plane, g: f64, k: [f64; 2]) -> [f64; 2] {
     let norm = k[0].hypot(k[1]);
-    if !(norm > 0.0) {
+    if norm.is_nan() || norm == 0.0 {
         return [f64::NAN; 2];
     }
     let scale = (e_prime(m, plane) * g.max(0.0)).sqrt() / norm;

@@ -112,6 +112,12 @@ pub enum Measure {
     EnergyDrift,
     /// |L(end) - L(0)| / |L(0)| about the initial centre of mass (relative).
     AngularMomentumDrift,
+    /// The largest kinetic energy over the strain energy from time `from` on: whether a
+    /// damped run has come to rest.
+    KineticFraction {
+        /// Start of the window (s).
+        from: f64,
+    },
     /// A value at a crack tip, the last one or at a time: `qty` 0..4 = K_I, K_II, J_x, J_y
     /// (Pa sqrt(m), J/m^2).
     Tip {
@@ -293,6 +299,13 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
                 .fold(0.0, f64::max);
             finite((total(&last.energies) - total(&first.energies)).abs() / scale)
         }
+        Measure::KineticFraction { from } => h
+            .rows
+            .iter()
+            .filter(|r| r.time >= from)
+            .map(|r| r.energies.kinetic / r.energies.strain)
+            .reduce(f64::max)
+            .and_then(finite),
         Measure::AngularMomentumDrift => {
             let (first, last) = (h.rows.first()?, h.rows.last()?);
             finite(norm3(sub3(last.angular, first.angular)) / norm3(first.angular))

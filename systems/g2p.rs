@@ -14,7 +14,7 @@ use rayon::prelude::*;
 /// parallel over particle chunks (USF), the particles near a crack afterwards from their
 /// fields' entries; the particles' bins are stale afterwards.
 pub fn run<D: Dim>(world: &mut World<D>) {
-    let dt = world.settings.dt;
+    let (dt, alpha) = (world.settings.dt, world.settings.damping);
     let shape = world.settings.shape;
     let grid = &world.grid;
     let stencils = &world.tiles.stencils;
@@ -35,7 +35,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 }
                 let st = Stencil::<N>::cached::<D>(S, stencils, i);
                 let (dv, vn) = gather::<D, N>(&st, &st.rows::<D>(&grid.geom.stride), nodal);
-                v[k] += dv * dt;
+                v[k] = flip::<D>(v[k], dv, vn, dt, alpha);
                 x[k] += vn * dt;
                 if track {
                     fastest = fastest.max(D::dot(vn, vn));
@@ -56,7 +56,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
 /// Schreyer 1995); without this remap, nodes with a tiny share of mass get huge velocities
 /// and linear shape functions go unstable. The nodal masses stay those of `p2g`.
 pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
-    let dt = world.settings.dt;
+    let (dt, alpha) = (world.settings.dt, world.settings.damping);
     let shape = world.settings.shape;
     let grid = &mut world.grid;
     grid.momentum.par_iter_mut().for_each(|m| *m = D::zero());
@@ -87,7 +87,7 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
             // thread, so no other thread touches particle i's entries; tiles of one colour
             // class touch disjoint nodes (tiles.rs).
             unsafe {
-                let v = v_w.get(i) + dv * dt;
+                let v = flip::<D>(v_w.get(i), dv, vn, dt, alpha);
                 v_w.set(i, v);
                 x_w.set(i, x_w.get(i) + vn * dt);
                 let mv = v * pmass[i];
@@ -111,6 +111,19 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
         );
     }
     finish(world, fastest);
+}
+
+/// A particle's new velocity: the FLIP update v + dt sum S a_i, less the damping of the
+/// part of v that the grid does not see. The grid's damping (-alpha p, Guo & Nairn 2D
+/// (2004) Eq. 5) only reaches what a particle's velocity adds to its nodes' momenta; the
+/// rest, v - sum S v_i (v_i = v_i' - a_i dt the nodal velocities the step started from),
+/// is relaxed at the same rate alpha here. Without it a damped run kept particles moving
+/// at metres per second against each other next to a loaded edge while the grid was at
+/// rest (a FLIP null-space mode). Undamped (alpha = 0) this is the plain FLIP update.
+#[inline(always)]
+fn flip<D: Dim>(v: D::Vec, dv: D::Vec, vn: D::Vec, dt: f64, alpha: f64) -> D::Vec {
+    let unseen = v - (vn - dv * dt);
+    v + dv * dt - unseen * (alpha * dt)
 }
 
 /// The velocity change per unit time and the velocity moving one particle away from
@@ -145,7 +158,11 @@ fn move_coded<D: Dim>(world: &mut World<D>) -> f64 {
     let Some(c) = world.cracks.as_ref() else {
         return 0.0;
     };
-    let (dt, shape) = (world.settings.dt, world.settings.shape);
+    let (dt, shape, alpha) = (
+        world.settings.dt,
+        world.settings.shape,
+        world.settings.damping,
+    );
     let (grid, p) = (&world.grid, &mut world.particles);
     let mut fastest = 0.0f64;
     for &i in &c.fields.coded {
@@ -159,7 +176,7 @@ fn move_coded<D: Dim>(world: &mut World<D>) -> f64 {
                 vn += grid.velocity[n] * w;
             });
         });
-        p.v[i] += dv * dt;
+        p.v[i] = flip::<D>(p.v[i], dv, vn, dt, alpha);
         p.x[i] += vn * dt;
         fastest = fastest.max(D::dot(vn, vn));
     }

@@ -70,6 +70,9 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         world.work.damping += damp;
         world.work.external += grav;
     }
+    if let Some(c) = world.cracks.as_ref() {
+        merge_slivers(&mut world.grid, &mut world.work, &c.fields, &world.settings);
+    }
     let t1 = world.time + dt;
     let g = &mut world.grid;
     let fields = world.cracks.as_ref().map(|c| &c.fields);
@@ -87,6 +90,63 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                     }
                 }
             }
+        }
+    }
+}
+
+/// A node's crack field that holds a sliver of mass (at most `sliver_mass`: a particle
+/// whose line to the node crosses the crack while the node is at the edge of its support)
+/// would get the acceleration f/m of a tiny mass, which explicit integration cannot follow:
+/// the particle's velocity grew by metres per second while the damping held everything
+/// else at rest. Such fields move with the node's heaviest field instead: their masses,
+/// momenta and forces are summed with it and all get the sum's velocity and acceleration,
+/// which conserves momentum; the sliver's force then acts across the crack, a thousandth
+/// of a particle's share at most.
+fn merge_slivers<D: Dim>(
+    grid: &mut Grid<D>,
+    work: &mut crate::world::Work,
+    fields: &Fields,
+    settings: &crate::world::Settings<D>,
+) {
+    let (dt, alpha, gravity, tol) = (
+        settings.dt,
+        settings.damping,
+        settings.gravity,
+        settings.mass_tol,
+    );
+    let sliver = settings.sliver_mass;
+    let mut k = 0;
+    while k < fields.node.len() {
+        let node = fields.node[k];
+        let rows = fields.rows_of(node);
+        k += rows.len();
+        let group = || std::iter::once(node as usize).chain(rows.clone());
+        let light = |n: usize| grid.mass[n] > tol && grid.mass[n] <= sliver;
+        if !group().any(light) {
+            continue;
+        }
+        let heavy = group()
+            .max_by(|&a, &b| grid.mass[a].total_cmp(&grid.mass[b]))
+            .expect("a node's own entry");
+        let (mut m, mut p, mut f) = (0.0, D::zero(), D::zero());
+        for n in group().filter(|&n| n == heavy || light(n)) {
+            // Take back the damping and gravity work booked for the entry alone.
+            let (m0, p0) = (grid.mass[n], grid.momentum[n]);
+            let vmid = p0 * (1.0 / m0) + grid.accel[n] * (0.5 * dt);
+            work.damping -= alpha * D::dot(p0, vmid) * dt;
+            work.external -= m0 * D::dot(gravity, vmid) * dt;
+            m += m0;
+            p += p0;
+            f += grid.force[n];
+        }
+        let a = (f - p * alpha + gravity * m) * (1.0 / m);
+        let v1 = p * (1.0 / m) + a * dt;
+        let vmid = p * (1.0 / m) + a * (0.5 * dt);
+        work.damping += alpha * D::dot(p, vmid) * dt;
+        work.external += m * D::dot(gravity, vmid) * dt;
+        for n in group().filter(|&n| n == heavy || light(n)) {
+            grid.velocity[n] = v1;
+            grid.accel[n] = a;
         }
     }
 }

@@ -233,6 +233,8 @@ fn bad_fracture_requests_name_the_key() {
     assert_error(&e, "expect[0].from", None, "give its start");
     let e = error_with_text(&expect("quantity = \"KI\"\nfrom = 1e-5\n"));
     assert_error(&e, "expect[0].from", None, "applies to K_drift");
+    let e = error_with_text(&expect("quantity = \"kinetic_fraction\"\nfrom = 1.0\n"));
+    assert_error(&e, "expect[0].from", None, "give its start");
     let e = error_with_text(&format!("{crack}[fracture]\nk_from = \"fit\"\n"));
     assert_error(&e, "fracture.k_from", None, "unknown method `fit`");
     let e = error_with_text(&format!("{crack}[fracture]\ndomain = 1.5\n"));

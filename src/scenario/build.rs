@@ -474,8 +474,11 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let tip_qty = ["KI", "KII", "J1", "J2"]
             .iter()
             .position(|q| *q == e.quantity);
-        if e.from.is_some() && e.quantity != "K_drift" {
-            return Err(src.error(&key("from"), "`from` applies to K_drift"));
+        if e.from.is_some() && !["K_drift", "kinetic_fraction"].contains(&e.quantity.as_str()) {
+            return Err(src.error(
+                &key("from"),
+                "`from` applies to K_drift and kinetic_fraction",
+            ));
         }
         let crack_measure = match tip_qty {
             Some(qty) => Some(super::cracks::tip_measure(src, i, e, qty)?),
@@ -507,14 +510,14 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let need = match e.quantity.as_str() {
             "wave_speed" => 2,
             "final" | "max" | "min" | "frequency" => 1,
-            "momentum_drift" | "energy_drift" | "angular_momentum_drift" => 0,
+            "momentum_drift" | "energy_drift" | "angular_momentum_drift" | "kinetic_fraction" => 0,
             other => {
                 return Err(src.error(
                     &key("quantity"),
                     format!(
                         "unknown quantity `{other}` (final, max, min, frequency, wave_speed, \
                          momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2, \
-                         J_path, K_drift)"
+                         J_path, K_drift, kinetic_fraction)"
                     ),
                 ));
             }
@@ -537,6 +540,21 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             "wave_speed" => Measure::WaveSpeed(ids[0], ids[1]),
             "momentum_drift" => Measure::MomentumDrift,
             "energy_drift" => Measure::EnergyDrift,
+            "kinetic_fraction" => {
+                let end = src.scenario.simulation.duration;
+                match e.from {
+                    Some(from) if (0.0..end).contains(&from) => Measure::KineticFraction { from },
+                    _ => {
+                        return Err(src.error(
+                            &key("from"),
+                            format!(
+                                "`kinetic_fraction` runs over a window: give its start \
+                                 `from`, 0 to {end:.4e} s"
+                            ),
+                        ));
+                    }
+                }
+            }
             _ => Measure::AngularMomentumDrift,
         };
         if !e.reference.is_finite() {
