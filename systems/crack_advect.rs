@@ -53,9 +53,6 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     else {
         return;
     };
-    if std::env::var("FISSURE_NOADV").is_ok() {
-        return;
-    }
     let dt = world.settings.dt;
     let sliver = world.settings.sliver_mass;
     let g = &world.grid;
