@@ -84,6 +84,53 @@ pub struct TipResult {
     pub domain: f64,
 }
 
+impl TipResult {
+    /// Number of [`TipResult::values`].
+    pub const VALUES: usize = 13;
+
+    /// Position, J, the reported K, the interaction integral's and the opening split's K and
+    /// the domain radius, in fracture.csv's column order.
+    pub fn values(&self) -> [f64; Self::VALUES] {
+        [
+            self.x[0],
+            self.x[1],
+            self.x[2],
+            self.j[0],
+            self.j[1],
+            self.k[0],
+            self.k[1],
+            self.k[2],
+            self.k_interaction[0],
+            self.k_interaction[1],
+            self.k_opening[0],
+            self.k_opening[1],
+            self.domain,
+        ]
+    }
+
+    /// The result whose [`TipResult::values`] are `v`.
+    pub fn from_values(
+        step: u64,
+        time: f64,
+        crack: u32,
+        tip: u32,
+        v: &[f64; Self::VALUES],
+    ) -> Self {
+        TipResult {
+            step,
+            time,
+            crack,
+            tip,
+            x: [v[0], v[1], v[2]],
+            j: [v[3], v[4]],
+            k: [v[5], v[6], v[7]],
+            k_interaction: [v[8], v[9]],
+            k_opening: [v[10], v[11]],
+            domain: v[12],
+        }
+    }
+}
+
 /// Crack-speed factors for a tip running at speed `c` (Nishioka 1995, as quoted in Guo &
 /// Nairn 2D (2004) Eqs. 16-18): (beta_d, beta_s, A_I, A_II) with beta_d = sqrt(1 - c^2/cd^2)
 /// and beta_s = sqrt(1 - c^2/cs^2). At c = 0 the A's take their limit (kappa + 1)/4 (Eq. 20).

@@ -21,6 +21,20 @@ pub struct GridGeom<D: Dim> {
 }
 
 impl<D: Dim> GridGeom<D> {
+    /// The range of cells per axis (first, last, inclusive) that the box `lo`..`hi` (m)
+    /// touches, clamped to the grid.
+    pub fn cell_range(&self, lo: D::Vec, hi: D::Vec) -> ([usize; 3], [usize; 3]) {
+        let (mut a, mut b) = ([0; 3], [0; 3]);
+        for k in 0..D::D {
+            let cell = |x: f64| {
+                let c = ((x - self.origin[k]) * self.inv_h[k]).floor();
+                c.clamp(0.0, (self.cells[k] - 1) as f64) as usize
+            };
+            (a[k], b[k]) = (cell(lo[k]), cell(hi[k]));
+        }
+        (a, b)
+    }
+
     /// A grid of `cells` cells of size `h` starting at `origin`.
     pub fn new(origin: D::Vec, h: D::Vec, cells: [usize; 3]) -> Self {
         let mut inv_h = h;

@@ -88,8 +88,7 @@ impl Sample {
         a: [f64; 2],
         [kap, mu]: [f64; 2],
     ) -> Sample {
-        let r = x[0].hypot(x[1]);
-        let modes = [[1.0, 0.0], [0.0, 1.0]];
+        let (aux_s, aux_g) = near_tip::unit_fields(x[0].hypot(x[1]), theta, kap, mu);
         Sample {
             x,
             area,
@@ -97,8 +96,8 @@ impl Sample {
             s,
             gu,
             a,
-            aux_s: modes.map(|k| near_tip::stress(k[0], k[1], r, theta)),
-            aux_g: modes.map(|k| near_tip::displacement_gradient(k[0], k[1], r, theta, kap, mu)),
+            aux_s,
+            aux_g,
         }
     }
 }
@@ -217,18 +216,26 @@ fn gather<D: Dim>(
         .map(|k| (xy(cracks.x[k]), xy(cracks.x[k + 1])))
         .filter(|(a, b)| seg_distance(tip.x, *a, *b) < 2.0 * r_max)
         .collect();
+    // Only a particle within a cell of the band the crack's vertices span about the tip's
+    // line can be on the other side of the crack from where theta's sign puts it.
+    let band = segs
+        .iter()
+        .flat_map(|(a, b)| [a, b])
+        .map(|v| to_local([v[0] - tip.x[0], v[1] - tip.x[1]])[1].abs())
+        .fold(0.0, f64::max)
+        + world.grid.geom.h[0].max(world.grid.geom.h[1]);
     // Left of the tip direction is left of the segments at an end tip, right at a start.
     let handed = if tip.end == 1 { 1.0 } else { -1.0 };
     let thickness = world.settings.thickness;
     let mut out = Vec::new();
-    for i in 0..p.len() {
+    for i in near(world, tip.x, r_max) {
         let d = [p.x[i][0] - tip.x[0], p.x[i][1] - tip.x[1]];
         if d[0].abs() >= r_max || d[1].abs() >= r_max || d[0].hypot(d[1]) >= r_max {
             continue;
         }
         let x = to_local(d);
         let mut theta = x[1].atan2(x[0]);
-        if x[0] < 0.0 {
+        if x[0] < 0.0 && x[1].abs() <= band {
             let pos = xy(p.x[i]);
             let side = segs
                 .iter()
@@ -259,6 +266,22 @@ fn gather<D: Dim>(
         ));
     }
     out
+}
+
+/// The particles that can lie within `reach` of `x`, in ascending index order: those binned
+/// in the tiles around it (padded by a cell for the particles' moves since binning), or
+/// every particle before the first binning.
+pub(crate) fn near<D: Dim>(world: &World<D>, x: [f64; 2], reach: f64) -> Vec<usize> {
+    let geom = &world.grid.geom;
+    let pad = reach + geom.h[0].max(geom.h[1]);
+    // The whole third axis in 3D.
+    let at = |s: f64| D::from_slice(&[x[0] + s * pad, x[1] + s * pad, s * f64::INFINITY][..D::D]);
+    let (lo, hi) = geom.cell_range(at(-1.0), at(1.0));
+    let n = world.particles.len();
+    match world.tiles.particles_in_cells(lo, hi, n) {
+        Some(p) => p.into_iter().map(|i| i as usize).collect(),
+        None => (0..n).collect(),
+    }
 }
 
 /// Distance from `x` to the segment `a`-`b` in the plane (m).

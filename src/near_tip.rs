@@ -5,12 +5,42 @@
 
 use std::f64::consts::PI;
 
+/// The sines and cosines of theta/2, 3 theta/2 and theta the fields are made of.
+#[derive(Clone, Copy, Debug)]
+struct Angle {
+    s: f64,
+    c: f64,
+    s3: f64,
+    c3: f64,
+    st: f64,
+    ct: f64,
+}
+
+impl Angle {
+    fn new(theta: f64) -> Angle {
+        let (s, c) = (0.5 * theta).sin_cos();
+        let (s3, c3) = (1.5 * theta).sin_cos();
+        let (st, ct) = theta.sin_cos();
+        Angle {
+            s,
+            c,
+            s3,
+            c3,
+            st,
+            ct,
+        }
+    }
+}
+
 /// Stress (xx, yy, xy) of the leading near-tip term at polar position (r, theta) about the
 /// tip. Independent of the material and of plane strain or stress.
 pub fn stress(k1: f64, k2: f64, r: f64, theta: f64) -> [f64; 3] {
+    stress_at(k1, k2, r, &Angle::new(theta))
+}
+
+fn stress_at(k1: f64, k2: f64, r: f64, t: &Angle) -> [f64; 3] {
     let a = 1.0 / (2.0 * PI * r).sqrt();
-    let (s, c) = (0.5 * theta).sin_cos();
-    let (s3, c3) = (1.5 * theta).sin_cos();
+    let Angle { s, c, s3, c3, .. } = *t;
     [
         a * (k1 * c * (1.0 - s * s3) - k2 * s * (2.0 + c * c3)),
         a * (k1 * c * (1.0 + s * s3) + k2 * s * c * c3),
@@ -20,8 +50,8 @@ pub fn stress(k1: f64, k2: f64, r: f64, theta: f64) -> [f64; 3] {
 
 /// The angular functions of the displacement, u_i = sqrt(r) / (2 mu sqrt(2 pi)) f_i(theta),
 /// and their derivatives f_i'(theta), for K_I = k1 and K_II = k2.
-fn angular(k1: f64, k2: f64, theta: f64, kappa: f64) -> ([f64; 2], [f64; 2]) {
-    let (s, c) = (0.5 * theta).sin_cos();
+fn angular(k1: f64, k2: f64, t: &Angle, kappa: f64) -> ([f64; 2], [f64; 2]) {
+    let Angle { s, c, .. } = *t;
     let f = [
         k1 * c * (kappa - 1.0 + 2.0 * s * s) + k2 * s * (kappa + 1.0 + 2.0 * c * c),
         k1 * s * (kappa + 1.0 - 2.0 * c * c) - k2 * c * (kappa - 1.0 - 2.0 * s * s),
@@ -39,7 +69,7 @@ fn angular(k1: f64, k2: f64, theta: f64, kappa: f64) -> ([f64; 2], [f64; 2]) {
 /// Displacement (x, y) of the leading near-tip term, for shear modulus `mu` and
 /// kappa = 3 - 4 nu (plane strain) or (3 - nu)/(1 + nu) (plane stress).
 pub fn displacement(k1: f64, k2: f64, r: f64, theta: f64, kappa: f64, mu: f64) -> [f64; 2] {
-    let (f, _) = angular(k1, k2, theta, kappa);
+    let (f, _) = angular(k1, k2, &Angle::new(theta), kappa);
     let a = r.sqrt() / (2.0 * mu * (2.0 * PI).sqrt());
     [a * f[0], a * f[1]]
 }
@@ -55,15 +85,31 @@ pub fn displacement_gradient(
     kappa: f64,
     mu: f64,
 ) -> [[f64; 2]; 2] {
-    let (f, df) = angular(k1, k2, theta, kappa);
+    gradient_at(k1, k2, r, &Angle::new(theta), kappa, mu)
+}
+
+fn gradient_at(k1: f64, k2: f64, r: f64, t: &Angle, kappa: f64, mu: f64) -> [[f64; 2]; 2] {
+    let (f, df) = angular(k1, k2, t, kappa);
     let a = 1.0 / (2.0 * mu * (2.0 * PI * r).sqrt());
-    let (st, ct) = theta.sin_cos();
+    let (st, ct) = (t.st, t.ct);
     [0, 1].map(|i| {
         [
             a * (0.5 * ct * f[i] - st * df[i]),
             a * (0.5 * st * f[i] + ct * df[i]),
         ]
     })
+}
+
+/// Stress and displacement gradient of unit K_I (index 0) and unit K_II (index 1) at
+/// (r, theta): the interaction integral's auxiliary fields, from one evaluation of the
+/// angle's sines and cosines.
+pub fn unit_fields(r: f64, theta: f64, kappa: f64, mu: f64) -> ([[f64; 3]; 2], [[[f64; 2]; 2]; 2]) {
+    let t = Angle::new(theta);
+    let modes = [[1.0, 0.0], [0.0, 1.0]];
+    (
+        modes.map(|k| stress_at(k[0], k[1], r, &t)),
+        modes.map(|k| gradient_at(k[0], k[1], r, &t, kappa, mu)),
+    )
 }
 
 #[cfg(test)]

@@ -95,6 +95,32 @@ impl Tiles {
         &self.order[self.start[t] as usize..self.start[t + 1] as usize]
     }
 
+    /// The particles binned in the tiles that hold cells `lo` to `hi` (inclusive, per axis),
+    /// in ascending index order, or None while not every particle is binned (before the
+    /// first step). Bins date from the last binning: a caller wanting the particles in a
+    /// region pads it by the distance they can have moved since (under a cell per step).
+    pub fn particles_in_cells(
+        &self,
+        lo: [usize; 3],
+        hi: [usize; 3],
+        count: usize,
+    ) -> Option<Vec<u32>> {
+        if self.order.len() != count {
+            return None;
+        }
+        let [nx, ny, _] = self.counts;
+        let mut out = Vec::new();
+        for tk in lo[2] / self.size..=hi[2] / self.size {
+            for tj in lo[1] / self.size..=hi[1] / self.size {
+                for ti in lo[0] / self.size..=hi[0] / self.size {
+                    out.extend_from_slice(self.particles((ti + nx * (tj + ny * tk)) as u32));
+                }
+            }
+        }
+        out.sort_unstable();
+        Some(out)
+    }
+
     /// Number of particles in tile `t`, the work a scatter does there.
     fn weight(&self, t: u32) -> u64 {
         self.particles(t).len() as u64

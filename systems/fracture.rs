@@ -6,7 +6,7 @@
 use crate::crack::{Crack, Cracks};
 use crate::dim::Dim;
 use crate::fracture::{FracturePlan, KMethod, PathResult, TipResult, k_from_g, k_from_mixity};
-use crate::interaction::{Tip, interaction_k};
+use crate::interaction::{Tip, interaction_k, near};
 use crate::shape::Stencil;
 use crate::sym::SymTensor;
 use crate::with_shape;
@@ -272,7 +272,9 @@ fn contour_j<D: Dim>(
     let reach = 2.0 * geom.h[0].max(geom.h[1]);
     let mut area = [0.0; 2];
     let mut nearest = (f64::INFINITY, 0usize);
-    for i in 0..p.len() {
+    let half = 0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+    for i in near(world, centre, half + reach) {
         let x = xy(p.x[i]);
         if x[0] < lo[0] - reach
             || x[0] > hi[0] + reach

@@ -122,6 +122,9 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
 /// rest (a FLIP null-space mode). Undamped (alpha = 0) this is the plain FLIP update.
 #[inline(always)]
 fn flip<D: Dim>(v: D::Vec, dv: D::Vec, vn: D::Vec, dt: f64, alpha: f64) -> D::Vec {
+    if alpha == 0.0 {
+        return v + dv * dt;
+    }
     let unseen = v - (vn - dv * dt);
     v + dv * dt - unseen * (alpha * dt)
 }

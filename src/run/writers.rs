@@ -127,28 +127,18 @@ impl Writers {
             }
         }
         for t in tips {
-            writeln!(
+            write!(
                 f,
-                "{},{:.9e},{},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},\
-                 {:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
+                "{},{:.9e},{},{}",
                 t.step,
                 t.time,
                 names[t.crack as usize],
                 ["start", "end"][t.tip as usize],
-                t.x[0],
-                t.x[1],
-                t.x[2],
-                t.j[0],
-                t.j[1],
-                t.k[0],
-                t.k[1],
-                t.k[2],
-                t.k_interaction[0],
-                t.k_interaction[1],
-                t.k_opening[0],
-                t.k_opening[1],
-                t.domain
             )?;
+            for v in t.values() {
+                write!(f, ",{v:.9e}")?;
+            }
+            writeln!(f)?;
         }
         Ok(())
     }

@@ -36,25 +36,10 @@ fn row_data(r: &Row) -> [f64; ROW_WIDTH] {
 }
 
 /// Scalars per crack-tip result in the `history.fracture.data` column.
-const TIP_WIDTH: usize = 14;
+const TIP_WIDTH: usize = 1 + TipResult::VALUES;
 
-fn tip_data(t: &TipResult) -> [f64; TIP_WIDTH] {
-    [
-        t.time,
-        t.x[0],
-        t.x[1],
-        t.x[2],
-        t.j[0],
-        t.j[1],
-        t.k[0],
-        t.k[1],
-        t.k[2],
-        t.k_interaction[0],
-        t.k_interaction[1],
-        t.k_opening[0],
-        t.k_opening[1],
-        t.domain,
-    ]
+fn tip_data(t: &TipResult) -> impl Iterator<Item = f64> {
+    std::iter::once(t.time).chain(t.values())
 }
 
 /// Scalars per path result in the `history.paths.data` column.
@@ -298,17 +283,9 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
         .iter()
         .zip(&tip_ids)
         .zip(data.chunks_exact(TIP_WIDTH))
-        .map(|((&step, &id), d)| TipResult {
-            step,
-            time: d[0],
-            crack: (id / 2) as u32,
-            tip: (id % 2) as u32,
-            x: [d[1], d[2], d[3]],
-            j: [d[4], d[5]],
-            k: [d[6], d[7], d[8]],
-            k_interaction: [d[9], d[10]],
-            k_opening: [d[11], d[12]],
-            domain: d[13],
+        .map(|((&step, &id), d)| {
+            let v = d[1..].try_into().expect("chunks of TIP_WIDTH");
+            TipResult::from_values(step, d[0], (id / 2) as u32, (id % 2) as u32, v)
         })
         .collect();
     let path_steps: Vec<u64> = r.column_any("history.paths.step")?;
