@@ -108,7 +108,7 @@ pub enum Measure {
     WaveSpeed(usize, usize),
     /// Largest |P(t) - P(0)| over the largest sum |m v| (relative).
     MomentumDrift,
-    /// |E(end) - E(0)| over the largest K + W (relative), E = K + W - W_ext + W_damp.
+    /// The energy balance: [`energy_balance`].
     EnergyDrift,
     /// |L(end) - L(0)| / |L(0)| about the initial centre of mass (relative).
     AngularMomentumDrift,
@@ -289,16 +289,7 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
                 .fold(0.0, f64::max);
             finite(worst / scale)
         }
-        Measure::EnergyDrift => {
-            let (first, last) = (h.rows.first()?, h.rows.last()?);
-            let total = |e: &Energies| e.kinetic + e.strain - e.external_work + e.damping_work;
-            let scale = h
-                .rows
-                .iter()
-                .map(|r| r.energies.kinetic + r.energies.strain)
-                .fold(0.0, f64::max);
-            finite((total(&last.energies) - total(&first.energies)).abs() / scale)
-        }
+        Measure::EnergyDrift => energy_balance(h).and_then(finite),
         Measure::KineticFraction { from } => h
             .rows
             .iter()
@@ -311,6 +302,23 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             finite(norm3(sub3(last.angular, first.angular)) / norm3(first.angular))
         }
     }
+}
+
+/// How far the energy balance E = K + W - W_ext + W_damp strays from its start: the
+/// largest |E(t) - E(0)| over the largest of K + W, |W_ext| and W_damp in the run.
+pub fn energy_balance(h: &History) -> Option<f64> {
+    let total = |e: &Energies| e.kinetic + e.strain - e.external_work + e.damping_work;
+    let e0 = total(&h.rows.first()?.energies);
+    let (mut worst, mut scale) = (0.0f64, 0.0f64);
+    for r in &h.rows {
+        let e = &r.energies;
+        worst = worst.max((total(e) - e0).abs());
+        scale = scale
+            .max(e.kinetic + e.strain)
+            .max(e.external_work.abs())
+            .max(e.damping_work);
+    }
+    Some(worst / scale)
 }
 
 fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

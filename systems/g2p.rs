@@ -196,14 +196,33 @@ fn finish<D: Dim>(world: &mut World<D>, fastest: f64) {
     load_work_end(world);
 }
 
-/// Books the second half of the external loads' work over the step (trapezoidal rule).
+/// Books the work of the external loads over the step: each load's force (constant over
+/// the step, as `p2g` scattered it) times the displacement its particle just made,
+/// dt sum S v_i' over its own fields. The particle velocity, which FLIP updates with
+/// accelerations the particle does not move with, is not the rate of that displacement.
 fn load_work_end<D: Dim>(world: &mut World<D>) {
     let (t, dt) = (world.time, world.settings.dt);
+    let shape = world.settings.shape;
+    let grid = &world.grid;
+    let fields = world.cracks.as_ref().map(|c| &c.fields);
     let mut work = 0.0;
     for load in &world.loads {
         let scale = load.time.at(t);
         for (&i, &f) in load.particles.iter().zip(&load.forces) {
-            work += 0.5 * dt * scale * D::dot(f, world.particles.v[i as usize]);
+            let i = i as usize;
+            let mut vn = D::zero();
+            with_shape!(shape, S, N => {
+                let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
+                match fields.and_then(|c| c.targets_of(i)) {
+                    Some(t) => st.for_each_target::<D>(&grid.geom.stride, t, |n, w, _| {
+                        vn += grid.velocity[n] * w
+                    }),
+                    None => st.for_each::<D>(&grid.geom.stride, |n, w, _| {
+                        vn += grid.velocity[n] * w
+                    }),
+                }
+            });
+            work += dt * scale * D::dot(f, vn);
         }
     }
     world.work.external += work;

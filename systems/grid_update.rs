@@ -9,6 +9,8 @@ use rayon::prelude::*;
 
 /// Overwrites prescribed components of the extrapolated momenta so that p/m equals the
 /// prescribed velocity at the start of the step, or at its end when `end` (after a remap).
+/// This sets what the grid computes with, not the particles' velocities, so it does no
+/// work; the support's reaction is booked in [`run`].
 pub fn momentum_bc<D: Dim>(world: &mut World<D>, end: bool) {
     let t = world.time + if end { world.settings.dt } else { 0.0 };
     let g = &mut world.grid;
@@ -27,7 +29,8 @@ pub fn momentum_bc<D: Dim>(world: &mut World<D>, end: bool) {
 }
 
 /// Integrates nodal momenta over the step: a = (f - alpha p + m g)/m, v' = p/m + a dt; then
-/// prescribed components are set to their end-of-step values with the matching acceleration.
+/// prescribed components are set to their end-of-step values with the matching acceleration,
+/// and the work of the support's reaction is booked as external work.
 pub fn run<D: Dim>(world: &mut World<D>) {
     let s = &world.settings;
     let (dt, alpha, gravity, tol) = (s.dt, s.damping, s.gravity, s.mass_tol);
@@ -76,22 +79,30 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let t1 = world.time + dt;
     let g = &mut world.grid;
     let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let mut work = 0.0;
     for bc in &world.bcs {
         for &node in &bc.nodes {
             for n in entries(node, fields) {
-                if g.mass[n] <= tol {
+                let m = g.mass[n];
+                if m <= tol {
                     continue;
                 }
-                let v0 = g.momentum[n] * (1.0 / g.mass[n]);
+                let v0 = g.momentum[n] * (1.0 / m);
                 for a in 0..D::D {
                     if bc.axes[a] {
-                        g.velocity[n][a] = bc.value(a, t1);
-                        g.accel[n][a] = (g.velocity[n][a] - v0[a]) / dt;
+                        // The support's reaction m (a_bc - a_free) works over the step at
+                        // the mean of the start and prescribed end velocities.
+                        let v1 = bc.value(a, t1);
+                        let a_bc = (v1 - v0[a]) / dt;
+                        work += m * (a_bc - g.accel[n][a]) * 0.5 * (v0[a] + v1) * dt;
+                        g.velocity[n][a] = v1;
+                        g.accel[n][a] = a_bc;
                     }
                 }
             }
         }
     }
+    world.work.external += work;
 }
 
 /// A node's crack field that holds a sliver of mass (at most `sliver_mass`: a particle

@@ -139,14 +139,12 @@ pub(crate) fn scatter_coded<D: Dim, const MASS: bool, const MOMENTUM: bool, cons
     }
 }
 
-/// Adds external particle forces to the grid (sequential, in load order) and books the
-/// first half of their work over the step.
+/// Adds external particle forces to the grid (sequential, in load order); `g2p` books
+/// their work over the step.
 fn scatter_loads<D: Dim>(world: &mut World<D>) {
-    let (t, dt) = (world.time, world.settings.dt);
-    let p = &world.particles;
+    let t = world.time;
     let geom = &world.grid.geom;
     let shape = world.settings.shape;
-    let mut work = 0.0;
     for load in &world.loads {
         let scale = load.time.at(t);
         for (&i, &f) in load.particles.iter().zip(&load.forces) {
@@ -161,8 +159,6 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
                     None => st.for_each::<D>(&geom.stride, |n, w, _| world.grid.force[n] += f * w),
                 }
             });
-            work += 0.5 * dt * D::dot(f, p.v[i]);
         }
     }
-    world.work.external += work;
 }

@@ -2,7 +2,7 @@
 
 mod common;
 use common::{Bar, history};
-use fissure::measure::{arrival, frequency};
+use fissure::measure::{arrival, energy_balance, frequency};
 
 /// Probe averaging `quantity` `component` over the slice of particles in [x0, x1].
 fn probe(bar: &Bar, name: &str, x0: f64, x1: f64, quantity: &str) -> String {
@@ -197,7 +197,8 @@ fn bar_wave_speed_with_non_cubic_cells() {
 }
 
 /// A grip moving at a prescribed velocity drags the end of a clamped bar with it: after
-/// the ramp the end particles follow the grip's displacement v (t - t_ramp/2).
+/// the ramp the end particles follow the grip's displacement v (t - t_ramp/2); the grip's
+/// reaction does the work that the bar stores and carries (energy balance within 1 %).
 #[test]
 fn prescribed_velocity_moves_the_grip() {
     let mut bar = Bar {
@@ -222,4 +223,11 @@ fn prescribed_velocity_moves_the_grip() {
         (got - want).abs() / want < 0.02,
         "grip displacement {got} vs {want}"
     );
+    let last = &hist.rows.last().unwrap().energies;
+    assert!(
+        last.external_work > 0.5 * (last.kinetic + last.strain),
+        "{last:?}"
+    );
+    let balance = energy_balance(&hist).unwrap();
+    assert!(balance < 0.01, "energy balance off by {balance}");
 }
