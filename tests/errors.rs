@@ -300,3 +300,26 @@ fn bad_loads_name_the_key() {
     ));
     assert_error(&e, "load[0].normal", None, "traction field");
 }
+
+#[test]
+fn bad_regions_name_the_key() {
+    let load = |region: &str| {
+        error_with_text(&format!(
+            "[[load]]\nregion = {region}\nforce = [1.0, 0.0]\n"
+        ))
+    };
+    let e = load("{ polygon = [[0.005, 0.005], [0.01, 0.005], [0.015, 0.005]] }");
+    assert_error(&e, "load[0].region.polygon", None, "degenerate");
+    let e = load("{ polygon = [[0.005, 0.005], [0.015, 0.015], [0.015, 0.005], [0.005, 0.015]] }");
+    assert_error(&e, "load[0].region.polygon", None, "crosses itself");
+    let e = load("{ point = [0.01, 0.01], normal = [0.0, 0.0] }");
+    assert_error(&e, "load[0].region.normal", None, "non-zero length");
+    let e = load("{ center = [0.01, 0.01], half = [0.001, 0.0], angle = 30.0 }");
+    assert_error(&e, "load[0].region.half", None, "positive");
+    let e = load("{ center = [0.01, 0.01], half = [0.001, 0.001] }");
+    assert_error(&e, "load[0].region.angle", None, "finite `angle`");
+    let e = load("{ min = [0.005, 0.005], polygon = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] }");
+    assert_error(&e, "load[0].region", None, "exactly one shape");
+    let e = load("{ center = [0.03, 0.03], half = [0.001, 0.001], angle = 45.0 }");
+    assert_error(&e, "load[0].region", None, "no particle");
+}

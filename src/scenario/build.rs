@@ -1,6 +1,7 @@
 //! Building a World from a parsed scenario, validating every value on the way.
 
-use super::schema::{BodySpec, BoxSpec};
+use super::region::region;
+use super::schema::{BodySpec, BoxSpec, RegionSpec};
 use super::source::Source;
 use super::traction::{Face, Field, tractions};
 use crate::bodies::{Geometry, fill};
@@ -124,10 +125,6 @@ fn bounds<D: Dim>(src: &Source, key: &str, b: &BoxSpec) -> R<([f64; 3], [f64; 3]
         return Err(src.error(&format!("{key}.max"), "max must not be below min"));
     }
     Ok((lo, hi))
-}
-
-fn inside(x: [f64; 3], lo: [f64; 3], hi: [f64; 3], dims: usize, tol: [f64; 3]) -> bool {
-    (0..dims).all(|a| x[a] >= lo[a] - tol[a] && x[a] <= hi[a] + tol[a])
 }
 
 /// Builds the scene described by `src` in dimension `D`.
@@ -304,10 +301,10 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let key = |k: &str| format!("boundary[{i}].{k}");
         let (nodes, normal) = match (&bc.region, &bc.plane) {
             (Some(r), None) => {
-                let (lo, hi) = bounds::<D>(src, &key("region"), r)?;
-                let tol = h.map(|x| 1e-6 * x);
+                let r = region::<D>(src, &key("region"), r)?;
+                let tol = 1e-6 * (0..D::D).map(|a| h[a]).fold(f64::INFINITY, f64::min);
                 let nodes: Vec<u32> = (0..geom.node_count())
-                    .filter(|&n| inside(D::to_xyz(geom.node_position(n)), lo, hi, D::D, tol))
+                    .filter(|&n| r.contains(D::to_xyz(geom.node_position(n)), D::D, tol))
                     .map(|n| n as u32)
                     .collect();
                 (nodes, None)
@@ -359,10 +356,10 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     }
 
     // Loads.
-    let select = |key: &str, r: &BoxSpec| -> R<Vec<u32>> {
-        let (lo, hi) = bounds::<D>(src, key, r)?;
+    let select = |key: &str, r: &RegionSpec| -> R<Vec<u32>> {
+        let r = region::<D>(src, key, r)?;
         let sel: Vec<u32> = (0..particles.len())
-            .filter(|&p| inside(D::to_xyz(particles.x[p]), lo, hi, D::D, [0.0; 3]))
+            .filter(|&p| r.contains(D::to_xyz(particles.x[p]), D::D, 0.0))
             .map(|p| p as u32)
             .collect();
         if sel.is_empty() {

@@ -3,6 +3,7 @@
 
 pub mod build;
 mod cracks;
+mod region;
 pub mod schema;
 pub mod source;
 mod traction;

@@ -121,6 +121,33 @@ pub struct BoxSpec {
     pub max: Vec<f64>,
 }
 
+/// A region of boundary nodes, loaded particles or probed particles (m). Exactly one shape:
+/// `min` and `max` (an axis-aligned box, inclusive); `polygon` (2D); `center`, `half` and
+/// `angle` (2D, degrees from +x) or `axes` (3D, the first two axis directions) (an
+/// oriented box); `point` and `normal` (the half-space the normal points into).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionSpec {
+    /// Lower corner of a box.
+    pub min: Option<Vec<f64>>,
+    /// Upper corner of a box.
+    pub max: Option<Vec<f64>>,
+    /// Polygon vertices [[x, y], ...], either winding, not crossing itself.
+    pub polygon: Option<Vec<Vec<f64>>>,
+    /// Centre of an oriented box.
+    pub center: Option<Vec<f64>>,
+    /// Half-sizes of an oriented box along its axes.
+    pub half: Option<Vec<f64>>,
+    /// 2D oriented box: angle of its first axis, degrees from +x.
+    pub angle: Option<f64>,
+    /// 3D oriented box: its first two axis directions (perpendicular).
+    pub axes: Option<Vec<Vec<f64>>>,
+    /// A point on a half-space's boundary plane.
+    pub point: Option<Vec<f64>>,
+    /// A half-space's normal, pointing into it.
+    pub normal: Option<Vec<f64>>,
+}
+
 /// A disc (2D) or sphere (3D).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -245,8 +272,8 @@ pub struct PlaneSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoundarySpec {
-    /// Nodes inside this box (inclusive).
-    pub region: Option<BoxSpec>,
+    /// Nodes inside this region (inclusive).
+    pub region: Option<RegionSpec>,
     /// Nodes on this plane (a symmetry plane fixes its normal component).
     pub plane: Option<PlaneSpec>,
     /// Components to prescribe; default all (region) or the normal (plane).
@@ -263,8 +290,8 @@ pub struct BoundarySpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSpec {
-    /// Particles initially inside this box are loaded.
-    pub region: BoxSpec,
+    /// Particles initially inside this region are loaded.
+    pub region: RegionSpec,
     /// Total force (N).
     pub force: Option<Vec<f64>>,
     /// Traction of the near-tip (Williams) stress field, 2D only.
@@ -301,8 +328,8 @@ pub struct WilliamsSpec {
 pub struct ProbeSpec {
     /// Name used by `[[expect]]` and in probes.csv.
     pub name: String,
-    /// Particles initially inside this box are averaged.
-    pub region: BoxSpec,
+    /// Particles initially inside this region are averaged.
+    pub region: RegionSpec,
     /// "displacement", "velocity", "position", "stress" or "strain".
     pub quantity: String,
     /// "x", "y", "z" for vectors; "xx", "yy", "zz", "yz", "xz", "xy" for tensors.
