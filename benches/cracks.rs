@@ -19,7 +19,7 @@ fn cracks(c: &mut Criterion) {
     let scene = build::<D2>(&src).expect("the DCB scenario builds");
     let plan = scene.fracture.clone().expect("the DCB measures J");
     let mut world = scene.world;
-    let mut schedule = Schedule::for_world(&world);
+    let mut schedule = Schedule::for_world(&world, None);
     for _ in 0..50 {
         schedule.step(&mut world).expect("stable");
     }
@@ -33,6 +33,7 @@ fn cracks(c: &mut Criterion) {
             .cracks
             .as_mut()
             .expect("the DCB has a crack")
+            .scratch
             .classified
             .every_step = on;
     };
@@ -41,13 +42,15 @@ fn cracks(c: &mut Criterion) {
     every_step(&mut world, false);
     g.bench_function("classify_reuse", |b| b.iter(|| classify::run(&mut world)));
     g.throughput(Throughput::Elements(1));
-    g.bench_function("j_integral", |b| b.iter(|| fracture::run(&world, &plan)));
+    g.bench_function("j_integral", |b| {
+        b.iter(|| fracture::measure(&world, &plan))
+    });
     g.finish();
 
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/enf_2d.toml");
     let src = Source::load(std::path::Path::new(path), &[]).expect("the ENF scenario loads");
     let mut world = build::<D2>(&src).expect("the ENF scenario builds").world;
-    let mut schedule = Schedule::for_world(&world);
+    let mut schedule = Schedule::for_world(&world, None);
     for _ in 0..200 {
         schedule.step(&mut world).expect("stable");
     }

@@ -62,7 +62,7 @@ fn median(v: &mut [f64]) -> f64 {
 /// Measures one scene and prints its row.
 fn scene<D: Dim>(label: &str, n: usize, shape: &str, update: &str, pools: &[ThreadPool; 2]) {
     let mut world = block::<D>(label, n, shape, update);
-    let mut schedule = Schedule::for_world(&world);
+    let mut schedule = Schedule::for_world(&world, None);
     let particles = world.particles.len() as f64;
     let mut block_of = |pool: &ThreadPool, steps: usize| {
         let t0 = Instant::now();

@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 
 fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, n: usize, shape: &str, update: &str) {
     let mut world = block::<D>(label, n, shape, update);
-    let mut schedule = Schedule::for_world(&world);
+    let mut schedule = Schedule::for_world(&world, None);
     schedule.step(&mut world).expect("stable");
     let mut g = c.benchmark_group(label);
     g.sample_size(10)

@@ -5,9 +5,12 @@
 //! Grid indices are always `[usize; 3]` with a unit third axis in 2D, so stencil loops are
 //! written once.
 
-use crate::geometry::{point_segment, point_triangle, segment_segment};
+use crate::crack::{Element, Segment, Triangle};
+use crate::fracture::FracturePlan;
+use crate::geometry::{point_segment, point_segment_sq, point_triangle, segment_segment};
 use crate::snapshot::Columnar;
 use crate::sym::{Sym2, Sym3, SymTensor};
+use crate::world::World;
 use glam::{DMat2, DMat3, DVec2, DVec3};
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, Index, IndexMut, Mul, MulAssign, Neg, Sub, SubAssign};
@@ -44,6 +47,12 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
         + Columnar;
     /// Stress as stored on particles: [`Sym2`] in 2D, [`Sym3`] in 3D.
     type Sym: SymTensor;
+    /// Crack element: a [`Segment`] in 2D, a [`Triangle`] in 3D.
+    type Elem: Element;
+    /// The fracture system of this dimension (J and K at crack fronts, stored in the crack
+    /// scratch), if it has one: 2D tips have it; 3D crack fronts do not yet, and a 3D
+    /// scenario with cracks is refused.
+    const FRACTURE: Option<FractureSystem<Self>>;
 
     /// The zero vector.
     fn zero() -> Self::Vec;
@@ -80,31 +89,42 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     /// if below, 0 if there is no crossing. Exact orientation predicates (Shewchuk's, from
     /// `robust`); a point exactly on the crack line or plane counts as above, so a line
     /// through a vertex shared by two segments crosses exactly one of them.
-    fn crossing(p: Self::Vec, q: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8 {
+    fn crossing(p: Self::Vec, q: Self::Vec, v: &[Self::Vec], e: Self::Elem) -> i8 {
         Self::crossing_from(p, Self::elem_side(p, v, e), q, v, e)
     }
     /// [`Dim::crossing`] given `sp`, the [`Dim::elem_side`] of `p` (a particle tested against
     /// every node of its stencil computes it once).
-    fn crossing_from(p: Self::Vec, sp: i8, q: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8;
+    fn crossing_from(p: Self::Vec, sp: i8, q: Self::Vec, v: &[Self::Vec], e: Self::Elem) -> i8;
     /// Side of the line (2D) or plane (3D) of crack element `e` that `x` lies on: +1 above
     /// or on it, -1 below; the first test of [`Dim::crossing`].
-    fn elem_side(x: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> i8;
-    /// Boundary features of a crack element: end points of a 2D segment, edges of a 3D
-    /// triangle.
-    const FEATURES: usize;
+    fn elem_side(x: Self::Vec, v: &[Self::Vec], e: Self::Elem) -> i8;
     /// Whether a line through a feature shared by two elements crosses exactly one of them
     /// under [`Dim::crossing`]'s tie rule (true for 2D vertices; not for 3D edges, where it
     /// crosses both or neither).
     const SHARED_FEATURE_SAFE: bool;
-    /// Vertex indices of feature `k` of element `e` (2D: the vertex twice).
-    fn feature(e: [u32; 3], k: usize) -> [u32; 2];
+    /// Squared distance from `x` to crack element `e` (m^2).
+    fn elem_distance_sq(x: Self::Vec, v: &[Self::Vec], e: Self::Elem) -> f64;
     /// Distance from `x` to crack element `e` (m).
-    fn elem_distance(x: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> f64;
+    fn elem_distance(x: Self::Vec, v: &[Self::Vec], e: Self::Elem) -> f64 {
+        Self::elem_distance_sq(x, v, e).sqrt()
+    }
     /// Distance from `x` to the line (2D) or plane (3D) of crack element `e` (m).
-    fn plane_distance(x: Self::Vec, v: &[Self::Vec], e: [u32; 3]) -> f64;
+    fn plane_distance(x: Self::Vec, v: &[Self::Vec], e: Self::Elem) -> f64;
+    /// Unit normal of crack element `e`, pointing above it (left of a segment's direction;
+    /// along a counterclockwise triangle's normal).
+    fn elem_normal(v: &[Self::Vec], e: Self::Elem) -> Self::Vec;
     /// Distance from feature `k` of crack element `e` to the segment `p`-`q` (m).
-    fn feature_distance(p: Self::Vec, q: Self::Vec, v: &[Self::Vec], e: [u32; 3], k: usize) -> f64;
+    fn feature_distance(
+        p: Self::Vec,
+        q: Self::Vec,
+        v: &[Self::Vec],
+        e: Self::Elem,
+        k: usize,
+    ) -> f64;
 }
+
+/// A fracture system: measures at every crack front of the world as the plan says.
+pub type FractureSystem<D> = fn(&mut World<D>, &FracturePlan);
 
 /// +1 for a non-negative orientation, -1 otherwise (the tie rule of [`Dim::crossing`]).
 #[inline(always)]
@@ -123,11 +143,12 @@ pub struct D3;
 impl Dim for D2 {
     const D: usize = 2;
     const COLOURS: usize = 4;
-    const FEATURES: usize = 2;
     const SHARED_FEATURE_SAFE: bool = true;
     type Vec = DVec2;
     type Mat = DMat2;
     type Sym = Sym2;
+    type Elem = Segment;
+    const FRACTURE: Option<FractureSystem<Self>> = Some(crate::systems::fracture::run);
 
     #[inline(always)]
     fn zero() -> DVec2 {
@@ -189,7 +210,7 @@ impl Dim for D2 {
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, _k: usize) -> DVec2 {
         DVec2::new(dw[0][i] * w[1][j], w[0][i] * dw[1][j])
     }
-    fn elem_side(x: DVec2, v: &[DVec2], e: [u32; 3]) -> i8 {
+    fn elem_side(x: DVec2, v: &[DVec2], e: Segment) -> i8 {
         let c = |u: DVec2| robust::Coord { x: u.x, y: u.y };
         side(robust::orient2d(
             c(v[e[0] as usize]),
@@ -197,13 +218,10 @@ impl Dim for D2 {
             c(x),
         ))
     }
-    fn feature(e: [u32; 3], k: usize) -> [u32; 2] {
-        [e[k], e[k]]
+    fn elem_distance_sq(x: DVec2, v: &[DVec2], e: Segment) -> f64 {
+        point_segment_sq::<Self>(x, v[e[0] as usize], v[e[1] as usize])
     }
-    fn elem_distance(x: DVec2, v: &[DVec2], e: [u32; 3]) -> f64 {
-        point_segment::<Self>(x, v[e[0] as usize], v[e[1] as usize])
-    }
-    fn plane_distance(x: DVec2, v: &[DVec2], e: [u32; 3]) -> f64 {
+    fn plane_distance(x: DVec2, v: &[DVec2], e: Segment) -> f64 {
         let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
         let t = b - a;
         let len = t.length();
@@ -213,10 +231,15 @@ impl Dim for D2 {
             (x - a).length()
         }
     }
-    fn feature_distance(p: DVec2, q: DVec2, v: &[DVec2], e: [u32; 3], k: usize) -> f64 {
+    fn elem_normal(v: &[DVec2], e: Segment) -> DVec2 {
+        let ab = v[e[1] as usize] - v[e[0] as usize];
+        let len = Self::dot(ab, ab).sqrt();
+        DVec2::new(-ab[1] / len, ab[0] / len)
+    }
+    fn feature_distance(p: DVec2, q: DVec2, v: &[DVec2], e: Segment, k: usize) -> f64 {
         point_segment::<Self>(v[e[k] as usize], p, q)
     }
-    fn crossing_from(p: DVec2, sp: i8, q: DVec2, v: &[DVec2], e: [u32; 3]) -> i8 {
+    fn crossing_from(p: DVec2, sp: i8, q: DVec2, v: &[DVec2], e: Segment) -> i8 {
         let c = |u: DVec2| robust::Coord { x: u.x, y: u.y };
         let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
         if sp == Self::elem_side(q, v, e) {
@@ -233,11 +256,12 @@ impl Dim for D2 {
 impl Dim for D3 {
     const D: usize = 3;
     const COLOURS: usize = 8;
-    const FEATURES: usize = 3;
     const SHARED_FEATURE_SAFE: bool = false;
     type Vec = DVec3;
     type Mat = DMat3;
     type Sym = Sym3;
+    type Elem = Triangle;
+    const FRACTURE: Option<FractureSystem<Self>> = None;
 
     #[inline(always)]
     fn zero() -> DVec3 {
@@ -311,7 +335,7 @@ impl Dim for D3 {
             w[0][i] * w[1][j] * dw[2][k],
         )
     }
-    fn elem_side(x: DVec3, v: &[DVec3], e: [u32; 3]) -> i8 {
+    fn elem_side(x: DVec3, v: &[DVec3], e: Triangle) -> i8 {
         let c = |u: DVec3| robust::Coord3D {
             x: u.x,
             y: u.y,
@@ -321,14 +345,14 @@ impl Dim for D3 {
         // robust::orient3d is positive below the plane of a counterclockwise triangle.
         side(-robust::orient3d(a, b, t, c(x)))
     }
-    fn feature(e: [u32; 3], k: usize) -> [u32; 2] {
-        [e[k], e[(k + 1) % 3]]
+    fn elem_distance_sq(x: DVec3, v: &[DVec3], e: Triangle) -> f64 {
+        Self::elem_distance(x, v, e).powi(2)
     }
-    fn elem_distance(x: DVec3, v: &[DVec3], e: [u32; 3]) -> f64 {
+    fn elem_distance(x: DVec3, v: &[DVec3], e: Triangle) -> f64 {
         let [a, b, c] = e.map(|k| v[k as usize]);
         point_triangle(x, a, b, c)
     }
-    fn plane_distance(x: DVec3, v: &[DVec3], e: [u32; 3]) -> f64 {
+    fn plane_distance(x: DVec3, v: &[DVec3], e: Triangle) -> f64 {
         let [a, b, c] = e.map(|k| v[k as usize]);
         let n = (b - a).cross(c - a);
         let len = n.length();
@@ -338,11 +362,15 @@ impl Dim for D3 {
             point_triangle(x, a, b, c)
         }
     }
-    fn feature_distance(p: DVec3, q: DVec3, v: &[DVec3], e: [u32; 3], k: usize) -> f64 {
-        let [a, b] = Self::feature(e, k).map(|i| v[i as usize]);
+    fn elem_normal(v: &[DVec3], e: Triangle) -> DVec3 {
+        let [a, b, c] = e.map(|k| v[k as usize]);
+        (b - a).cross(c - a).normalize()
+    }
+    fn feature_distance(p: DVec3, q: DVec3, v: &[DVec3], e: Triangle, k: usize) -> f64 {
+        let [a, b] = e.feature(k).map(|i| v[i as usize]);
         segment_segment(p, q, a, b)
     }
-    fn crossing_from(p: DVec3, sp: i8, q: DVec3, v: &[DVec3], e: [u32; 3]) -> i8 {
+    fn crossing_from(p: DVec3, sp: i8, q: DVec3, v: &[DVec3], e: Triangle) -> i8 {
         let c = |u: DVec3| robust::Coord3D {
             x: u.x,
             y: u.y,

@@ -38,6 +38,16 @@ pub enum KMethod {
     Opening,
 }
 
+/// What one fracture measurement found: J and K at every tip, and J on the compared
+/// contours.
+#[derive(Clone, Debug, Default)]
+pub struct Measured {
+    /// One result per crack tip.
+    pub tips: Vec<TipResult>,
+    /// One result per tip and compared contour.
+    pub paths: Vec<PathResult>,
+}
+
 /// J on one contour at one tip and time, its line and area parts apart (J/m^2): the
 /// path-independence record (paths.csv).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -6,6 +6,11 @@ use glam::DVec3;
 
 /// Distance from `x` to the segment `a`-`b` (m).
 pub fn point_segment<D: Dim>(x: D::Vec, a: D::Vec, b: D::Vec) -> f64 {
+    point_segment_sq::<D>(x, a, b).sqrt()
+}
+
+/// Squared distance from `x` to the segment `a`-`b` (m^2).
+pub fn point_segment_sq<D: Dim>(x: D::Vec, a: D::Vec, b: D::Vec) -> f64 {
     let ab = b - a;
     let len2 = D::dot(ab, ab);
     let t = if len2 > 0.0 {
@@ -14,7 +19,7 @@ pub fn point_segment<D: Dim>(x: D::Vec, a: D::Vec, b: D::Vec) -> f64 {
         0.0
     };
     let d = x - (a + ab * t);
-    D::dot(d, d).sqrt()
+    D::dot(d, d)
 }
 
 /// Distance from `x` to the triangle `a`, `b`, `c` (m): to its plane when `x` projects

@@ -32,11 +32,13 @@ use std::f64::consts::PI;
 
 /// A crack tip and the direction the crack would extend in (unit vector).
 #[derive(Clone, Copy, Debug)]
-pub struct Tip {
+pub struct Tip<'a> {
     /// Crack index.
     pub crack: usize,
     /// 0 for the crack's start vertex, 1 for its end vertex.
     pub end: usize,
+    /// The crack's polyline vertices, start to end.
+    pub path: &'a [usize],
     /// Tip position (m).
     pub x: [f64; 2],
     /// Unit direction of extension.
@@ -105,9 +107,9 @@ impl Sample {
 /// K_I and K_II at `tip` from the interaction integral over a disc of radius `radius` (m),
 /// shrunk by `step` (m) at a time while it reaches another crack or past the body's edge,
 /// down to `min_radius`.
-pub fn interaction_k<D: Dim>(
-    world: &World<D>,
-    cracks: &Cracks<D>,
+pub fn interaction_k(
+    world: &World<D2>,
+    cracks: &Cracks<D2>,
     tip: Tip,
     radius: f64,
     step: f64,
@@ -135,15 +137,17 @@ pub fn interaction_k<D: Dim>(
 }
 
 /// Distance from the tip to the nearest segment of any other crack (m).
-fn other_crack_distance<D: Dim>(cracks: &Cracks<D>, tip: Tip) -> f64 {
-    let x = D::from_slice(&[tip.x[0], tip.x[1], 0.0][..D::D]);
+fn other_crack_distance(cracks: &Cracks<D2>, tip: Tip) -> f64 {
+    let x = DVec2::from(tip.x);
+    let at = |k: u32| cracks.geometry.x[k as usize];
     cracks
-        .cracks
+        .topology
+        .cracks()
         .iter()
         .enumerate()
         .filter(|(c, _)| *c != tip.crack)
-        .flat_map(|(_, cr)| cr.vertices.start..cr.vertices.end - 1)
-        .map(|k| point_segment::<D>(x, cracks.x[k], cracks.x[k + 1]))
+        .flat_map(|(_, cr)| cr.vertices.windows(2))
+        .map(|w| point_segment::<D2>(x, at(w[0]), at(w[1])))
         .fold(f64::INFINITY, f64::min)
 }
 
@@ -187,9 +191,9 @@ fn integrate(samples: &[Sample], r_max: f64) -> Option<[f64; 2]> {
 /// their positions. Behind the tip, the side of the crack (theta = +pi or -pi) comes from
 /// the crack's own nearest segment, so that a crack that is not straight still puts each
 /// particle on its own face's branch.
-fn gather<D: Dim>(
-    world: &World<D>,
-    cracks: &Cracks<D>,
+fn gather(
+    world: &World<D2>,
+    cracks: &Cracks<D2>,
     tip: Tip,
     r_max: f64,
     kap: f64,
@@ -209,11 +213,10 @@ fn gather<D: Dim>(
             [c * rm[1][0] + s * rm[1][1], -s * rm[1][0] + c * rm[1][1]],
         ]
     };
-    let crack = &cracks.cracks[tip.crack];
-    let xy = |v: D::Vec| [v[0], v[1]];
+    let vx = |k: usize| cracks.geometry.x[k].to_array();
     // Segments that can be nearest to a particle in the disc, oriented start -> end.
-    let segs: Vec<([f64; 2], [f64; 2])> = (crack.vertices.start..crack.vertices.end - 1)
-        .map(|k| (xy(cracks.x[k]), xy(cracks.x[k + 1])))
+    let segs: Vec<([f64; 2], [f64; 2])> = (tip.path.windows(2))
+        .map(|w| (vx(w[0]), vx(w[1])))
         .filter(|(a, b)| seg_distance(tip.x, *a, *b) < 2.0 * r_max)
         .collect();
     // Only a particle within a cell of the band the crack's vertices span about the tip's
@@ -236,7 +239,7 @@ fn gather<D: Dim>(
         let x = to_local(d);
         let mut theta = x[1].atan2(x[0]);
         if x[0] < 0.0 && x[1].abs() <= band {
-            let pos = xy(p.x[i]);
+            let pos = p.x[i].to_array();
             let side = segs
                 .iter()
                 .map(|&(a, b)| (seg_distance(pos, a, b), (a, b)))
@@ -252,8 +255,8 @@ fn gather<D: Dim>(
         let sl = rot([[st.xx, st.xy], [st.xy, st.yy]]);
         let g = &p.grad_u[i];
         let gu = rot([
-            [D::entry(g, 0, 0), D::entry(g, 0, 1)],
-            [D::entry(g, 1, 0), D::entry(g, 1, 1)],
+            [D2::entry(g, 0, 0), D2::entry(g, 0, 1)],
+            [D2::entry(g, 1, 0), D2::entry(g, 1, 1)],
         ]);
         out.push(Sample::new(
             x,
@@ -271,11 +274,11 @@ fn gather<D: Dim>(
 /// The particles that can lie within `reach` of `x`, in ascending index order: those binned
 /// in the tiles around it (padded by a cell for the particles' moves since binning), or
 /// every particle before the first binning.
-pub(crate) fn near<D: Dim>(world: &World<D>, x: [f64; 2], reach: f64) -> Vec<usize> {
+pub(crate) fn near(world: &World<D2>, x: [f64; 2], reach: f64) -> Vec<usize> {
     let geom = &world.grid.geom;
     let pad = reach + geom.h[0].max(geom.h[1]);
     // The whole third axis in 3D.
-    let at = |s: f64| D::from_slice(&[x[0] + s * pad, x[1] + s * pad, s * f64::INFINITY][..D::D]);
+    let at = |s: f64| D2::from_slice(&[x[0] + s * pad, x[1] + s * pad, s * f64::INFINITY][..D2::D]);
     let (lo, hi) = geom.cell_range(at(-1.0), at(1.0));
     let n = world.particles.len();
     match world.tiles.particles_in_cells(lo, hi, n) {
@@ -291,7 +294,7 @@ fn seg_distance(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 
 /// Particle `i`'s acceleration interpolated from its grid entries (its own crack side's
 /// fields near a crack), global axes.
-fn accel<D: Dim>(world: &World<D>, cracks: &Cracks<D>, i: usize) -> [f64; 2] {
+fn accel(world: &World<D2>, cracks: &Cracks<D2>, i: usize) -> [f64; 2] {
     let g = &world.grid;
     let mut a = [0.0; 2];
     let mut visit = |entry: usize, w: f64| {
@@ -299,10 +302,10 @@ fn accel<D: Dim>(world: &World<D>, cracks: &Cracks<D>, i: usize) -> [f64; 2] {
         a[1] += g.accel[entry][1] * w;
     };
     with_shape!(world.settings.shape, S, N => {
-        let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
-        match cracks.fields.targets_of(i) {
-            Some(t) => st.for_each_target::<D>(&g.geom.stride, t, |n, w, _| visit(n, w)),
-            None => st.for_each::<D>(&g.geom.stride, |n, w, _| visit(n, w)),
+        let st = Stencil::<N>::cached::<D2>(S, &world.tiles.stencils, i);
+        match cracks.scratch.fields.targets_of(i) {
+            Some(t) => st.for_each_target::<D2>(&g.geom.stride, t, |n, w, _| visit(n, w)),
+            None => st.for_each::<D2>(&g.geom.stride, |n, w, _| visit(n, w)),
         }
     });
     a

@@ -328,7 +328,7 @@ fn cmd_check(path: &Path, overrides: &[String]) -> ExitCode {
             match build::<$d>(&src) {
                 Ok(scene) => {
                     let w = &scene.world;
-                    let sched = Schedule::for_world(w);
+                    let sched = Schedule::for_world(w, scene.fracture.clone());
                     let names: Vec<&str> = sched.systems.iter().map(|s| s.name()).collect();
                     println!(
                         "{}: ok. {}D, {} particles, {} nodes, dt {:.4e} s (limit {:.4e} s), {} steps, schedule: {}",

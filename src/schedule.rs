@@ -2,6 +2,7 @@
 
 use crate::dim::Dim;
 use crate::error::Unstable;
+use crate::fracture::FracturePlan;
 use crate::systems::{
     bin, classify, contact, crack_advect, g2p, grid_update, p2g, stress, stress_bin, stress_force,
 };
@@ -50,6 +51,8 @@ pub enum System {
     /// As `G2p`, then re-scatter the updated particle momenta for the final stress update
     /// (USL and USAVG), in one pass.
     G2pRemap,
+    /// J and K at the crack fronts, on the steps that end at an output row.
+    Fracture,
 }
 
 impl System {
@@ -67,6 +70,7 @@ impl System {
             System::GridUpdate => "grid_update",
             System::G2p => "g2p",
             System::G2pRemap => "g2p_remap",
+            System::Fracture => "fracture",
         }
     }
 }
@@ -78,6 +82,8 @@ pub struct Schedule {
     pub systems: Vec<System>,
     /// Wall seconds spent in each entry of `systems`.
     pub seconds: Vec<f64>,
+    /// What the fracture system measures (None: the scene measures nothing at its cracks).
+    fracture: Option<FracturePlan>,
 }
 
 impl Schedule {
@@ -85,14 +91,16 @@ impl Schedule {
     /// forces; USL after the particles move (on momenta remapped with the start-of-step
     /// shape functions); USAVG does half of each.
     /// Prescribed velocities add `grid_bc` after each scatter of momenta; cracks add
-    /// `classify` after binning and `crack_advect` after the particles move.
-    pub fn for_world<D: Dim>(world: &World<D>) -> Self {
+    /// `classify` after binning and `crack_advect` after the particles move; a fracture
+    /// plan adds `fracture` at the end of the steps that end at an output row.
+    pub fn for_world<D: Dim>(world: &World<D>, fracture: Option<FracturePlan>) -> Self {
         use System::*;
         let bc = !world.bcs.is_empty();
         let update = world.settings.update;
         let cracks = world.cracks.is_some();
         let contact = world.cracks.as_ref().is_some_and(|c| {
-            c.cracks
+            c.topology
+                .cracks()
                 .iter()
                 .any(|c| c.contact.law != crate::crack::Law::None)
         });
@@ -127,49 +135,109 @@ impl Schedule {
             }
             let fraction = if update == Update::Usl { 1.0 } else { 0.5 };
             // The closing update also bins the particles for the next step (see
-            // `step_keeping` for the steps after which J is measured).
+            // `step_measuring` for the steps after which J is measured).
             s.push(StressBin { fraction });
+        }
+        let fracture = fracture.filter(|_| cracks && D::FRACTURE.is_some());
+        if fracture.is_some() {
+            s.push(Fracture);
         }
         let seconds = vec![0.0; s.len()];
         Schedule {
             systems: s,
             seconds,
+            fracture,
         }
     }
 
-    /// Advances the world one time step.
-    pub fn step<D: Dim>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
-        self.step_keeping(world, false)
+    /// Whether the schedule measures J and K.
+    pub fn measures(&self) -> bool {
+        self.fracture.is_some()
     }
 
-    /// Advances the world one time step; with `keep_stencils` the closing stress update
-    /// leaves the binning to the next step, so that between steps the particles' stencils
-    /// are the step's own, matching the crack fields, as the J-integral reads them (the
-    /// results are bitwise the same either way). Kept out of line (one call per step costs
-    /// nothing) so that profiles count the step's instructions apart from the run's outputs.
-    /// The pool's other workers wait for work spinning through the step, not sleeping
-    /// (`warm.rs`).
-    #[inline(never)]
+    /// Advances the world one time step, measuring nothing.
+    pub fn step<D: Dim>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
+        self.step_measuring(world, false)
+    }
+
+    /// Advances the world one time step; with `measure` the fracture system (if any) runs
+    /// at its end, and the closing stress update leaves the binning to the next step, so
+    /// that the particles' stencils are still the step's own, matching the crack fields,
+    /// as the J-integral reads them (the results are bitwise the same either way).
+    pub fn step_measuring<D: Dim>(
+        &mut self,
+        world: &mut World<D>,
+        measure: bool,
+    ) -> Result<(), Unstable> {
+        let measure = measure && self.measures();
+        self.advance(world, measure, measure)
+    }
+
+    /// Advances the world one time step measuring nothing; with `keep_stencils` the
+    /// closing stress update leaves the binning to the next step as on a measuring step
+    /// (the results are bitwise the same either way, which the tests check).
     pub fn step_keeping<D: Dim>(
         &mut self,
         world: &mut World<D>,
         keep_stencils: bool,
     ) -> Result<(), Unstable> {
+        self.advance(world, keep_stencils, false)
+    }
+
+    /// One step. Kept out of line (one call per step costs nothing) so that profiles count
+    /// the step's instructions apart from the run's outputs. The pool's other workers wait
+    /// for work spinning through the step, not sleeping (`warm.rs`).
+    #[inline(never)]
+    fn advance<D: Dim>(
+        &mut self,
+        world: &mut World<D>,
+        keep_stencils: bool,
+        measure: bool,
+    ) -> Result<(), Unstable> {
         with_warm_workers(|| self.run_systems(world, keep_stencils))?;
         world.step += 1;
         world.time = world.step as f64 * world.settings.dt;
+        // The fracture system, last in the schedule, measures the state at the step's end,
+        // so it runs once the clock has moved to it.
+        if measure {
+            self.fracture_system(world);
+        }
         Ok(())
     }
 
-    /// Runs every system once, in order, timing each.
+    /// Measures J and K on the world as it stands (before the first step): bins the
+    /// particles and classifies them near the cracks, as a step would, then runs the
+    /// fracture system. Nothing to do without a fracture plan.
+    pub fn measure_now<D: Dim>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
+        if !self.measures() {
+            return Ok(());
+        }
+        bin::run(world)?;
+        classify::run(world);
+        self.fracture_system(world);
+        Ok(())
+    }
+
+    /// Runs the fracture system, timing it under its schedule entry.
+    fn fracture_system<D: Dim>(&mut self, world: &mut World<D>) {
+        if let (Some(plan), Some(run)) = (&self.fracture, D::FRACTURE) {
+            let t0 = Instant::now();
+            run(world, plan);
+            if let Some(k) = self.systems.iter().position(|s| *s == System::Fracture) {
+                self.seconds[k] += t0.elapsed().as_secs_f64();
+            }
+        }
+    }
+
+    /// Runs the step's systems once, in order, timing each (the fracture system apart).
     fn run_systems<D: Dim>(
         &mut self,
         world: &mut World<D>,
         keep_stencils: bool,
     ) -> Result<(), Unstable> {
-        for (k, sys) in self.systems.iter().enumerate() {
+        for k in 0..self.systems.len() {
             let t0 = Instant::now();
-            match *sys {
+            match self.systems[k] {
                 System::Bin => bin::run(world)?,
                 System::Classify => classify::run(world),
                 System::CrackAdvect => crack_advect::run(world),
@@ -182,6 +250,7 @@ impl Schedule {
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),
+                System::Fracture => continue,
             }
             self.seconds[k] += t0.elapsed().as_secs_f64();
         }

@@ -9,7 +9,7 @@
 //! longer holds (clearance used up, or a new stencil) until the skin itself is used up; the
 //! result is exactly that of a full pass.
 
-use crate::crack::{Classified, Cracks, Fields, side_bit};
+use crate::crack::{Classified, Cracks, Element, Fields, side_bit};
 use crate::dim::Dim;
 use crate::grid::GridGeom;
 use crate::shape::{ShapeKind, Stencil, StencilCache};
@@ -47,7 +47,7 @@ fn grow<D: Dim>(b: &Aabb<D>, by: f64) -> Aabb<D> {
 /// most, so the elements a box can meet are one run of the list.
 struct Elements<'a, D: Dim> {
     x: &'a [D::Vec],
-    elems: &'a [[u32; 3]],
+    elems: &'a [D::Elem],
     elem_crack: &'a [u16],
     boxes: Vec<Aabb<D>>,
     order: Vec<u32>,
@@ -66,20 +66,19 @@ const NONE: u32 = u32::MAX;
 impl<'a, D: Dim> Elements<'a, D> {
     fn new(
         x: &'a [D::Vec],
-        elems: &'a [[u32; 3]],
+        elems: &'a [D::Elem],
         elem_crack: &'a [u16],
         neighbour: &'a [[u32; 3]],
     ) -> Self {
         let boxes: Vec<Aabb<D>> = elems
             .iter()
             .map(|e| {
-                let (lo, hi) = span::<D>(x[e[0] as usize], x[e[1] as usize]);
-                if D::D == 3 {
-                    let v = x[e[2] as usize];
-                    (span::<D>(lo, v).0, span::<D>(hi, v).1)
-                } else {
-                    (lo, hi)
-                }
+                let v = e.vertices();
+                let first = span::<D>(x[v[0] as usize], x[v[1] as usize]);
+                v[2..].iter().fold(first, |(lo, hi), &k| {
+                    let y = x[k as usize];
+                    (span::<D>(lo, y).0, span::<D>(hi, y).1)
+                })
             })
             .collect();
         let all =
@@ -166,20 +165,24 @@ impl<'a, D: Dim> Elements<'a, D> {
 /// Per element and boundary feature, the one other element sharing that feature when a
 /// crossing through it is parity-safe ([`Dim::SHARED_FEATURE_SAFE`]), else `NONE`. Depends
 /// on the elements' connectivity only, so `run` rebuilds it only when that changes.
-fn neighbours<D: Dim>(elems: &[[u32; 3]]) -> Vec<[u32; 3]> {
+fn neighbours<D: Dim>(elems: &[D::Elem]) -> Vec<[u32; 3]> {
     let mut neighbour = vec![[NONE; 3]; elems.len()];
     if D::SHARED_FEATURE_SAFE {
         let mut sharing: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
         for (e, &el) in elems.iter().enumerate() {
-            for k in 0..D::FEATURES {
-                let mut f = D::feature(el, k);
+            for k in 0..<D::Elem as Element>::FEATURES {
+                let mut f = el.feature(k);
                 f.sort_unstable();
                 sharing.entry(f).or_default().push(e as u32);
             }
         }
         for (e, &el) in elems.iter().enumerate() {
-            for (k, nb) in neighbour[e].iter_mut().enumerate().take(D::FEATURES) {
-                let mut f = D::feature(el, k);
+            for (k, nb) in neighbour[e]
+                .iter_mut()
+                .enumerate()
+                .take(<D::Elem as Element>::FEATURES)
+            {
+                let mut f = el.feature(k);
                 f.sort_unstable();
                 if let [a, b] = sharing[&f][..] {
                     *nb = if a == e as u32 { b } else { a };
@@ -293,7 +296,11 @@ impl<D: Dim> Pass<'_, D> {
             }
             clearance = clearance.min(D::elem_distance(xp, x, el));
             let mut open = [false; 3];
-            for (k, o) in open.iter_mut().enumerate().take(D::FEATURES) {
+            for (k, o) in open
+                .iter_mut()
+                .enumerate()
+                .take(<D::Elem as Element>::FEATURES)
+            {
                 let nb = elements.neighbour[e as usize][k];
                 if nb != NONE && D::elem_side(xp, x, elements.elems[nb as usize]) == sp {
                     let both = D::plane_distance(xp, x, el).min(D::plane_distance(
@@ -308,7 +315,7 @@ impl<D: Dim> Pass<'_, D> {
             }
             for &xn in &s.nodes {
                 let mut c = D::elem_distance(xn, x, el);
-                for k in (0..D::FEATURES).filter(|&k| open[k]) {
+                for k in (0..<D::Elem as Element>::FEATURES).filter(|&k| open[k]) {
                     c = c.min(D::feature_distance(xp, xn, x, el, k));
                 }
                 clearance = clearance.min(c);
@@ -496,20 +503,25 @@ impl<D: Dim> Pass<'_, D> {
 /// holds) and sizes the grid's extra field rows. Nothing to do in a scene without cracks.
 pub fn run<D: Dim>(world: &mut World<D>) {
     let Some(Cracks {
-        x,
-        elems,
-        elem_crack,
-        fields,
-        classified: rec,
-        links,
-        ..
+        topology,
+        geometry,
+        scratch:
+            crate::crack::Scratch {
+                fields,
+                classified: rec,
+                links,
+                ..
+            },
     }) = world.cracks.as_mut()
     else {
         return;
     };
-    if links.elems != *elems {
-        links.neighbour = neighbours::<D>(elems);
-        links.elems.clone_from(elems);
+    let x = &geometry.x;
+    if links.version != Some(topology.version()) {
+        links.neighbour = neighbours::<D>(topology.elems());
+        links.version = Some(topology.version());
+        // Elements or vertices changed: the record's crossings no longer apply.
+        rec.x0.clear();
     }
     let geom = &world.grid.geom;
     let tiles = &world.tiles;
@@ -518,7 +530,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         geom,
         shape: world.settings.shape,
         stencils: &tiles.stencils,
-        elements: Elements::<D>::new(x, elems, elem_crack, &links.neighbour),
+        elements: Elements::<D>::new(x, topology.elems(), topology.elem_crack(), &links.neighbour),
         skin: 0.25 * h_min,
         slack: 1e-6 * h_min,
     };

@@ -14,24 +14,19 @@ use std::collections::HashMap;
 /// Unit normal (pointing above) of the element of crack `c` nearest to `x`.
 fn normal<D: Dim>(
     verts: &[D::Vec],
-    elems: &[[u32; 3]],
+    elems: &[D::Elem],
     elem_crack: &[u16],
     c: usize,
     x: D::Vec,
 ) -> D::Vec {
     let mut best = (f64::INFINITY, D::zero());
-    for (e, el) in elems.iter().enumerate() {
+    for (e, &el) in elems.iter().enumerate() {
         if elem_crack[e] as usize != c {
             continue;
         }
-        let (a, b) = (verts[el[0] as usize], verts[el[1] as usize]);
-        let ab = b - a;
-        let t = (D::dot(x - a, ab) / D::dot(ab, ab)).clamp(0.0, 1.0);
-        let d = x - (a + ab * t);
-        let d2 = D::dot(d, d);
-        if d2 < best.0 {
-            let len = D::dot(ab, ab).sqrt();
-            best = (d2, D::from_slice(&[-ab[1] / len, ab[0] / len]));
+        let d = D::elem_distance_sq(x, verts, el);
+        if d < best.0 {
+            best = (d, D::elem_normal(verts, el));
         }
     }
     best.1
@@ -41,7 +36,7 @@ fn normal<D: Dim>(
 /// the particles of the tiles around them (Eq. 68), in a fixed order.
 fn nodal_displacements<D: Dim>(world: &World<D>) -> HashMap<usize, D::Vec> {
     let cracks = world.cracks.as_ref().expect("contact runs with cracks");
-    let f = &cracks.fields;
+    let f = &cracks.scratch.fields;
     let geom = &world.grid.geom;
     let tiles = &world.tiles;
     let p = &world.particles;
@@ -102,21 +97,21 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
         // the FLIP velocity update reads it, not the momenta.
         if let Some(c) = world.cracks.as_ref() {
             let g = &mut world.grid;
-            for &(e, dp) in &c.contact_dp {
+            for &(e, dp) in &c.scratch.contact_dp {
                 g.accel[e] += dp * (1.0 / (g.mass[e] * dt));
             }
         }
     } else {
         let disp = nodal_displacements(world);
         if let Some(c) = world.cracks.as_mut() {
-            c.disp = disp;
-            c.contact_dp.clear();
+            c.scratch.disp = disp;
+            c.scratch.contact_dp.clear();
         }
     }
     let Some(cracks) = world.cracks.as_mut() else {
         return;
     };
-    let f = &cracks.fields;
+    let f = &cracks.scratch.fields;
     let g = &mut world.grid;
     let mut changes = Vec::new();
     for r in 0..f.node.len() {
@@ -127,7 +122,7 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
         }
         let bit = mask.trailing_zeros() as usize;
         let (c, above) = (bit / 2, bit.is_multiple_of(2));
-        let contact = cracks.cracks[c].contact;
+        let contact = cracks.topology.cracks()[c].contact;
         if contact.law == Law::None {
             continue;
         }
@@ -138,13 +133,15 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
             continue;
         }
         let nrm = normal::<D>(
-            &cracks.x,
-            &cracks.elems,
-            &cracks.elem_crack,
+            &cracks.geometry.x,
+            cracks.topology.elems(),
+            cracks.topology.elem_crack(),
             c,
             g.geom.node_position(n),
         );
-        let d = |e: usize, m: f64| cracks.disp.get(&e).copied().unwrap_or(D::zero()) * (1.0 / m);
+        let d = |e: usize, m: f64| {
+            cracks.scratch.disp.get(&e).copied().unwrap_or(D::zero()) * (1.0 / m)
+        };
         if D::dot(d(a, ma) - d(b, mb), nrm) >= 0.0 {
             continue;
         }
@@ -170,6 +167,6 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
         }
     }
     if !update {
-        cracks.contact_dp = changes;
+        cracks.scratch.contact_dp = changes;
     }
 }

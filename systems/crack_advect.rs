@@ -2,7 +2,7 @@
 //! and the top and bottom crack surfaces with the fields above and below the crack (Guo &
 //! Nairn 3D (2006) Eqs. 21-23; 2D (2004) section 2.2), which gives the crack opening.
 
-use crate::crack::{Cracks, Fields};
+use crate::crack::{Cracks, Fields, Geometry, Scratch};
 use crate::dim::Dim;
 use crate::shape::{ShapeKind, Stencil};
 use crate::world::{Update, World};
@@ -43,12 +43,9 @@ fn node_fields<D: Dim>(
 /// Vertices outside the grid do not move.
 pub fn run<D: Dim>(world: &mut World<D>) {
     let Some(Cracks {
-        x: xs,
-        top,
-        bottom,
-        cracks,
-        fields,
-        ..
+        topology,
+        geometry: Geometry { x: xs, top, bottom },
+        scratch: Scratch { fields, .. },
     }) = world.cracks.as_mut()
     else {
         return;
@@ -71,8 +68,8 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         }
     };
     let geom = &g.geom;
-    for (c, crack) in cracks.iter().enumerate() {
-        for k in crack.vertices.clone() {
+    for (c, crack) in topology.cracks().iter().enumerate() {
+        for k in crack.vertices.iter().map(|&k| k as usize) {
             let x = xs[k];
             if !geom.fits(ShapeKind::Linear, x, D::zero()) {
                 continue;

@@ -3,14 +3,17 @@
 //! optional area term (Eq. 8), then G (Eq. 10) and K_I, K_II from the crack opening
 //! (Eqs. 14-22). Runs on output steps only; it reads the world and changes nothing.
 
-use crate::crack::{Crack, Cracks};
-use crate::dim::Dim;
-use crate::fracture::{FracturePlan, KMethod, PathResult, TipResult, k_from_g, k_from_mixity};
+use crate::crack::{Cracks, Front};
+use crate::dim::{D2, Dim};
+use crate::fracture::{
+    FracturePlan, KMethod, Measured, PathResult, TipResult, k_from_g, k_from_mixity,
+};
 use crate::interaction::{Tip, interaction_k, near};
 use crate::shape::Stencil;
 use crate::sym::SymTensor;
 use crate::with_shape;
 use crate::world::World;
+use glam::DVec2;
 use std::collections::HashMap;
 
 /// Mass-weighted nodal values of one field (Eq. 11): stress xx, yy, xy; displacement
@@ -46,22 +49,27 @@ impl Nodal {
     }
 }
 
-/// J and K at every tip of every crack, and J on the compared contours.
-pub fn run<D: Dim>(world: &World<D>, plan: &FracturePlan) -> (Vec<TipResult>, Vec<PathResult>) {
-    let (mut tips, mut paths) = (Vec::new(), Vec::new());
-    let Some(cracks) = &world.cracks else {
-        return (tips, paths);
-    };
-    for (c, crack) in cracks.cracks.iter().enumerate() {
-        for end in 0..2 {
-            if crack.tips[end] {
-                let (t, p) = tip::<D>(world, cracks, c, crack, end, plan);
-                tips.push(t);
-                paths.extend(p);
-            }
-        }
+/// J and K at every tip of every crack, and J on the compared contours, into the crack
+/// scratch's `measured`.
+pub fn run(world: &mut World<D2>, plan: &FracturePlan) {
+    let measured = measure(world, plan);
+    if let Some(c) = world.cracks.as_mut() {
+        c.scratch.measured = measured;
     }
-    (tips, paths)
+}
+
+/// What [`run`] stores: J and K at every tip, J on the compared contours.
+pub fn measure(world: &World<D2>, plan: &FracturePlan) -> Measured {
+    let mut m = Measured::default();
+    let Some(cracks) = &world.cracks else {
+        return m;
+    };
+    for front in cracks.topology.fronts() {
+        let (t, p) = tip(world, cracks, front, plan);
+        m.tips.push(t);
+        m.paths.extend(p);
+    }
+    m
 }
 
 /// The square contour of half-size `n` cells around node (i0, j0), counterclockwise, as
@@ -75,6 +83,10 @@ fn contour(i0: usize, j0: usize, n: usize) -> Vec<[usize; 2]> {
     p.extend((lo_j + 1..=hi_j).rev().map(|j| [lo_i, j]));
     p.push([lo_i, lo_j]);
     p
+}
+
+fn xy(v: DVec2) -> [f64; 2] {
+    v.to_array()
 }
 
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -95,29 +107,34 @@ fn intersect(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> Option<f64> 
     ((0.0..1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
 }
 
-fn tip<D: Dim>(
-    world: &World<D>,
-    cracks: &Cracks<D>,
-    c: usize,
-    crack: &Crack,
-    end: usize,
+fn tip(
+    world: &World<D2>,
+    cracks: &Cracks<D2>,
+    front: &Front,
     plan: &FracturePlan,
 ) -> (TipResult, Vec<PathResult>) {
     let geom = &world.grid.geom;
-    let xy = |v: D::Vec| [v[0], v[1]];
-    let verts = crack.vertices.clone();
-    let (kt, kp) = if end == 1 {
-        (verts.end - 1, verts.end - 2)
+    let topo = &cracks.topology;
+    let (c, end) = (front.crack as usize, front.end as usize);
+    let path: Vec<usize> = topo.cracks()[c]
+        .vertices
+        .iter()
+        .map(|&k| k as usize)
+        .collect();
+    // The polyline's vertices from the tip inwards.
+    let walk: Vec<usize> = if end == 1 {
+        path.iter().rev().copied().collect()
     } else {
-        (verts.start, verts.start + 1)
+        path.clone()
     };
-    let xt = xy(cracks.x[kt]);
+    let (kt, kp) = (walk[0], walk[1]);
+    let xt = xy(cracks.geometry.x[kt]);
     let mut res = TipResult {
         step: world.step,
         time: world.time,
         crack: c as u32,
         tip: end as u32,
-        x: D::to_xyz(cracks.x[kt]),
+        x: D2::to_xyz(cracks.geometry.x[kt]),
         j: [f64::NAN; 2],
         k: [f64::NAN, f64::NAN, 0.0],
         k_interaction: [f64::NAN; 2],
@@ -125,7 +142,7 @@ fn tip<D: Dim>(
         domain: 0.0,
     };
 
-    let Some(main) = contour_j(world, cracks, c, &verts, xt, plan.contour, plan.area_term) else {
+    let Some(main) = contour_j(world, cracks, c, &path, xt, plan.contour, plan.area_term) else {
         return (res, Vec::new());
     };
     let j = [main.line[0] + main.area[0], main.line[1] + main.area[1]];
@@ -141,7 +158,7 @@ fn tip<D: Dim>(
                 let (line, area) = if n == plan.contour && plan.area_term {
                     (main.line, main.area)
                 } else {
-                    let m = contour_j(world, cracks, c, &verts, xt, n, true)?;
+                    let m = contour_j(world, cracks, c, &path, xt, n, true)?;
                     (m.line, m.area)
                 };
                 Some(PathResult {
@@ -158,25 +175,31 @@ fn tip<D: Dim>(
     };
 
     // G along the tip direction (Eq. 10), split by the opening behind the tip (Eqs. 14-22).
-    let xp = xy(cracks.x[kp]);
+    let xp = xy(cracks.geometry.x[kp]);
     let len = ((xt[0] - xp[0]).powi(2) + (xt[1] - xp[1]).powi(2)).sqrt();
     let dir = [(xt[0] - xp[0]) / len, (xt[1] - xp[1]) / len];
     let gr = j[0] * dir[0] + j[1] * dir[1];
     let h = geom.h[0].max(geom.h[1]);
     // With a tip at each end, the fit stays in this tip's half of the crack.
     let mut window = plan.opening * h;
-    if crack.tips[1 - end] {
-        let length: f64 = (verts.start..verts.end - 1)
-            .map(|k| dist(xy(cracks.x[k]), xy(cracks.x[k + 1])))
+    let other_end = topo
+        .fronts()
+        .iter()
+        .any(|f| f.crack == front.crack && f.end != front.end);
+    if other_end {
+        let length: f64 = path
+            .windows(2)
+            .map(|w| dist(xy(cracks.geometry.x[w[0]]), xy(cracks.geometry.x[w[1]])))
             .sum();
         window = window.min(0.5 * length);
     }
-    let [d_i, d_ii] = opening_amplitudes(cracks, &verts, end, xt, dir, h, window);
+    let [d_i, d_ii] = opening_amplitudes(cracks, &walk, end, xt, dir, h, window);
     let mat = &world.materials[world.particles.material[main.nearest] as usize];
     res.k_opening = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
     let at = Tip {
         crack: c,
         end,
+        path: &path,
         x: xt,
         dir,
     };
@@ -206,18 +229,17 @@ struct ContourJ {
 
 /// J on the square contour `n` cells from the node nearest the tip `xt` of crack `c` (shrunk
 /// to fit the grid), or None when no contour fits or the crack does not leave it.
-fn contour_j<D: Dim>(
-    world: &World<D>,
-    cracks: &Cracks<D>,
+fn contour_j(
+    world: &World<D2>,
+    cracks: &Cracks<D2>,
     c: usize,
-    verts: &std::ops::Range<usize>,
+    path: &[usize],
     xt: [f64; 2],
     n: usize,
     area_term: bool,
 ) -> Option<ContourJ> {
     let g = &world.grid;
     let geom = &g.geom;
-    let xy = |v: D::Vec| [v[0], v[1]];
     // The contour around the node nearest the tip, shrunk to fit inside the grid.
     let node = |a: usize| ((xt[a] - geom.origin[a]) * geom.inv_h[a]).round().max(0.0) as usize;
     let (i0, j0) = (node(0), node(1));
@@ -242,20 +264,20 @@ fn contour_j<D: Dim>(
     let mut cut = None;
     'find: for e in 0..ring.len() - 1 {
         let (a, b) = (pos(ring[e]), pos(ring[e + 1]));
-        for k in verts.start..verts.end - 1 {
-            if let Some(s) = intersect(a, b, xy(cracks.x[k]), xy(cracks.x[k + 1])) {
-                cut = Some((e, s, k));
+        for w in path.windows(2) {
+            let (ca, cb) = (xy(cracks.geometry.x[w[0]]), xy(cracks.geometry.x[w[1]]));
+            if let Some(s) = intersect(a, b, ca, cb) {
+                cut = Some((e, s, (ca, cb)));
                 break 'find;
             }
         }
     }
-    let (e, s, k) = cut?;
+    let (e, s, (ca, cb)) = cut?;
     // The path starts on the side of the crack that ring[e + 1] is on and ends on the other.
-    let (ca, cb) = (xy(cracks.x[k]), xy(cracks.x[k + 1]));
     let after = pos(ring[e + 1]);
     let orient = (cb[0] - ca[0]) * (after[1] - ca[1]) - (cb[1] - ca[1]) * (after[0] - ca[0]);
     let first: i8 = if orient >= 0.0 { 1 } else { -1 };
-    let fields = &cracks.fields;
+    let fields = &cracks.scratch.fields;
 
     // Nodal values of every field at the contour nodes (Eq. 11).
     let mut acc: HashMap<usize, [f64; 10]> = HashMap::new();
@@ -292,10 +314,10 @@ fn contour_j<D: Dim>(
         let st = p.stress[i].to_sym3();
         let gu = p.grad_u[i];
         let gu = [
-            D::entry(&gu, 0, 0),
-            D::entry(&gu, 0, 1),
-            D::entry(&gu, 1, 0),
-            D::entry(&gu, 1, 1),
+            D2::entry(&gu, 0, 0),
+            D2::entry(&gu, 0, 1),
+            D2::entry(&gu, 1, 0),
+            D2::entry(&gu, 1, 1),
         ];
         let v = xy(p.v[i]);
         let f = [
@@ -315,7 +337,7 @@ fn contour_j<D: Dim>(
         let inside = area_term && x[0] > lo[0] && x[0] < hi[0] && x[1] > lo[1] && x[1] < hi[1];
         let mut accel = [0.0; 2];
         with_shape!(shape, S, N => {
-            let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
+            let st = Stencil::<N>::cached::<D2>(S, &world.tiles.stencils, i);
             let mut visit = |entry: usize, w: f64| {
                 if let Some(a) = acc.get_mut(&entry) {
                     for (a, f) in a.iter_mut().zip(&f) {
@@ -328,8 +350,8 @@ fn contour_j<D: Dim>(
                 }
             };
             match targets {
-                Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, w, _| visit(n, w)),
-                None => st.for_each::<D>(&geom.stride, |n, w, _| visit(n, w)),
+                Some(t) => st.for_each_target::<D2>(&geom.stride, t, |n, w, _| visit(n, w)),
+                None => st.for_each::<D2>(&geom.stride, |n, w, _| visit(n, w)),
             }
         });
         if inside {
@@ -338,8 +360,11 @@ fn contour_j<D: Dim>(
             let gv = p.grad_v[i];
             let scale = m / world.settings.thickness;
             for (mm, a) in area.iter_mut().enumerate() {
-                let du = [D::entry(&p.grad_u[i], 0, mm), D::entry(&p.grad_u[i], 1, mm)];
-                let dv = [D::entry(&gv, 0, mm), D::entry(&gv, 1, mm)];
+                let du = [
+                    D2::entry(&p.grad_u[i], 0, mm),
+                    D2::entry(&p.grad_u[i], 1, mm),
+                ];
+                let dv = [D2::entry(&gv, 0, mm), D2::entry(&gv, 1, mm)];
                 *a += scale * (accel[0] * du[0] + accel[1] * du[1] - v[0] * dv[0] - v[1] * dv[1]);
             }
         }
@@ -402,24 +427,18 @@ fn contour_j<D: Dim>(
 /// one cell to `window` behind the tip (least squares, the offset r0 free), and the signed
 /// amplitudes A take the place of the point values. With one vertex in the window its
 /// opening is used as is; with none, NaN.
-fn opening_amplitudes<D: Dim>(
-    cracks: &Cracks<D>,
-    verts: &std::ops::Range<usize>,
+fn opening_amplitudes(
+    cracks: &Cracks<D2>,
+    walk: &[usize],
     end: usize,
     xt: [f64; 2],
     dir: [f64; 2],
     h: f64,
     window: f64,
 ) -> [f64; 2] {
-    let xy = |v: D::Vec| [v[0], v[1]];
     let mut samples: Vec<(f64, [f64; 2])> = Vec::new();
-    let behind: Box<dyn Iterator<Item = usize>> = if end == 1 {
-        Box::new(verts.clone().rev())
-    } else {
-        Box::new(verts.clone())
-    };
-    for k in behind.skip(1) {
-        let r = dist(xy(cracks.x[k]), xt);
+    for &k in walk.iter().skip(1) {
+        let r = dist(xy(cracks.geometry.x[k]), xt);
         if r > window {
             break;
         }
@@ -429,9 +448,9 @@ fn opening_amplitudes<D: Dim>(
         // The surface left of the tip direction: the top one at an end tip, the bottom at a
         // start.
         let (upper, lower) = if end == 1 {
-            (cracks.top[k], cracks.bottom[k])
+            (cracks.geometry.top[k], cracks.geometry.bottom[k])
         } else {
-            (cracks.bottom[k], cracks.top[k])
+            (cracks.geometry.bottom[k], cracks.geometry.top[k])
         };
         let d = xy(upper - lower);
         let d_i = -d[0] * dir[1] + d[1] * dir[0];

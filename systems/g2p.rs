@@ -18,7 +18,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let shape = world.settings.shape;
     let grid = &world.grid;
     let stencils = &world.tiles.stencils;
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     let track = fields.is_some();
     let nodal = (&grid.accel[..], &grid.velocity[..]);
     let Particles { x, v, .. } = &mut world.particles;
@@ -62,7 +62,7 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
     grid.momentum.par_iter_mut().for_each(|m| *m = D::zero());
     let nodal = (&grid.accel[..], &grid.velocity[..]);
     let tiles = &world.tiles;
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     let track = fields.is_some();
     let p = &mut world.particles;
     let pmass = &p.mass;
@@ -103,7 +103,7 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
     if let Some(c) = world.cracks.as_ref() {
         let p = &world.particles;
         scatter_coded::<D, false, true, false>(
-            &c.fields,
+            &c.scratch.fields,
             p,
             shape,
             &world.tiles.stencils,
@@ -168,9 +168,9 @@ fn move_coded<D: Dim>(world: &mut World<D>) -> f64 {
     );
     let (grid, p) = (&world.grid, &mut world.particles);
     let mut fastest = 0.0f64;
-    for &i in &c.fields.coded {
+    for &i in &c.scratch.fields.coded {
         let i = i as usize;
-        let targets = c.fields.targets_of(i).expect("coded particle");
+        let targets = c.scratch.fields.targets_of(i).expect("coded particle");
         let (mut dv, mut vn) = (D::zero(), D::zero());
         with_shape!(shape, S, N => {
             let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
@@ -190,7 +190,7 @@ fn move_coded<D: Dim>(world: &mut World<D>) -> f64 {
 /// largest squared velocity is `fastest`), stale bins, the load work.
 fn finish<D: Dim>(world: &mut World<D>, fastest: f64) {
     if let Some(c) = world.cracks.as_mut() {
-        c.classified.drift += fastest.sqrt() * world.settings.dt;
+        c.scratch.classified.drift += fastest.sqrt() * world.settings.dt;
     }
     world.tiles.fresh = false;
     load_work_end(world);
@@ -204,7 +204,7 @@ fn load_work_end<D: Dim>(world: &mut World<D>) {
     let (t, dt) = (world.time, world.settings.dt);
     let shape = world.settings.shape;
     let grid = &world.grid;
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     let mut work = 0.0;
     for load in &world.loads {
         let scale = load.time.at(t);

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 pub fn momentum_bc<D: Dim>(world: &mut World<D>, end: bool) {
     let t = world.time + if end { world.settings.dt } else { 0.0 };
     let g = &mut world.grid;
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     for bc in &world.bcs {
         for &node in &bc.nodes {
             for n in entries(node, fields) {
@@ -74,11 +74,16 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         world.work.external += grav;
     }
     if let Some(c) = world.cracks.as_ref() {
-        merge_slivers(&mut world.grid, &mut world.work, &c.fields, &world.settings);
+        merge_slivers(
+            &mut world.grid,
+            &mut world.work,
+            &c.scratch.fields,
+            &world.settings,
+        );
     }
     let t1 = world.time + dt;
     let g = &mut world.grid;
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     let mut work = 0.0;
     for bc in &world.bcs {
         for &node in &bc.nodes {

@@ -49,7 +49,7 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
     let p = &world.particles;
     let shape = world.settings.shape;
     let geom = &grid.geom;
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     world.tiles.for_each_coloured(|t| {
         with_shape!(shape, S, N => for &i in world.tiles.particles(t) {
             let i = i as usize;
@@ -149,7 +149,10 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
         let scale = load.time.at(t);
         for (&i, &f) in load.particles.iter().zip(&load.forces) {
             let (i, f) = (i as usize, f * scale);
-            let targets = world.cracks.as_ref().and_then(|c| c.fields.targets_of(i));
+            let targets = world
+                .cracks
+                .as_ref()
+                .and_then(|c| c.scratch.fields.targets_of(i));
             with_shape!(shape, S, N => {
                 let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
                 match targets {

@@ -23,7 +23,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let grid = &world.grid;
     let materials = &world.materials;
     let stencils = &world.tiles.stencils;
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     let Particles {
         grad_v,
         grad_u,
@@ -75,7 +75,7 @@ pub(crate) fn update_coded<D: Dim>(world: &mut World<D>, dt: f64) {
         return;
     };
     let (shape, plane) = (world.settings.shape, world.settings.plane);
-    let (grid, f) = (&world.grid, &c.fields);
+    let (grid, f) = (&world.grid, &c.scratch.fields);
     let p = &mut world.particles;
     let keep = !p.grad_u.is_empty();
     for &i in &f.coded {

@@ -40,7 +40,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) -> Result<(), Unstable> 
         inv_h: world.tiles.stencils.inv_h,
         material,
         materials: &world.materials,
-        fields: world.cracks.as_ref().map(|c| &c.fields),
+        fields: world.cracks.as_ref().map(|c| &c.scratch.fields),
         columns: StressColumns::new(stress, grad_v, grad_u),
     };
     let shape = world.settings.shape;

@@ -38,7 +38,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     } = &mut world.particles;
     let columns = StressColumns::<D>::new(stress, grad_v, grad_u);
     let (tiles, materials) = (&world.tiles, &world.materials);
-    let fields = world.cracks.as_ref().map(|c| &c.fields);
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     tiles.for_each_coloured(|t| {
         with_shape!(shape, S, N => for &i in tiles.particles(t) {
             let i = i as usize;
@@ -61,7 +61,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     });
     if world.cracks.is_some() {
         update_coded(world, dt);
-        let f = &world.cracks.as_ref().expect("cracks").fields;
+        let f = &world.cracks.as_ref().expect("cracks").scratch.fields;
         let stencils = &world.tiles.stencils;
         scatter_coded::<D, false, false, true>(
             f,

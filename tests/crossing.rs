@@ -11,7 +11,7 @@ fn v2(x: f64, y: f64) -> DVec2 {
 /// Crossings of the line p -> q with every segment of the polyline `pts`, per segment.
 fn crossings(p: DVec2, q: DVec2, pts: &[DVec2]) -> Vec<i8> {
     (0..pts.len() - 1)
-        .map(|k| D2::crossing(p, q, pts, [k as u32, k as u32 + 1, 0]))
+        .map(|k| D2::crossing(p, q, pts, [k as u32, k as u32 + 1]))
         .collect()
 }
 

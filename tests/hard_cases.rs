@@ -181,13 +181,12 @@ tips = ["start", "end"]
     );
     let w = final_world::<D2>(&text, 2);
     let cracks = w.cracks.as_ref().unwrap();
-    let crack = &cracks.cracks[0];
+    let crack = &cracks.topology.cracks()[0];
     let dir = [co, s];
-    let opening = crack
-        .vertices
-        .clone()
-        .map(|k| {
-            let d = cracks.top[k] - cracks.bottom[k];
+    let opening = (crack.vertices.iter())
+        .map(|&k| {
+            let k = k as usize;
+            let d = cracks.geometry.top[k] - cracks.geometry.bottom[k];
             // The top surface is left of the crack's start -> end direction.
             -d[0] * dir[1] + d[1] * dir[0]
         })

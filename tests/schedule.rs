@@ -14,7 +14,7 @@ fn names(extra: &str, update: &str) -> Vec<&'static str> {
         &format!("dimension = 2\nupdate = \"{update}\""),
     );
     let world = build::<D2>(&source(&text)).unwrap().world;
-    Schedule::for_world(&world)
+    Schedule::for_world(&world, None)
         .systems
         .iter()
         .map(|s| s.name())

@@ -1,7 +1,7 @@
 //! VTK XML output for ParaView: particle and crack `.vtu` files (appended raw binary) and
 //! `.pvd` collections indexing them by time.
 
-use crate::crack::Cracks;
+use crate::crack::{Cracks, Element};
 use crate::dim::Dim;
 use crate::particles::Particles;
 use crate::sym::SymTensor;
@@ -73,17 +73,22 @@ pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result
     )
 }
 
-/// Writes the cracks of `c` as line cells: the crack-plane vertices joined by the crack
-/// segments, with the opening (top minus bottom surface, m) and the crack index.
+/// Writes the cracks of `c` as line cells (2D) or triangle cells (3D): the crack-plane
+/// vertices joined by the crack elements, with the opening (top minus bottom surface, m)
+/// and the crack index.
 pub fn write_cracks<D: Dim>(path: &Path, c: &Cracks<D>) -> std::io::Result<()> {
-    let n = c.x.len();
-    let m = c.elems.len();
-    let opening = f64s((0..n).flat_map(|k| D::to_xyz(c.top[k] - c.bottom[k])));
+    let n = c.geometry.x.len();
+    let topo = &c.topology;
+    let m = topo.elems().len();
+    let per = <D::Elem as Element>::VERTICES;
+    // VTK_LINE and VTK_TRIANGLE.
+    let kind = if per == 2 { 3u8 } else { 5u8 };
+    let opening = f64s((0..n).flat_map(|k| D::to_xyz(c.geometry.top[k] - c.geometry.bottom[k])));
     let mut crack = vec![0i32; n];
-    for (k, cr) in c.cracks.iter().enumerate() {
-        crack[cr.vertices.clone()]
-            .iter_mut()
-            .for_each(|x| *x = k as i32);
+    for (k, cr) in topo.cracks().iter().enumerate() {
+        for &v in &cr.vertices {
+            crack[v as usize] = k as i32;
+        }
     }
     let point_data = vec![
         Array {
@@ -97,16 +102,18 @@ pub fn write_cracks<D: Dim>(path: &Path, c: &Cracks<D>) -> std::io::Result<()> {
     ];
     let points = Array {
         attrs: r#"type="Float64" Name="Points" NumberOfComponents="3""#.into(),
-        bytes: f64s(c.x.iter().flat_map(|v| D::to_xyz(*v))),
+        bytes: f64s(c.geometry.x.iter().flat_map(|v| D::to_xyz(*v))),
     };
     let cells = [
-        c.elems
+        topo.elems()
             .iter()
-            .flat_map(|e| [e[0] as i64, e[1] as i64])
+            .flat_map(|e| e.vertices().iter().map(|&v| v as i64))
             .flat_map(i64::to_le_bytes)
             .collect(),
-        (1..=m as i64).flat_map(|k| (2 * k).to_le_bytes()).collect(),
-        vec![3u8; m],
+        (1..=m as i64)
+            .flat_map(|k| (per as i64 * k).to_le_bytes())
+            .collect(),
+        vec![kind; m],
     ];
     write_unstructured(
         path,

@@ -16,7 +16,7 @@ use crate::schedule::Schedule;
 use crate::snapshot::Reader;
 use crate::snapshot::state::restore;
 use crate::sym::SymTensor;
-use crate::systems::{bin, classify, fracture};
+use crate::systems::bin;
 use crate::world::{Energies, World};
 use anyhow::Context;
 use checkpoint::Checkpointer;
@@ -149,7 +149,7 @@ fn drive<D: Dim>(
         checkpoint,
         fracture,
     } = scene;
-    let mut schedule = Schedule::for_world(&world);
+    let mut schedule = Schedule::for_world(&world, fracture.clone());
     let dt = world.settings.dt;
     let end = opts.until.unwrap_or(duration);
     if !(end.is_finite() && end > world.time) {
@@ -175,7 +175,7 @@ fn drive<D: Dim>(
     let crack_names: Option<Vec<String>> = fracture
         .as_ref()
         .and(world.cracks.as_ref())
-        .map(|c| c.cracks.iter().map(|c| c.name.clone()).collect());
+        .map(|c| c.topology.cracks().iter().map(|c| c.name.clone()).collect());
     let mut writers = match &opts.out {
         Some(dir) => Some(Writers::open(
             dir,
@@ -186,19 +186,17 @@ fn drive<D: Dim>(
         )?),
         None => None,
     };
-    let mut fracture_seconds = 0.0;
-    let mut measure = |world: &World<D>, state: &mut RunState, w: &mut Option<Writers>| {
-        let Some(plan) = &fracture else {
+    // Takes what the fracture system measured to fracture.csv and the history.
+    let take = |world: &mut World<D>, state: &mut RunState, w: &mut Option<Writers>| {
+        let Some(c) = world.cracks.as_mut() else {
             return Ok::<(), anyhow::Error>(());
         };
-        let t0 = Instant::now();
-        let (tips, paths) = fracture::run(world, plan);
-        fracture_seconds += t0.elapsed().as_secs_f64();
+        let m = std::mem::take(&mut c.scratch.measured);
         if let Some(w) = w {
-            w.fracture(&tips, &paths)?;
+            w.fracture(&m.tips, &m.paths)?;
         }
-        state.history.fracture.extend(tips);
-        state.history.paths.extend(paths);
+        state.history.fracture.extend(m.tips);
+        state.history.paths.extend(m.paths);
         Ok(())
     };
     let mut checkpoints = match &opts.out {
@@ -213,13 +211,8 @@ fn drive<D: Dim>(
     if resumed_from.is_none() {
         state.sample(&world, &probes);
         let row = *state.record(&world, world.energies());
-        if fracture.is_some() {
-            // J at t = 0 reads the particles' stencils and fields, which the first step
-            // would build anyway.
-            bin::run(&mut world)?;
-            classify::run(&mut world);
-        }
-        measure(&world, &mut state, &mut writers)?;
+        schedule.measure_now(&mut world)?;
+        take(&mut world, &mut state, &mut writers)?;
         if let Some(w) = &mut writers {
             w.row(&row, &state.history)?;
             if vtk {
@@ -250,7 +243,7 @@ fn drive<D: Dim>(
             state.next_history,
             next == steps,
         );
-        if let Err(e) = schedule.step_keeping(&mut world, fracture.is_some() && ends_at_row) {
+        if let Err(e) = schedule.step_measuring(&mut world, ends_at_row) {
             stop = Stop::Unstable(e);
             break;
         }
@@ -264,7 +257,7 @@ fn drive<D: Dim>(
                 break;
             }
             let row = *state.record(&world, energies);
-            measure(&world, &mut state, &mut writers)?;
+            take(&mut world, &mut state, &mut writers)?;
             if let Some(w) = &mut writers {
                 w.row(&row, &state.history)?;
             }
@@ -361,11 +354,6 @@ fn drive<D: Dim>(
             .seconds_by_name()
             .into_iter()
             .map(|(n, s)| (n.to_string(), s))
-            .chain(
-                fracture
-                    .is_some()
-                    .then(|| ("fracture".to_string(), fracture_seconds)),
-            )
             .collect(),
         bytes_per_particle: world.bytes_per_particle(),
         bytes_per_node: crate::grid::Grid::<D>::bytes_per_node(),
@@ -542,14 +530,17 @@ fn path_reports<D: Dim>(
         return Vec::new();
     };
     let mut out = Vec::new();
-    for (c, crack) in cracks.cracks.iter().enumerate() {
-        for tip in (0..2).filter(|&t| crack.tips[t]) {
+    let topo = &cracks.topology;
+    for front in topo.fronts() {
+        let (c, tip) = (front.crack as u32, front.end);
+        let crack = &topo.cracks()[c as usize];
+        {
             for &n in &plan.compare {
                 let diff = |area| {
                     path_difference(
                         history,
-                        c as u32,
-                        tip as u32,
+                        c,
+                        tip,
                         plan.contour as u32,
                         n as u32,
                         plan.compare_from,
@@ -558,7 +549,7 @@ fn path_reports<D: Dim>(
                 };
                 out.push(PathReport {
                     crack: crack.name.clone(),
-                    tip: ["start", "end"][tip].into(),
+                    tip: ["start", "end"][tip as usize].into(),
                     main: plan.contour as u32,
                     contour: n as u32,
                     from: plan.compare_from,

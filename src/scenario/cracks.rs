@@ -3,7 +3,7 @@
 use super::build::{positive, to_vec, vec3};
 use super::schema::{CrackSpec, ExpectSpec};
 use super::source::Source;
-use crate::crack::{Contact, Crack, Cracks, Law, MAX_CRACKS};
+use crate::crack::{Contact, Cracks, Element, Law, MAX_CRACKS};
 use crate::dim::Dim;
 use crate::error::ScenarioError;
 use crate::fracture::{FracturePlan, KMethod};
@@ -70,39 +70,46 @@ pub(super) fn build<D: Dim>(
                 format!("the crack crosses itself (segments {a} and {b})"),
             ));
         }
-        let mut tips = [false, true];
+        let mut ends = vec![1u32];
         if let Some(t) = &spec.tips {
-            tips = [false, false];
+            ends.clear();
             for name in t {
-                match name.as_str() {
-                    "start" => tips[0] = true,
-                    "end" => tips[1] = true,
+                let end = match name.as_str() {
+                    "start" => 0,
+                    "end" => 1,
                     other => {
                         return Err(
                             src.error(&key("tips"), format!("unknown tip `{other}` (start, end)"))
                         );
                     }
+                };
+                if !ends.contains(&end) {
+                    ends.push(end);
                 }
             }
+            ends.sort_unstable();
         }
         let contact = contact(src, c, spec)?;
-        let first = store.x.len();
-        for k in 0..points.len() - 1 {
-            store
-                .elems
-                .push([(first + k) as u32, (first + k + 1) as u32, 0]);
-            store.elem_crack.push(c as u16);
-        }
-        store.x.extend(&points);
-        store.cracks.push(Crack {
-            name: spec.name.clone().unwrap_or_else(|| format!("crack{c}")),
-            vertices: first..store.x.len(),
-            tips,
+        let n = points.len();
+        let elems: Vec<D::Elem> = (0..n as u32 - 1)
+            .map(|k| D::Elem::from_vertices(&[k, k + 1]))
+            .collect();
+        let fronts: Vec<(u32, Vec<u32>)> = ends
+            .iter()
+            .map(|&end| (end, vec![if end == 0 { 0 } else { n as u32 - 1 }]))
+            .collect();
+        store.topology.add_crack(
+            spec.name.clone().unwrap_or_else(|| format!("crack{c}")),
             contact,
-        });
+            n,
+            &elems,
+            &fronts,
+        );
+        store.geometry.x.extend(&points);
     }
-    store.top = store.x.clone();
-    store.bottom = store.x.clone();
+    let g = &mut store.geometry;
+    g.top = g.x.clone();
+    g.bottom = g.x.clone();
     Ok(Some(store))
 }
 
@@ -219,7 +226,7 @@ fn near_particle<D: Dim>(x: D::Vec, p: &Particles<D>, geom: &GridGeom<D>) -> boo
 
 /// The first pair of non-adjacent segments of a polyline that intersect, if any.
 fn self_crossing<D: Dim>(pts: &[D::Vec]) -> Option<(usize, usize)> {
-    let e = |k: usize| [k as u32, k as u32 + 1, 0];
+    let e = |k: usize| D::Elem::from_vertices(&[k as u32, k as u32 + 1]);
     let n = pts.len() - 1;
     for a in 0..n {
         for b in a + 2..n {
@@ -246,7 +253,7 @@ pub(super) fn fracture_plan<D: Dim>(
     let Some(cracks) = cracks else {
         return Err(src.error("fracture", "J and K need at least one [[crack]]"));
     };
-    if !cracks.cracks.iter().any(|c| c.tips[0] || c.tips[1]) {
+    if cracks.topology.fronts().is_empty() {
         return Err(src.error(
             "fracture",
             "J and K are measured at crack tips, and no crack has one (see `tips`)",
@@ -256,12 +263,10 @@ pub(super) fn fracture_plan<D: Dim>(
         if n == 0 {
             return Err(src.error(key, "must be at least 1 cell"));
         }
-        for c in &cracks.cracks {
-            for (end, k) in [(0, c.vertices.start), (1, c.vertices.end - 1)] {
-                if !c.tips[end] {
-                    continue;
-                }
-                let x = cracks.x[k];
+        let topo = &cracks.topology;
+        for f in topo.fronts() {
+            for &k in &f.vertices {
+                let x = cracks.geometry.x[k as usize];
                 let inside = (0..D::D).all(|a| {
                     let i = ((x[a] - geom.origin[a]) * geom.inv_h[a]).round();
                     i >= n as f64 && i + n as f64 <= geom.cells[a] as f64
@@ -271,8 +276,8 @@ pub(super) fn fracture_plan<D: Dim>(
                         key,
                         format!(
                             "a {n} x {n} cell contour around the {} tip of `{}` leaves the grid",
-                            ["start", "end"][end],
-                            c.name
+                            ["start", "end"][f.end as usize],
+                            topo.cracks()[f.crack as usize].name
                         ),
                     ));
                 }

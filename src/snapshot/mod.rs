@@ -3,5 +3,6 @@
 
 pub mod format;
 pub mod state;
+mod topology;
 
 pub use format::{Columnar, Reader, SnapshotError};

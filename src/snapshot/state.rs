@@ -1,9 +1,11 @@
 //! A run's state as snapshot columns, and back. The scene is rebuilt from the stored scenario
-//! text (loads, boundaries, probes, grid, crack topology) and the evolving state is then put
-//! back from the columns (particles, crack vertices and surfaces, work, history); grid
-//! scratch, particle bins and crack velocity fields are rebuilt by the first step.
+//! text (loads, boundaries, probes, grid, crack names and contact laws) and the evolving
+//! state is then put back from the columns (particles, crack topology, vertices and
+//! surfaces, work, history); grid scratch, particle bins and crack velocity fields are
+//! rebuilt by the first step.
 
 use super::format::{ColumnSet, Header, Reader, SnapshotError};
+use super::topology::{self, Encoded};
 use crate::dim::Dim;
 use crate::fracture::{PathResult, TipResult};
 use crate::material::Elastic;
@@ -105,6 +107,7 @@ pub fn write<D: Dim>(
         .map(|k| format!("history.probe.{k}"))
         .collect();
 
+    let topology = world.cracks.as_ref().map(|cr| Encoded::new(&cr.topology));
     let mut c = ColumnSet::default();
     c.add("scenario.toml", src.text.as_bytes());
     c.add("scenario.file", src.file.as_bytes());
@@ -129,10 +132,11 @@ pub fn write<D: Dim>(
     for (name, series) in probe_names.iter().zip(&h.probes) {
         c.add(name, series);
     }
-    if let Some(cr) = &world.cracks {
-        c.add("cracks.x", &cr.x);
-        c.add("cracks.top", &cr.top);
-        c.add("cracks.bottom", &cr.bottom);
+    if let (Some(cr), Some(t)) = (&world.cracks, &topology) {
+        t.add(&mut c);
+        c.add("cracks.x", &cr.geometry.x);
+        c.add("cracks.top", &cr.geometry.top);
+        c.add("cracks.bottom", &cr.geometry.bottom);
     }
     c.add("history.fracture.step", &tip_steps);
     c.add("history.fracture.tip", &tip_ids);
@@ -245,10 +249,11 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     w.work.external = run[0];
     w.work.damping = run[1];
     if let Some(cr) = &mut w.cracks {
-        let nv = cr.x.len();
-        cr.x = r.column("cracks.x", nv)?;
-        cr.top = r.column("cracks.top", nv)?;
-        cr.bottom = r.column("cracks.bottom", nv)?;
+        cr.topology = topology::read(r, &cr.topology)?;
+        let nv = cr.topology.vertex_count();
+        cr.geometry.x = r.column("cracks.x", nv)?;
+        cr.geometry.top = r.column("cracks.top", nv)?;
+        cr.geometry.bottom = r.column("cracks.bottom", nv)?;
     }
     w.time = h.time;
     w.step = h.step;

@@ -43,7 +43,7 @@ pub fn final_world_with<D: Dim>(
         let scene = build::<D>(&src).unwrap_or_else(|e| panic!("{e}"));
         let mut world = scene.world;
         prepare(&mut world);
-        let mut schedule = Schedule::for_world(&world);
+        let mut schedule = Schedule::for_world(&world, None);
         let steps = (scene.duration / world.settings.dt).ceil() as u64;
         while world.step < steps {
             schedule.step(&mut world).unwrap_or_else(|e| panic!("{e}"));
@@ -188,7 +188,7 @@ history_interval = {hist:e}
 pub fn fused_and_unfused<D: Dim>(text: &str, steps: usize) -> (World<D>, World<D>) {
     let mut fused = build::<D>(&source(text)).unwrap().world;
     let mut apart = fused.clone();
-    let mut fused_schedule = Schedule::for_world(&fused);
+    let mut fused_schedule = Schedule::for_world(&fused, None);
     let mut apart_schedule = fused_schedule.clone();
     assert!(
         fused_schedule

@@ -1,0 +1,54 @@
+//! Crack elements per dimension: a segment of two vertices in 2D, a triangle of three in
+//! 3D. [`crate::dim::Dim::Elem`] picks one, so code written for one shape of element
+//! does not compile for the other.
+
+use std::fmt::Debug;
+
+/// A crack element: a fixed number of vertex indices into the crack store.
+pub trait Element: Copy + Debug + PartialEq + Send + Sync + 'static {
+    /// Vertices per element.
+    const VERTICES: usize;
+    /// Boundary features per element: end points of a segment, edges of a triangle.
+    const FEATURES: usize;
+    /// The element's vertex indices.
+    fn vertices(&self) -> &[u32];
+    /// The element of these vertices (exactly [`Element::VERTICES`] of them).
+    fn from_vertices(v: &[u32]) -> Self;
+    /// Vertex indices of boundary feature `k` (a segment's end point twice, a triangle's
+    /// edge from vertex k to k + 1).
+    fn feature(&self, k: usize) -> [u32; 2];
+}
+
+/// A 2D crack element: the segment from vertex 0 to vertex 1.
+pub type Segment = [u32; 2];
+
+/// A 3D crack element: the triangle of vertices 0, 1, 2, counterclockwise seen from above.
+pub type Triangle = [u32; 3];
+
+impl Element for Segment {
+    const VERTICES: usize = 2;
+    const FEATURES: usize = 2;
+    fn vertices(&self) -> &[u32] {
+        self
+    }
+    fn from_vertices(v: &[u32]) -> Self {
+        [v[0], v[1]]
+    }
+    fn feature(&self, k: usize) -> [u32; 2] {
+        [self[k], self[k]]
+    }
+}
+
+impl Element for Triangle {
+    const VERTICES: usize = 3;
+    const FEATURES: usize = 3;
+    fn vertices(&self) -> &[u32] {
+        self
+    }
+    fn from_vertices(v: &[u32]) -> Self {
+        [v[0], v[1], v[2]]
+    }
+    fn feature(&self, k: usize) -> [u32; 2] {
+        [self[k], self[(k + 1) % 3]]
+    }
+}

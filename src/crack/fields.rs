@@ -1,0 +1,171 @@
+//! Per-step scratch of the crack systems: the extra velocity fields `classify` builds, the
+//! classification it reuses between steps, the element neighbours it keeps while the
+//! topology stands, and what contact measures. None of it is part of a snapshot.
+
+use crate::dim::Dim;
+use crate::fracture::Measured;
+use std::collections::HashMap;
+use std::ops::Range;
+
+/// Which grid entry each particle-node pair of a particle near a crack uses, and the extra
+/// field rows appended to the grid columns (Guo & Nairn 2D (2004) Eqs. 3-6 per field).
+///
+/// A particle whose stencil line to some node crosses a crack is *coded*: each of its
+/// stencil nodes maps to a grid entry, the node itself (field 0, the node's own side) or an
+/// extra row `nodes + r` for the node's field with crack-side mask `mask[r]`. Bits `2c` and
+/// `2c + 1` of a mask say that the line crossed crack `c` with the particle above or below
+/// it. Most particles are not coded and use their stencil's nodes directly.
+#[derive(Clone, Debug, Default)]
+pub struct Fields {
+    /// Stencil nodes per particle.
+    pub per: usize,
+    /// Per particle: its index in `coded`, or `u32::MAX` if it sees no crack.
+    pub slot: Vec<u32>,
+    /// Coded particles in increasing index order.
+    pub coded: Vec<u32>,
+    /// Grid entry of every stencil node of each coded particle (`per` each).
+    pub targets: Vec<u32>,
+    /// Node of each extra row, in increasing order.
+    pub node: Vec<u32>,
+    /// Crack-side mask of each extra row.
+    pub mask: Vec<u64>,
+    /// Grid nodes (extra rows start here).
+    pub nodes: usize,
+    /// Scratch of `classify`, per grid node: the first extra row found there while the
+    /// rows are collected (`u32::MAX` outside that).
+    pub head: Vec<u32>,
+}
+
+/// What `classify` last found for each particle near a crack, kept so that a step can
+/// reuse it while neither the particle nor the crack has moved far enough to change a
+/// crossing (a skin, as in Verlet neighbour lists). Reuse gives exactly what a fresh
+/// classification would, so the record is not part of a snapshot.
+#[derive(Clone, Debug)]
+pub struct Classified<D: Dim> {
+    /// Classify every particle afresh every step (for checks; off by default).
+    pub every_step: bool,
+    /// Crack-plane vertex positions at the last full pass (m); empty before the first.
+    pub x0: Vec<D::Vec>,
+    /// Bound on any particle's displacement since the last full pass (m): `g2p` adds each
+    /// step's largest.
+    pub drift: f64,
+    /// Particles within reach of a crack at the last full pass, in increasing order.
+    pub watched: Vec<u32>,
+    /// First stencil node of each watched particle when it was classified.
+    pub first: Vec<u32>,
+    /// A watched particle's record stands while `drift` plus the cracks' movement since the
+    /// full pass stays below this (m).
+    pub budget: Vec<f64>,
+    /// Whether some line from the watched particle to a stencil node crosses a crack (kept
+    /// so a step scans only those particles' masks).
+    pub crosses: Vec<bool>,
+    /// Crack-side mask of every stencil node of each watched particle (`Fields::per` each,
+    /// zero weights included).
+    pub masks: Vec<u64>,
+}
+
+/// Which crack elements share a boundary feature (a vertex in 2D, an edge in 3D), as
+/// `classify` needs it: it depends on the topology only, so it is rebuilt when the
+/// topology's version changes.
+#[derive(Clone, Debug, Default)]
+pub struct Links {
+    /// The topology version the table was built for; None before the first build.
+    pub version: Option<u64>,
+    /// Per element and feature, the one other element sharing that feature when a
+    /// crossing through it is parity-safe, else `u32::MAX` (none).
+    pub neighbour: Vec<[u32; 3]>,
+}
+
+/// Everything the crack systems rebuild or keep between steps that a snapshot need not
+/// hold.
+#[derive(Clone, Debug)]
+pub struct Scratch<D: Dim> {
+    /// Extra velocity fields this step.
+    pub fields: Fields,
+    /// The last classification, reused while nothing moved far enough to change it.
+    pub classified: Classified<D>,
+    /// The elements' neighbours, rebuilt when the topology changes.
+    pub links: Links,
+    /// Mass-weighted nodal displacements m u of the crack fields' entries this step (for
+    /// contact detection).
+    pub disp: HashMap<usize, D::Vec>,
+    /// Momentum changes made by contact on the scattered momenta this step (entry, change),
+    /// which the particles' velocity update must also see.
+    pub contact_dp: Vec<(usize, D::Vec)>,
+    /// What the fracture system last measured, until the run loop takes it.
+    pub measured: Measured,
+}
+
+impl<D: Dim> Default for Scratch<D> {
+    fn default() -> Self {
+        Scratch {
+            fields: Fields::default(),
+            classified: Classified::default(),
+            links: Links::default(),
+            disp: HashMap::new(),
+            contact_dp: Vec::new(),
+            measured: Measured::default(),
+        }
+    }
+}
+
+impl<D: Dim> Default for Classified<D> {
+    fn default() -> Self {
+        Classified {
+            every_step: false,
+            x0: Vec::new(),
+            drift: 0.0,
+            watched: Vec::new(),
+            first: Vec::new(),
+            budget: Vec::new(),
+            crosses: Vec::new(),
+            masks: Vec::new(),
+        }
+    }
+}
+
+impl Fields {
+    /// Whether particle `p` sees a crack (and so is handled field by field).
+    #[inline(always)]
+    pub fn is_coded(&self, p: usize) -> bool {
+        self.slot[p] != u32::MAX
+    }
+
+    /// Grid entries of coded particle `p`'s stencil nodes, if it is coded.
+    #[inline(always)]
+    pub fn targets_of(&self, p: usize) -> Option<&[u32]> {
+        match self.slot.get(p) {
+            Some(&s) if s != u32::MAX => {
+                let s = s as usize * self.per;
+                Some(&self.targets[s..s + self.per])
+            }
+            _ => None,
+        }
+    }
+
+    /// Grid entry of node `n`'s field on `side` (+1 above, -1 below) of crack `c`: the row
+    /// whose particles crossed the crack from that side, or else the node's own field.
+    pub fn side_entry(&self, n: usize, c: usize, side: i8) -> usize {
+        self.side_entry_in(self.rows_of(n as u32), n, c, side)
+    }
+
+    /// [`Fields::side_entry`] given `rows`, node `n`'s [`Fields::rows_of`].
+    pub fn side_entry_in(&self, mut rows: Range<usize>, n: usize, c: usize, side: i8) -> usize {
+        let bit = side_bit(c, side);
+        rows.find(|&r| self.mask[r - self.nodes] & bit != 0)
+            .unwrap_or(n)
+    }
+
+    /// Grid entries of the extra fields of node `n`.
+    pub fn rows_of(&self, n: u32) -> Range<usize> {
+        let lo = self.node.partition_point(|&m| m < n);
+        let hi = self.node.partition_point(|&m| m <= n);
+        self.nodes + lo..self.nodes + hi
+    }
+}
+
+/// Mask bit for crack `c` crossed with the particle on `side` (+1 above, -1 below).
+#[inline(always)]
+pub fn side_bit(c: usize, side: i8) -> u64 {
+    1u64 << (2 * c + usize::from(side < 0))
+}
