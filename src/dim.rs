@@ -99,8 +99,9 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     /// or on it, -1 below; the first test of [`Dim::crossing`].
     fn elem_side(x: Self::Vec, v: &[Self::Vec], e: Self::Elem) -> i8;
     /// Whether a line through a feature shared by two elements crosses exactly one of them
-    /// under [`Dim::crossing`]'s tie rule (true for 2D vertices; not for 3D edges, where it
-    /// crosses both or neither).
+    /// under [`Dim::crossing`]'s tie rule (2D vertices: the orientation tie rule; 3D edges:
+    /// the perturbation of `edge_side`), so that `classify` may treat the feature as
+    /// interior.
     const SHARED_FEATURE_SAFE: bool;
     /// Squared distance from `x` to crack element `e` (m^2).
     fn elem_distance_sq(x: Self::Vec, v: &[Self::Vec], e: Self::Elem) -> f64;
@@ -256,7 +257,7 @@ impl Dim for D2 {
 impl Dim for D3 {
     const D: usize = 3;
     const COLOURS: usize = 8;
-    const SHARED_FEATURE_SAFE: bool = false;
+    const SHARED_FEATURE_SAFE: bool = true;
     type Vec = DVec3;
     type Mat = DMat3;
     type Sym = Sym3;
@@ -371,18 +372,44 @@ impl Dim for D3 {
         segment_segment(p, q, a, b)
     }
     fn crossing_from(p: DVec3, sp: i8, q: DVec3, v: &[DVec3], e: Triangle) -> i8 {
-        let c = |u: DVec3| robust::Coord3D {
-            x: u.x,
-            y: u.y,
-            z: u.z,
-        };
-        let [a, b, t] = e.map(|k| c(v[k as usize]));
         if sp == Self::elem_side(q, v, e) {
             return 0;
         }
-        let s1 = side(robust::orient3d(c(p), c(q), a, b));
-        let s2 = side(robust::orient3d(c(p), c(q), b, t));
-        let s3 = side(robust::orient3d(c(p), c(q), t, a));
+        let [va, vb, vt] = e.map(|k| v[k as usize]);
+        let s1 = edge_side(p, q, va, vb);
+        let s2 = edge_side(p, q, vb, vt);
+        let s3 = edge_side(p, q, vt, va);
         if s1 == s2 && s2 == s3 { sp } else { 0 }
     }
+}
+
+/// Directions along which [`edge_side`] moves a line that meets an edge exactly.
+pub const NUDGE: [DVec3; 2] = [
+    DVec3::new(0.571_428_57, 0.301_953_12, 0.763_143_73),
+    DVec3::new(-0.212_121_21, 0.927_835_05, 0.306_651_63),
+];
+
+/// Which side of the line from `p` to `q` the directed edge `a` -> `b` passes (the sign of
+/// robust::orient3d(p, q, a, b), as +1 or -1). Where the line meets the edge exactly the
+/// line is taken as moved a vanishing distance along a fixed direction (simulation of
+/// simplicity): the sign is that of the first-order change, d . ((q - p) x (a - b)), which
+/// flips exactly with the edge's direction. So a line through an edge shared by two
+/// triangles (met in opposite directions) crosses exactly one of them, and a line through
+/// a vertex crosses the one triangle of its fan the moved line passes through.
+fn edge_side(p: DVec3, q: DVec3, a: DVec3, b: DVec3) -> i8 {
+    let c = |u: DVec3| robust::Coord3D {
+        x: u.x,
+        y: u.y,
+        z: u.z,
+    };
+    let o = robust::orient3d(c(p), c(q), c(a), c(b));
+    if o != 0.0 {
+        return side(o);
+    }
+    let axis = (q - p).cross(a - b);
+    NUDGE
+        .iter()
+        .map(|d| d.dot(axis))
+        .find(|&k| k != 0.0)
+        .map_or(1, side)
 }

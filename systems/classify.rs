@@ -16,6 +16,7 @@ use crate::shape::{ShapeKind, Stencil, StencilCache};
 use crate::tiles::Tiles;
 use crate::with_shape;
 use crate::world::World;
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// Axis-aligned box (min, max).
@@ -193,6 +194,14 @@ fn neighbours<D: Dim>(elems: &[D::Elem]) -> Vec<[u32; 3]> {
     neighbour
 }
 
+/// One watched particle's entries in the classification record.
+struct Slot<'a> {
+    first: &'a mut u32,
+    budget: &'a mut f64,
+    crosses: &'a mut bool,
+    masks: &'a mut [u64],
+}
+
 /// Scratch lists reused from particle to particle.
 struct Scratch<D: Dim> {
     close: Vec<u32>,
@@ -341,22 +350,47 @@ impl<D: Dim> Pass<'_, D> {
     /// absorb. A particle whose clearance was zero with the same stencil keeps a zero one
     /// until the next full pass (a node on a crack line, a line through a crack tip): it is
     /// redone every step, and its clearance is not worth measuring each time.
-    fn one(&self, rec: &mut Classified<D>, j: usize, xp: D::Vec, used: f64, s: &mut Scratch<D>) {
-        let per = self.per();
-        let i = rec.watched[j] as usize;
-        let masks = &mut rec.masks[j * per..(j + 1) * per];
-        let clear = rec.budget[j] > f64::NEG_INFINITY || self.stencils.first[i] != rec.first[j];
+    fn one(&self, i: usize, slot: Slot, xp: D::Vec, used: f64, s: &mut Scratch<D>) {
+        let clear = *slot.budget > f64::NEG_INFINITY || self.stencils.first[i] != *slot.first;
         let clearance = with_shape!(self.shape, S, N => {
             let st = Stencil::<N>::cached::<D>(S, self.stencils, i);
-            self.classify_one(xp, &st, clear, s, masks)
+            self.classify_one(xp, &st, clear, s, slot.masks)
         });
-        rec.crosses[j] = masks.iter().any(|&m| m != 0);
-        rec.first[j] = self.stencils.first[i];
-        rec.budget[j] = if clearance > self.slack {
+        *slot.crosses = slot.masks.iter().any(|&m| m != 0);
+        *slot.first = self.stencils.first[i];
+        *slot.budget = if clearance > self.slack {
             clearance - self.slack + used
         } else {
             f64::NEG_INFINITY
         };
+    }
+
+    /// Runs `visit` on every watched particle's record entries in parallel, each with its
+    /// index and a scratch of its thread (every particle's entries are its own, so the
+    /// result does not depend on the thread count).
+    fn each_watched(
+        &self,
+        rec: &mut Classified<D>,
+        visit: impl Fn(usize, Slot, &mut Scratch<D>) + Sync,
+    ) {
+        let per = self.per();
+        (rec.watched.par_iter())
+            .zip(rec.first.par_iter_mut())
+            .zip(rec.budget.par_iter_mut())
+            .zip(rec.crosses.par_iter_mut())
+            .zip(rec.masks.par_chunks_mut(per))
+            .for_each_init(
+                Scratch::new,
+                |s, ((((&i, first), budget), crosses), masks)| {
+                    let slot = Slot {
+                        first,
+                        budget,
+                        crosses,
+                        masks,
+                    };
+                    visit(i as usize, slot, s);
+                },
+            );
     }
 
     /// Finds the particles a crack could reach before the skin is used up (a stencil
@@ -396,28 +430,22 @@ impl<D: Dim> Pass<'_, D> {
         rec.budget.resize(n, f64::INFINITY);
         rec.crosses.resize(n, false);
         rec.masks.resize(n * self.per(), 0);
-        let mut s = Scratch::new();
-        for j in 0..n {
-            let xp = xs[rec.watched[j] as usize];
-            self.one(rec, j, xp, 0.0, &mut s);
-        }
+        self.each_watched(rec, |i, slot, s| self.one(i, slot, xs[i], 0.0, s));
     }
 
     /// Reclassifies the watched particles whose record no longer holds: a new stencil, or
     /// more movement than their clearance allows. `moved` is how far the cracks moved since
     /// the full pass.
     fn refresh(&self, xs: &[D::Vec], moved: f64, rec: &mut Classified<D>) {
-        let mut s = Scratch::new();
-        for j in 0..rec.watched.len() {
-            let i = rec.watched[j] as usize;
-            if self.stencils.first[i] == rec.first[j] && rec.drift + moved < rec.budget[j] {
-                continue;
+        let (drift, first) = (rec.drift, &self.stencils.first);
+        self.each_watched(rec, |i, slot, s| {
+            if first[i] == *slot.first && drift + moved < *slot.budget {
+                return;
             }
             // From now on the particle moves at most the drift still to come, and the cracks
             // at most their movement from the full pass plus `moved` back to it.
-            let used = rec.drift - moved;
-            self.one(rec, j, xs[i], used, &mut s);
-        }
+            self.one(i, slot, xs[i], drift - moved, s);
+        });
     }
 
     /// The grid entries of the particles whose lines cross a crack, with this step's

@@ -73,3 +73,70 @@ fn triangle_crossings_in_3d() {
     let outside = DVec3::new(0.8, 0.8, 0.5);
     assert_eq!(D3::crossing(outside, outside - DVec3::Z, &tri, e), 0);
 }
+
+/// Crossings of the line `p`-`q` with each triangle of `tris`.
+fn tri_crossings(p: DVec3, q: DVec3, v: &[DVec3], tris: &[[u32; 3]]) -> Vec<i8> {
+    tris.iter().map(|&t| D3::crossing(p, q, v, t)).collect()
+}
+
+/// A hexagonal fan of six counterclockwise triangles around the origin in the plane z = 0.
+fn fan() -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let mut v = vec![DVec3::ZERO];
+    v.extend((0..6).map(|k| {
+        let a = k as f64 * std::f64::consts::PI / 3.0;
+        DVec3::new(a.cos(), a.sin(), 0.0)
+    }));
+    let tris = (0..6u32).map(|k| [0, 1 + k, 1 + (k + 1) % 6]).collect();
+    (v, tris)
+}
+
+/// A line through an edge shared by two triangles, or through the vertex of a fan, crosses
+/// exactly one triangle, the one the line moved a little along the tie-break direction
+/// crosses; so does a line ending on an edge (a node on the crack surface).
+#[test]
+fn lines_through_shared_edges_and_vertices_cross_once() {
+    let (v, tris) = fan();
+    let edge_point = v[2] * 0.5; // on the edge from the centre to vertex 2
+    let cases = [
+        (
+            edge_point + DVec3::Z,
+            edge_point - DVec3::Z,
+            "through a shared edge",
+        ),
+        (
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(0.0, 0.0, -1.0),
+            "through the centre vertex",
+        ),
+        (
+            DVec3::new(0.1, -0.3, 1.0),
+            DVec3::new(-0.1, 0.3, -1.0),
+            "slanted, through the centre",
+        ),
+        (
+            edge_point - DVec3::new(0.05, 0.02, 1.0),
+            edge_point,
+            "ending on a shared edge",
+        ),
+    ];
+    for (p, q, what) in cases {
+        let c = tri_crossings(p, q, &v, &tris);
+        assert_eq!(c.iter().filter(|&&s| s != 0).count(), 1, "{what}: {c:?}");
+        // The same as the line moved a small distance along the tie-break direction.
+        let d = fissure::dim::NUDGE[0] * 1e-9;
+        let moved = tri_crossings(p + d, q + d, &v, &tris);
+        if q.z != 0.0 {
+            assert_eq!(c, moved, "{what}");
+        }
+        // Run backwards, the line crosses the same triangle from the other side.
+        if q.z != 0.0 {
+            let back = tri_crossings(q, p, &v, &tris);
+            let flipped: Vec<i8> = c.iter().map(|s| -s).collect();
+            assert_eq!(back, flipped, "{what}");
+        }
+    }
+    // A line through a vertex on the fan's rim, shared by two triangles only.
+    let rim = v[3];
+    let c = tri_crossings(rim + DVec3::Z, rim - DVec3::Z, &v, &tris);
+    assert!(c.iter().filter(|&&s| s != 0).count() <= 1, "{c:?}");
+}

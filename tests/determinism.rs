@@ -42,3 +42,13 @@ fn bitwise_identical_across_thread_counts_2d() {
 fn bitwise_identical_across_thread_counts_3d() {
     same_bits_for_thread_counts::<D3>(&mixed_scene(3, "bspline", "usf"));
 }
+
+/// A 3D scene with an inclined penny crack with frictionless contact: classification,
+/// crack fields, contact and crack advection are as deterministic as the rest.
+#[test]
+fn bitwise_identical_across_thread_counts_3d_with_a_crack() {
+    let crack = "[[crack]]\npenny = { center = [0.02, 0.007, 0.007], normal = [1.0, 0.3, 0.2], \
+                 radius = 0.003 }\ncontact = { law = \"frictionless\" }\n";
+    let text = mixed_scene(3, "ugimp", "usavg").replace("duration = 1e-5", "duration = 2e-6");
+    same_bits_for_thread_counts::<D3>(&(text + crack));
+}

@@ -323,3 +323,71 @@ fn bad_regions_name_the_key() {
     let e = load("{ center = [0.03, 0.03], half = [0.001, 0.001], angle = 45.0 }");
     assert_error(&e, "load[0].region", None, "no particle");
 }
+
+/// `GOOD` in 3D (a 12 mm cube in a 20 mm grid) with `extra` appended, and its error.
+fn error_3d(extra: &str) -> ScenarioError {
+    let text = GOOD
+        .replace("dimension = 2", "dimension = 3")
+        .replace("[0.0, 0.0]", "[0.0, 0.0, 0.0]")
+        .replace("[0.02, 0.02]", "[0.02, 0.02, 0.02]")
+        .replace("[0.002, 0.002]", "[0.002, 0.002, 0.002]")
+        .replace("[0.004, 0.004]", "[0.004, 0.004, 0.004]")
+        .replace("[0.016, 0.016]", "[0.016, 0.016, 0.016]")
+        + extra;
+    match Source::parse("bad.toml", &text, &[]) {
+        Err(e) => e,
+        Ok(src) => match fissure::scenario::build::<fissure::dim::D3>(&src) {
+            Ok(_) => panic!("scenario must be refused"),
+            Err(e) => e,
+        },
+    }
+}
+
+#[test]
+fn bad_crack_surfaces_name_the_problem() {
+    let mesh = |v: &str, t: &str| {
+        error_3d(&format!(
+            "[[crack]]\nmesh = {{ vertices = [{v}], triangles = [{t}] }}\n"
+        ))
+    };
+    let square = "[0.006, 0.006, 0.01], [0.014, 0.006, 0.01], [0.014, 0.014, 0.01], \
+                  [0.006, 0.014, 0.01], [0.01, 0.01, 0.014]";
+    let e = mesh(square, "[0, 1, 2], [0, 2, 3], [0, 2, 4]");
+    assert_error(&e, "crack[0].mesh", Some(19), "not a manifold");
+    let e = mesh(square, "[0, 1, 2], [0, 3, 2]");
+    assert_error(&e, "crack[0].mesh", Some(19), "oriented oppositely");
+    let e = mesh(square, "[0, 1, 1]");
+    assert_error(&e, "crack[0].mesh", Some(19), "degenerate");
+    let e = mesh(
+        "[0.006, 0.006, 0.01], [0.01, 0.006, 0.01], [0.014, 0.006, 0.01]",
+        "[0, 1, 2]",
+    );
+    assert_error(&e, "crack[0].mesh", Some(19), "no area");
+    let e = mesh(square, "[0, 1, 7]");
+    assert_error(
+        &e,
+        "crack[0].mesh.triangles",
+        Some(19),
+        "vertex 7 does not exist",
+    );
+    let e = error_3d(
+        "[[crack]]\npenny = { center = [0.01, 0.01, 0.01], normal = [0.0, 0.0, 0.0], radius = 0.003 }\n",
+    );
+    assert_error(&e, "crack[0].penny.normal", Some(19), "must not be zero");
+    let e = error_3d(
+        "[[crack]]\nrectangle = { center = [0.01, 0.01, 0.01], axes = [[0.003, 0.0, 0.0], [0.006, 0.0, 0.0]] }\n",
+    );
+    assert_error(&e, "crack[0].rectangle.axes", Some(19), "not parallel");
+    let e =
+        error_3d("[[crack]]\nline = { start = [0.006, 0.01, 0.01], end = [0.014, 0.01, 0.01] }\n");
+    assert_error(&e, "crack[0].line", Some(19), "a 3D crack is a surface");
+    let e = error_with_text(
+        "[[crack]]\npenny = { center = [0.01, 0.01], normal = [0.0, 1.0], radius = 0.003 }\n",
+    );
+    assert_error(&e, "crack[0].penny", Some(19), "a 2D crack is a polyline");
+    let e = error_3d(
+        "[[crack]]\npenny = { center = [0.01, 0.01, 0.01], normal = [0.0, 0.0, 1.0], radius = 0.003 }\n\
+         [fracture]\ncontour = 2\n",
+    );
+    assert_error(&e, "fracture", Some(20), "not implemented yet");
+}

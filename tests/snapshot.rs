@@ -155,6 +155,16 @@ fn restart_is_bit_exact_3d_one_and_two_threads() {
     restart_is_bit_exact(&text, 19, 2, "3d-2");
 }
 
+#[test]
+fn restart_is_bit_exact_with_a_3d_crack() {
+    let crack = "[[crack]]\npenny = { center = [0.02, 0.007, 0.007], normal = [1.0, 0.3, 0.2], \
+                 radius = 0.003 }\ncontact = { law = \"stick\" }\n";
+    let text = scene(3, "ugimp", "usavg")
+        .replace("duration = 1e-5", "duration = 4e-6")
+        .replace("[[probe]]", &format!("{crack}[[probe]]"));
+    restart_is_bit_exact(&text, 17, 2, "3d-crack");
+}
+
 /// Periodic snapshots land on multiples of `every_steps`, the last step gets one, and only
 /// the newest `keep` remain.
 #[test]

@@ -3,6 +3,7 @@
 use super::build::{positive, to_vec, vec3};
 use super::schema::{CrackSpec, ExpectSpec};
 use super::source::Source;
+use super::surface;
 use crate::crack::{Contact, Cracks, Element, Law, MAX_CRACKS};
 use crate::dim::Dim;
 use crate::error::ScenarioError;
@@ -10,6 +11,7 @@ use crate::fracture::{FracturePlan, KMethod};
 use crate::grid::GridGeom;
 use crate::measure::Measure;
 use crate::particles::Particles;
+use std::collections::HashMap;
 
 type R<T> = Result<T, ScenarioError>;
 
@@ -27,90 +29,144 @@ pub(super) fn build<D: Dim>(
     if specs.is_empty() {
         return Ok(None);
     }
-    if D::D != 2 {
-        return Err(src.error(
-            "crack[0]",
-            "cracks are 2D polylines for now; 3D crack surfaces are not implemented yet",
-        ));
-    }
     if specs.len() > MAX_CRACKS {
         return Err(src.error(
             &format!("crack[{MAX_CRACKS}]"),
             format!("at most {MAX_CRACKS} cracks per scene"),
         ));
     }
+    let occupied = Occupied::new(particles, geom);
     let mut store = Cracks::<D>::default();
     for (c, spec) in specs.iter().enumerate() {
-        let key = |k: &str| format!("crack[{c}].{k}");
-        let points = vertices::<D>(src, c, spec, geom)?;
-        for (j, x) in points.iter().enumerate() {
-            if !near_particle::<D>(*x, particles, geom) {
-                let at = D::to_xyz(*x);
+        let piece = if D::D == 2 {
+            polyline::<D>(src, c, spec, geom)?
+        } else {
+            let s = surface::surface(src, c, spec, geom.min_cell())?;
+            Piece {
+                key: format!("crack[{c}]"),
+                points: s
+                    .vertices
+                    .iter()
+                    .map(|v| D::from_slice(&v.to_array()))
+                    .collect(),
+                elems: s
+                    .triangles
+                    .iter()
+                    .map(|t| D::Elem::from_vertices(t))
+                    .collect(),
+                fronts: if s.front.is_empty() {
+                    Vec::new()
+                } else {
+                    vec![(0, s.front)]
+                },
+            }
+        };
+        for (j, x) in piece.points.iter().enumerate() {
+            let at = D::to_xyz(*x);
+            let at = at[..D::D]
+                .iter()
+                .map(|c| format!("{c:e}"))
+                .collect::<Vec<_>>();
+            if !geom.fits(crate::shape::ShapeKind::Linear, *x, D::zero()) {
                 return Err(src.error(
-                    &key(if spec.points.is_some() {
-                        "points"
-                    } else {
-                        "line"
-                    }),
+                    &piece.key,
+                    format!("vertex {j} at ({}) m lies outside the grid", at.join(", ")),
+                ));
+            }
+            if !occupied.near(*x) {
+                return Err(src.error(
+                    &piece.key,
                     format!(
-                        "vertex {j} at ({:e}, {:e}) m is outside every body (more than \
-                         {REACH_CELLS} cells from any particle)",
-                        at[0], at[1]
+                        "vertex {j} at ({}) m is outside every body (more than {REACH_CELLS} \
+                         cells from any particle)",
+                        at.join(", ")
                     ),
                 ));
             }
         }
-        if let Some((a, b)) = self_crossing::<D>(&points) {
-            return Err(src.error(
-                &key(if spec.points.is_some() {
-                    "points"
-                } else {
-                    "line"
-                }),
-                format!("the crack crosses itself (segments {a} and {b})"),
-            ));
-        }
-        let mut ends = vec![1u32];
-        if let Some(t) = &spec.tips {
-            ends.clear();
-            for name in t {
-                let end = match name.as_str() {
-                    "start" => 0,
-                    "end" => 1,
-                    other => {
-                        return Err(
-                            src.error(&key("tips"), format!("unknown tip `{other}` (start, end)"))
-                        );
-                    }
-                };
-                if !ends.contains(&end) {
-                    ends.push(end);
-                }
-            }
-            ends.sort_unstable();
-        }
         let contact = contact(src, c, spec)?;
-        let n = points.len();
-        let elems: Vec<D::Elem> = (0..n as u32 - 1)
-            .map(|k| D::Elem::from_vertices(&[k, k + 1]))
-            .collect();
-        let fronts: Vec<(u32, Vec<u32>)> = ends
-            .iter()
-            .map(|&end| (end, vec![if end == 0 { 0 } else { n as u32 - 1 }]))
-            .collect();
         store.topology.add_crack(
             spec.name.clone().unwrap_or_else(|| format!("crack{c}")),
             contact,
-            n,
-            &elems,
-            &fronts,
+            piece.points.len(),
+            &piece.elems,
+            &piece.fronts,
         );
-        store.geometry.x.extend(&points);
+        store.geometry.x.extend(&piece.points);
     }
     let g = &mut store.geometry;
     g.top = g.x.clone();
     g.bottom = g.x.clone();
     Ok(Some(store))
+}
+
+/// One crack before it joins the store: the key errors about its vertices name, its
+/// vertices, its elements and its fronts (end or index, vertices), in its own numbering.
+struct Piece<D: Dim> {
+    key: String,
+    points: Vec<D::Vec>,
+    elems: Vec<D::Elem>,
+    fronts: Vec<(u32, Vec<u32>)>,
+}
+
+/// A 2D crack: the polyline of `points` or `line`, its tips at the ends named in `tips`.
+fn polyline<D: Dim>(src: &Source, c: usize, spec: &CrackSpec, geom: &GridGeom<D>) -> R<Piece<D>> {
+    let key = |k: &str| format!("crack[{c}].{k}");
+    let surface_key = [
+        ("mesh", spec.mesh.is_some()),
+        ("rectangle", spec.rectangle.is_some()),
+        ("ellipse", spec.ellipse.is_some()),
+        ("penny", spec.penny.is_some()),
+    ];
+    if let Some((k, _)) = surface_key.iter().find(|k| k.1) {
+        return Err(src.error(
+            &key(k),
+            "a 2D crack is a polyline: give `points` or `line` (surfaces are 3D)",
+        ));
+    }
+    let points = vertices::<D>(src, c, spec, geom)?;
+    let what = key(if spec.points.is_some() {
+        "points"
+    } else {
+        "line"
+    });
+    if let Some((a, b)) = self_crossing::<D>(&points) {
+        return Err(src.error(
+            &what,
+            format!("the crack crosses itself (segments {a} and {b})"),
+        ));
+    }
+    let mut ends = vec![1u32];
+    if let Some(t) = &spec.tips {
+        ends.clear();
+        for name in t {
+            let end = match name.as_str() {
+                "start" => 0,
+                "end" => 1,
+                other => {
+                    return Err(
+                        src.error(&key("tips"), format!("unknown tip `{other}` (start, end)"))
+                    );
+                }
+            };
+            if !ends.contains(&end) {
+                ends.push(end);
+            }
+        }
+        ends.sort_unstable();
+    }
+    let n = points.len() as u32;
+    Ok(Piece {
+        key: what,
+        elems: (0..n - 1)
+            .map(|k| D::Elem::from_vertices(&[k, k + 1]))
+            .collect(),
+        fronts: ends
+            .iter()
+            .map(|&end| (end, vec![if end == 0 { 0 } else { n - 1 }]))
+            .collect(),
+        points,
+    })
 }
 
 /// The contact settings of crack `c`.
@@ -203,25 +259,56 @@ fn vertices<D: Dim>(
             return Err(src.error(&key("points"), format!("points {j} and {} coincide", j + 1)));
         }
     }
-    for (j, x) in points.iter().enumerate() {
-        if !geom.fits(crate::shape::ShapeKind::Linear, *x, D::zero()) {
-            return Err(src.error(
-                &key(if spec.points.is_some() {
-                    "points"
-                } else {
-                    "line"
-                }),
-                format!("vertex {j} lies outside the grid"),
-            ));
-        }
-    }
     Ok(points)
 }
 
-/// Whether some particle lies within `REACH_CELLS` cells of `x` on every axis.
-fn near_particle<D: Dim>(x: D::Vec, p: &Particles<D>, geom: &GridGeom<D>) -> bool {
-    p.x.iter()
-        .any(|y| (0..D::D).all(|a| ((y[a] - x[a]) * geom.inv_h[a]).abs() <= REACH_CELLS))
+/// The particles of each grid cell that holds some, to tell quickly whether a crack vertex
+/// is near the body.
+struct Occupied<'a, D: Dim> {
+    cells: HashMap<[i64; 3], Vec<u32>>,
+    x: &'a [D::Vec],
+    geom: &'a GridGeom<D>,
+}
+
+impl<'a, D: Dim> Occupied<'a, D> {
+    fn new(p: &'a Particles<D>, geom: &'a GridGeom<D>) -> Self {
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for (i, &x) in p.x.iter().enumerate() {
+            cells.entry(Self::cell(geom, x)).or_default().push(i as u32);
+        }
+        Occupied {
+            cells,
+            x: &p.x,
+            geom,
+        }
+    }
+
+    fn cell(geom: &GridGeom<D>, x: D::Vec) -> [i64; 3] {
+        let mut c = [0i64; 3];
+        for (a, ca) in c.iter_mut().enumerate().take(D::D) {
+            *ca = ((x[a] - geom.origin[a]) * geom.inv_h[a]).floor() as i64;
+        }
+        c
+    }
+
+    /// Whether some particle lies within `REACH_CELLS` cells of `x` on every axis.
+    fn near(&self, x: D::Vec) -> bool {
+        let r = REACH_CELLS.ceil() as i64;
+        let c = Self::cell(self.geom, x);
+        let span = |a: usize| if a < D::D { -r..=r } else { 0..=0 };
+        let close = |&i: &u32| {
+            let y = self.x[i as usize];
+            (0..D::D).all(|a| ((y[a] - x[a]) * self.geom.inv_h[a]).abs() <= REACH_CELLS)
+        };
+        span(2).any(|k| {
+            span(1).any(|j| {
+                span(0).any(|i| {
+                    (self.cells.get(&[c[0] + i, c[1] + j, c[2] + k]))
+                        .is_some_and(|ys| ys.iter().any(close))
+                })
+            })
+        })
+    }
 }
 
 /// The first pair of non-adjacent segments of a polyline that intersect, if any.
@@ -253,6 +340,13 @@ pub(super) fn fracture_plan<D: Dim>(
     let Some(cracks) = cracks else {
         return Err(src.error("fracture", "J and K need at least one [[crack]]"));
     };
+    if D::FRACTURE.is_none() {
+        return Err(src.error(
+            "fracture",
+            "J and K along 3D crack fronts are not implemented yet: remove [fracture] (the \
+             cracks themselves, contact and the crack opening work in 3D)",
+        ));
+    }
     if cracks.topology.fronts().is_empty() {
         return Err(src.error(
             "fracture",

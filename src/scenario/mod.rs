@@ -6,6 +6,7 @@ mod cracks;
 mod region;
 pub mod schema;
 pub mod source;
+mod surface;
 mod traction;
 
 pub use build::{CheckpointPlan, OutputPlan, Scene, build};

@@ -227,10 +227,76 @@ pub struct CrackSpec {
     pub points: Option<Vec<Vec<f64>>>,
     /// A straight crack with evenly spaced vertices.
     pub line: Option<LineSpec>,
+    /// 3D: a triangle mesh given as vertex and triangle lists.
+    pub mesh: Option<MeshSpec>,
+    /// 3D: a planar rectangle (no front: a crack cutting through a body).
+    pub rectangle: Option<PlanarSpec>,
+    /// 3D: a planar ellipse, whole (an embedded crack) or half (a surface crack).
+    pub ellipse: Option<EllipseSpec>,
+    /// 3D: a circular (penny-shaped) crack.
+    pub penny: Option<PennySpec>,
     /// Which ends are crack tips: "start" and/or "end" (default `["end"]`).
     pub tips: Option<Vec<String>>,
     /// Contact between the crack faces (default: none, an open crack).
     pub contact: Option<ContactSpec>,
+}
+
+/// A 3D crack surface as lists: `vertices = [[x, y, z], ...]` (m), `triangles = [[i, j,
+/// k], ...]` (counterclockwise seen from the side called above), and optionally the front
+/// as an ordered list of vertex indices.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// Vertex positions (m).
+    pub vertices: Vec<Vec<f64>>,
+    /// Vertex indices of each triangle.
+    pub triangles: Vec<Vec<i64>>,
+    /// Front vertices in order along the front (default: no front).
+    pub front: Option<Vec<i64>>,
+}
+
+/// A planar rectangle: centre and the two half-side vectors (m); above is the side of
+/// their cross product.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanarSpec {
+    /// Centre (m).
+    pub center: Vec<f64>,
+    /// Half-side vectors `[[ux, uy, uz], [vx, vy, vz]]` (m), not parallel.
+    pub axes: Vec<Vec<f64>>,
+    /// Target triangle edge length (m; default half the smallest cell).
+    pub spacing: Option<f64>,
+}
+
+/// A planar ellipse: centre and semi-axis vectors (m). `half = true` keeps the half on the
+/// side of the second axis, a surface crack whose straight edge (through the centre, along
+/// the first axis) is carried 1.5 cells outwards so that it reaches past the surface.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EllipseSpec {
+    /// Centre (m).
+    pub center: Vec<f64>,
+    /// Semi-axis vectors `[[ax, ay, az], [bx, by, bz]]` (m), not parallel.
+    pub axes: Vec<Vec<f64>>,
+    /// Only the half on the second axis's side (default false).
+    #[serde(default)]
+    pub half: bool,
+    /// Target triangle edge length (m; default half the smallest cell).
+    pub spacing: Option<f64>,
+}
+
+/// A circular crack: centre, normal (towards the side called above) and radius (m).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PennySpec {
+    /// Centre (m).
+    pub center: Vec<f64>,
+    /// Normal, any length.
+    pub normal: Vec<f64>,
+    /// Radius (m).
+    pub radius: f64,
+    /// Target triangle edge length (m; default half the smallest cell).
+    pub spacing: Option<f64>,
 }
 
 /// `contact = { law = "frictionless" }` on a crack.
