@@ -1,4 +1,5 @@
-//! Error types: scenario problems located by file, line and key; run instabilities.
+//! Error types: scenario problems located by file, line and key; unusable command-line
+//! values; run instabilities.
 
 use thiserror::Error;
 
@@ -15,6 +16,12 @@ pub struct Unstable {
     /// What happened.
     pub what: String,
 }
+
+/// A command-line value that cannot be used (an end time, a folder without snapshots):
+/// bad input like a scenario error, so the launcher exits with code 2.
+#[derive(Debug, Error, Clone)]
+#[error("{0}")]
+pub struct UsageError(pub String);
 
 /// A problem with a scenario file, located as precisely as possible.
 #[derive(Debug, Error, Clone)]

@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use fissure::dim::{D2, D3};
-use fissure::error::ScenarioError;
+use fissure::error::{ScenarioError, UsageError};
 use fissure::run::checkpoint::resolve;
 use fissure::run::{Outcome, RunOptions, resume, run};
 use fissure::scenario::{Source, build};
@@ -132,7 +132,7 @@ fn report(e: anyhow::Error) -> ExitCode {
         return bad_input(s);
     }
     eprintln!("error: {e:#}");
-    if e.downcast_ref::<SnapshotError>().is_some() {
+    if e.downcast_ref::<SnapshotError>().is_some() || e.downcast_ref::<UsageError>().is_some() {
         ExitCode::from(BAD_INPUT)
     } else {
         ExitCode::FAILURE
@@ -377,6 +377,11 @@ fn cmd_validate(
     overrides: &[String],
 ) -> ExitCode {
     let files = collect(paths);
+    if files.is_empty() {
+        let list: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+        eprintln!("error: no scenario (*.toml) in {}", list.join(", "));
+        return ExitCode::from(BAD_INPUT);
+    }
     let mut failed = 0usize;
     let mut passed = 0usize;
     println!(

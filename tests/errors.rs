@@ -24,6 +24,14 @@ material = "steel"
 box = { min = [0.004, 0.004], max = [0.016, 0.016] }
 "#;
 
+/// The build error of a scenario text that parses.
+fn refused(text: &str) -> ScenarioError {
+    match build::<D2>(&Source::parse("bad.toml", text, &[]).unwrap()) {
+        Ok(_) => panic!("scenario must be refused"),
+        Err(e) => e,
+    }
+}
+
 /// Loads `GOOD` with `overrides` and returns the error it must produce.
 fn error_with(overrides: &[&str]) -> ScenarioError {
     let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
@@ -114,8 +122,9 @@ fn cfl_at_or_above_one() {
 #[test]
 fn time_step_above_the_stability_limit() {
     // limit = 2 mm / c_d, c_d = sqrt((lambda + 2 mu)/rho) = 5875 m/s: 3.4e-7 s.
-    let e = error_with(&["simulation.dt=1e-6"]);
-    assert_error(&e, "simulation.dt", None, "above the stability limit");
+    let text = GOOD.replace("cfl = 0.5", "dt = 1e-6");
+    let e = refused(&text);
+    assert_error(&e, "simulation.dt", Some(5), "above the stability limit");
 }
 
 #[test]
@@ -390,4 +399,76 @@ fn bad_crack_surfaces_name_the_problem() {
          [fracture]\ncontour = 2\n",
     );
     assert_error(&e, "fracture", Some(20), "not implemented yet");
+}
+
+/// Inputs that used to be accepted although wrong: a name that is not one folder name, two
+/// time-step settings, a modulus whose derived quantities overflow, two cracks of one
+/// name, a crack that folds back on itself.
+#[test]
+fn accepted_but_wrong_inputs_are_refused() {
+    for (name, words) in [
+        ("../../X", "path separator"),
+        ("/tmp/X", "path separator"),
+        ("", "must not be empty"),
+        ("..", "`..`"),
+        ("a\\u0007b", "control characters"),
+    ] {
+        let text = GOOD.replace("name = \"good\"", &format!("name = \"{name}\""));
+        let e = match Source::parse("bad.toml", &text, &[]) {
+            Err(e) => e,
+            Ok(_) => refused(&text),
+        };
+        assert_error(&e, "name", Some(1), words);
+    }
+    let e = error_with(&["simulation.dt=1e-9"]);
+    assert_error(&e, "simulation.dt", None, "not both");
+    let text = GOOD
+        .replace("E = 200e9", "E = 1.7e308")
+        .replace("rho = 7800.0", "rho = 1e300");
+    let e = refused(&text);
+    assert_error(&e, "material[0].E", Some(12), "overflow");
+    let e = error_with_text(
+        "[[crack]]\nname = \"c\"\npoints = [[0.006, 0.01], [0.012, 0.01]]\n\
+         [[crack]]\nname = \"c\"\npoints = [[0.006, 0.012], [0.012, 0.012]]\n",
+    );
+    assert_error(&e, "crack[1].name", Some(22), "two cracks are named `c`");
+    let e = error_with_text("[[crack]]\npoints = [[0.006, 0.01], [0.012, 0.01], [0.009, 0.01]]\n");
+    assert_error(&e, "crack[0].points", Some(19), "folds back");
+}
+
+/// Command-line values that cannot be used exit with code 2: an end time that is not after
+/// the start (0, NaN, infinite) or needs too many steps; a resume from a folder without
+/// snapshots; a validate over a folder without scenarios.
+#[test]
+fn unusable_command_line_values_exit_with_code_2() {
+    let dir = std::env::temp_dir().join(format!("fissure-usage-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("good.toml");
+    std::fs::write(&file, GOOD).unwrap();
+    let fissure = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let out = dir.join("out");
+    let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
+    for until in ["0", "NaN", "inf", "1e30"] {
+        let (code, err) = fissure(&["run", f, "--out", o, "--until", until]);
+        assert_eq!(code, Some(2), "--until {until}: {err}");
+        assert!(err.contains("end time"), "{err}");
+    }
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let (code, err) = fissure(&["resume", empty.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("no snapshot"), "{err}");
+    let (code, err) = fissure(&["validate", empty.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("no scenario"), "{err}");
+    std::fs::remove_dir_all(dir).ok();
 }

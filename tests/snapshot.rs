@@ -415,8 +415,12 @@ fn resume_until_extends_a_finished_run() {
         until: Some(1e-6),
         ..opts(&dir, 1)
     };
-    let err = resume(&snap, &early).err().unwrap().to_string();
-    assert!(err.contains("must be after the current time"), "{err}");
+    let err = resume(&snap, &early).err().unwrap();
+    assert!(
+        err.downcast_ref::<fissure::error::UsageError>().is_some(),
+        "bad input (exit code 2): {err}"
+    );
+    assert!(err.to_string().contains("after the current time"), "{err}");
     let later = RunOptions {
         until: Some(3e-6),
         ..opts(&dir, 1)

@@ -2,6 +2,7 @@
 
 use super::state::RunState;
 use crate::dim::Dim;
+use crate::error::UsageError;
 use crate::scenario::{CheckpointPlan, Source};
 use crate::snapshot::state::write;
 use crate::world::World;
@@ -155,7 +156,7 @@ pub fn resolve(path: &Path) -> anyhow::Result<PathBuf> {
             Some((step_of(e.file_name().to_str()?)?, e.path()))
         })
         .max();
-    newest
-        .map(|(_, p)| p)
-        .with_context(|| format!("no snapshot (step_*.fsnap) in {}", dir.display()))
+    newest.map(|(_, p)| p).ok_or_else(|| {
+        UsageError(format!("no snapshot (step_*.fsnap) in {}", dir.display())).into()
+    })
 }

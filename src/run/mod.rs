@@ -6,11 +6,12 @@ pub mod state;
 pub mod writers;
 
 use crate::dim::{D2, D3, Dim};
-use crate::error::Unstable;
+use crate::error::{Unstable, UsageError};
 use crate::fracture::FracturePlan;
 use crate::measure::{Expect, History, Measure, Row, path_difference};
 use crate::output::plot::{self, Series};
 use crate::output::summary::{PathReport, Summary};
+use crate::scenario::build::MAX_STEPS;
 use crate::scenario::{Scene, Source, build};
 use crate::schedule::Schedule;
 use crate::snapshot::Reader;
@@ -153,10 +154,17 @@ fn drive<D: Dim>(
     let dt = world.settings.dt;
     let end = opts.until.unwrap_or(duration);
     if !(end.is_finite() && end > world.time) {
-        anyhow::bail!(
-            "the end time {end:e} s must be after the current time {:e} s",
+        return Err(UsageError(format!(
+            "the end time {end:e} s must be a number after the current time {:e} s",
             world.time
-        );
+        ))
+        .into());
+    }
+    if end / dt > MAX_STEPS {
+        return Err(UsageError(format!(
+            "the end time {end:e} s is more than {MAX_STEPS:e} steps of {dt:e} s"
+        ))
+        .into());
     }
     let steps = (end / dt).ceil() as u64;
     let names: Vec<String> = probes.iter().map(|p| p.name.clone()).collect();

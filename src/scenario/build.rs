@@ -110,6 +110,34 @@ fn axis_index<D: Dim>(src: &Source, key: &str, name: &str) -> R<usize> {
     Ok(a)
 }
 
+/// Most time steps a run may take (a duration or `--until` needing more is refused).
+pub const MAX_STEPS: f64 = 1e10;
+
+/// The CFL factor when neither `cfl` nor `dt` is given.
+const DEFAULT_CFL: f64 = 0.5;
+
+/// A scenario name becomes the output folder's name: it must be one plain path component.
+fn check_name(src: &Source, name: &str) -> R<()> {
+    let bad = if name.is_empty() {
+        Some("must not be empty")
+    } else if name.contains(['/', '\\']) {
+        Some("must not contain a path separator")
+    } else if name == "." || name == ".." {
+        Some("must not be `.` or `..`")
+    } else if name.chars().any(char::is_control) {
+        Some("must not contain control characters")
+    } else {
+        None
+    };
+    match bad {
+        Some(why) => Err(src.error(
+            "name",
+            format!("the name names the output folder under the output directory: it {why}"),
+        )),
+        None => Ok(()),
+    }
+}
+
 pub(super) fn positive(src: &Source, key: &str, v: f64, unit: &str) -> R<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
@@ -131,6 +159,9 @@ fn bounds<D: Dim>(src: &Source, key: &str, b: &BoxSpec) -> R<([f64; 3], [f64; 3]
 pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     let sc = &src.scenario;
     let sim = &sc.simulation;
+    if let Some(name) = &sc.name {
+        check_name(src, name)?;
+    }
     if sim.dimension as usize != D::D {
         return Err(src.error("simulation.dimension", "must be 2 or 3"));
     }
@@ -155,10 +186,18 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         _ => 1.0,
     };
     let duration = positive(src, "simulation.duration", sim.duration, "s")?;
-    if !(sim.cfl > 0.0 && sim.cfl < 1.0) {
+    let cfl = sim.cfl.unwrap_or(DEFAULT_CFL);
+    if !(cfl > 0.0 && cfl < 1.0) {
         return Err(src.error(
             "simulation.cfl",
-            format!("CFL factor must satisfy 0 < cfl < 1, got {}", sim.cfl),
+            format!("CFL factor must satisfy 0 < cfl < 1, got {cfl}"),
+        ));
+    }
+    if sim.cfl.is_some() && sim.dt.is_some() {
+        return Err(src.error(
+            "simulation.dt",
+            "give the time step either as `dt` or as a fraction `cfl` of the stability limit, \
+             not both",
         ));
     }
     if !(sim.damping >= 0.0 && sim.damping.is_finite()) {
@@ -221,7 +260,19 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 format!("Poisson's ratio must satisfy -1 < nu < 0.5, got {}", m.nu),
             ));
         }
-        materials.push(Elastic::new(&m.name, m.youngs, m.nu, m.rho));
+        let e = Elastic::new(&m.name, m.youngs, m.nu, m.rho);
+        let c = e.wave_speed(Plane::Strain).max(e.wave_speed(Plane::Stress));
+        if !(c.is_finite() && c > 0.0 && e.lambda.is_finite() && e.mu.is_finite()) {
+            return Err(src.error(
+                &key("E"),
+                format!(
+                    "E = {:e} Pa with rho = {:e} kg/m^3 and nu = {} overflow the derived \
+                     moduli or wave speed",
+                    m.youngs, m.rho, m.nu
+                ),
+            ));
+        }
+        materials.push(e);
     }
     if materials.len() > u16::MAX as usize {
         return Err(src.error("material", "too many materials"));
@@ -289,10 +340,13 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             }
             dt
         }
-        None => sim.cfl * dt_limit,
+        None => cfl * dt_limit,
     };
-    if duration / dt > 1e10 {
-        return Err(src.error("simulation.duration", "more than 1e10 time steps"));
+    if duration / dt > MAX_STEPS {
+        return Err(src.error(
+            "simulation.duration",
+            format!("more than {MAX_STEPS:e} time steps"),
+        ));
     }
 
     // Boundary conditions.

@@ -85,8 +85,15 @@ pub(super) fn build<D: Dim>(
             }
         }
         let contact = contact(src, c, spec)?;
+        let name = spec.name.clone().unwrap_or_else(|| format!("crack{c}"));
+        if store.topology.cracks().iter().any(|k| k.name == name) {
+            return Err(src.error(
+                &format!("crack[{c}].name"),
+                format!("two cracks are named `{name}`: expects and outputs name cracks"),
+            ));
+        }
         store.topology.add_crack(
-            spec.name.clone().unwrap_or_else(|| format!("crack{c}")),
+            name,
             contact,
             piece.points.len(),
             &piece.elems,
@@ -130,6 +137,12 @@ fn polyline<D: Dim>(src: &Source, c: usize, spec: &CrackSpec, geom: &GridGeom<D>
     } else {
         "line"
     });
+    if let Some(j) = fold_back::<D>(&points) {
+        return Err(src.error(
+            &what,
+            format!("the crack folds back onto itself at vertex {j}"),
+        ));
+    }
     if let Some((a, b)) = self_crossing::<D>(&points) {
         return Err(src.error(
             &what,
@@ -309,6 +322,16 @@ impl<'a, D: Dim> Occupied<'a, D> {
             })
         })
     }
+}
+
+/// The first vertex at which a polyline turns straight back along its previous segment
+/// (the two segments overlap, which the test for non-adjacent crossings cannot see).
+fn fold_back<D: Dim>(pts: &[D::Vec]) -> Option<usize> {
+    let c = |u: D::Vec| robust::Coord { x: u[0], y: u[1] };
+    (1..pts.len() - 1).find(|&j| {
+        let (a, b, d) = (pts[j - 1], pts[j], pts[j + 1]);
+        robust::orient2d(c(a), c(b), c(d)) == 0.0 && D::dot(b - a, d - b) < 0.0
+    })
 }
 
 /// The first pair of non-adjacent segments of a polyline that intersect, if any.

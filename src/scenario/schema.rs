@@ -66,10 +66,9 @@ pub struct Simulation {
     pub update: Update,
     /// Simulated duration (s).
     pub duration: f64,
-    /// Time step as a fraction of the stability limit (0 < cfl < 1).
-    #[serde(default = "default_cfl")]
-    pub cfl: f64,
-    /// Explicit time step (s); must not exceed the stability limit.
+    /// Time step as a fraction of the stability limit (0 < cfl < 1; default 0.5).
+    pub cfl: Option<f64>,
+    /// Explicit time step (s) instead of `cfl`; must not exceed the stability limit.
     pub dt: Option<f64>,
     /// Mass-proportional damping alpha = d_k/rho (1/s).
     #[serde(default)]
@@ -78,10 +77,6 @@ pub struct Simulation {
     pub gravity: Option<Vec<f64>>,
     /// Cells per tile edge (default 8 in 2D, 4 in 3D).
     pub tile: Option<usize>,
-}
-
-fn default_cfl() -> f64 {
-    0.5
 }
 
 /// `[grid]`.
