@@ -338,7 +338,7 @@ fn cmd_check(path: &Path, overrides: &[String]) -> ExitCode {
                         w.grid.geom.node_count(),
                         w.settings.dt,
                         scene.dt_limit,
-                        (scene.duration / w.settings.dt).ceil(),
+                        fissure::run::step_count(scene.duration, w.settings.dt),
                         names.join(" -> ")
                     );
                     ExitCode::SUCCESS

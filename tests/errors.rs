@@ -472,3 +472,13 @@ fn unusable_command_line_values_exit_with_code_2() {
     assert!(err.contains("no scenario"), "{err}");
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// Asking for more threads than cores caps the pool at the core count with a warning (the
+/// workers spin between parallel regions; 1000 of them on 2 cores made no progress).
+#[test]
+fn more_threads_than_cores_are_capped() {
+    let cores = std::thread::available_parallelism().unwrap().get();
+    assert_eq!(fissure::run::thread_count(1000), cores);
+    assert_eq!(fissure::run::thread_count(1), 1);
+    assert_eq!(fissure::run::thread_count(0), cores);
+}

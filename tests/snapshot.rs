@@ -187,6 +187,27 @@ fn checkpoint_cadence_and_keep() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// A write cut short by a kill leaves a `.fsnap.tmp` file; the next resume in that folder,
+/// and the next fresh run, remove it.
+#[test]
+fn partial_snapshot_files_are_removed() {
+    let dir = scratch("partial");
+    let text = scene(2, "linear", "usf").replace("duration = 1e-5", "duration = 2e-6");
+    let first = run(&source(&text), &opts(&dir, 1)).unwrap();
+    let partial = dir.join("snapshots").join("step_000000099999.fsnap.tmp");
+    std::fs::write(&partial, b"cut short").unwrap();
+    let later = RunOptions {
+        until: Some(3e-6),
+        ..opts(&dir, 1)
+    };
+    resume(&first.snapshot.unwrap(), &later).unwrap();
+    assert!(!partial.exists(), "resume removed the partial file");
+    std::fs::write(&partial, b"cut short").unwrap();
+    run(&source(&text), &opts(&dir, 1)).unwrap();
+    assert!(!partial.exists(), "a fresh run removed the partial file");
+    std::fs::remove_dir_all(dir).ok();
+}
+
 /// A valid 2D snapshot (written once per test binary).
 fn sample() -> &'static (PathBuf, Vec<u8>) {
     static SAMPLE: OnceLock<(PathBuf, Vec<u8>)> = OnceLock::new();
@@ -428,7 +449,7 @@ fn resume_until_extends_a_finished_run() {
     let more = resume(&snap, &later).unwrap();
     let dt = more.summary.dt;
     assert_eq!(more.summary.status, "completed");
-    assert_eq!(more.summary.steps, (3e-6 / dt).ceil() as u64);
+    assert_eq!(more.summary.steps, fissure::run::step_count(3e-6, dt));
     assert!(more.summary.steps > first.summary.steps);
     std::fs::remove_dir_all(dir).ok();
 }

@@ -60,7 +60,27 @@ impl Checkpointer {
                     .with_context(|| format!("cannot remove old snapshot {}", path.display()))?;
             }
         }
+        c.remove_partial()?;
         Ok(c)
+    }
+
+    /// Removes `*.fsnap.tmp` files: snapshot writes cut short by a kill (a write renames
+    /// its temporary file only once it is complete, so none of them is a snapshot).
+    fn remove_partial(&self) -> anyhow::Result<()> {
+        if !self.dir.exists() {
+            return Ok(());
+        }
+        let entries = std::fs::read_dir(&self.dir)
+            .with_context(|| format!("cannot list {}", self.dir.display()))?;
+        for e in entries.filter_map(Result::ok) {
+            if e.file_name().to_string_lossy().ends_with(".fsnap.tmp") {
+                let path = e.path();
+                std::fs::remove_file(&path).with_context(|| {
+                    format!("cannot remove a partial snapshot {}", path.display())
+                })?;
+            }
+        }
+        Ok(())
     }
 
     /// Snapshot files in the folder, by step (none while the folder does not exist).

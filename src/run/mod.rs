@@ -59,9 +59,24 @@ pub struct Outcome {
 
 fn pool(opts: &RunOptions) -> anyhow::Result<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
+        .num_threads(thread_count(opts.threads))
         .build()
         .context("cannot build the thread pool")
+}
+
+/// The pool size for `asked` threads (0: one per core): at most one per core, since the
+/// workers spin between a step's parallel regions (`warm.rs`) and more of them than cores
+/// starve the step (1000 threads on 2 cores made no progress). Results are bitwise the
+/// same for any thread count, so the cap changes only the speed.
+pub fn thread_count(asked: usize) -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if asked == 0 {
+        return cores;
+    }
+    if asked > cores {
+        eprintln!("warning: {asked} threads asked, {cores} cores: using {cores}");
+    }
+    asked.min(cores)
 }
 
 /// Runs `src` with `opts` in a thread pool of the requested size.
@@ -90,6 +105,12 @@ pub fn resume(path: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
             .invalid(format!("dimension {d} in the header (corrupt)"))
             .into()),
     })
+}
+
+/// Steps of `dt` that reach `end`: the fewest whose end is not short of it by more than
+/// round-off (4.5e-5 / 1e-7 is 450.00000000000006 in floating point: 450 steps, not 451).
+pub fn step_count(end: f64, dt: f64) -> u64 {
+    ((end / dt) * (1.0 - 1e-12)).ceil() as u64
 }
 
 /// Whether a step ending at `time` records a history row: the next row is due (to
@@ -166,7 +187,7 @@ fn drive<D: Dim>(
         ))
         .into());
     }
-    let steps = (end / dt).ceil() as u64;
+    let steps = step_count(end, dt);
     let names: Vec<String> = probes.iter().map(|p| p.name.clone()).collect();
     let resumed_from = resumed.as_ref().map(|r| r.1.clone());
     let mut state = match resumed {
@@ -568,4 +589,20 @@ fn path_reports<D: Dim>(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::step_count;
+
+    /// A duration that is a whole number of steps takes exactly that many, although the
+    /// quotient rounds a hair above it; one a little longer takes one more.
+    #[test]
+    fn whole_durations_take_no_extra_step() {
+        let (end, dt) = (std::hint::black_box(4.5e-5), 1e-7);
+        assert!(end / dt > 450.0, "the quotient rounds above 450");
+        assert_eq!(step_count(end, dt), 450);
+        assert_eq!(step_count(4.5e-5 + 1e-10, 1e-7), 451);
+        assert_eq!(step_count(3e-6, 1e-6), 3);
+    }
 }

@@ -44,7 +44,7 @@ pub fn final_world_with<D: Dim>(
         let mut world = scene.world;
         prepare(&mut world);
         let mut schedule = Schedule::for_world(&world, None);
-        let steps = (scene.duration / world.settings.dt).ceil() as u64;
+        let steps = fissure::run::step_count(scene.duration, world.settings.dt);
         while world.step < steps {
             schedule.step(&mut world).unwrap_or_else(|e| panic!("{e}"));
         }
