@@ -359,7 +359,7 @@ pub struct LoadSpec {
     pub williams: Option<WilliamsSpec>,
     /// Traction of the exact field of a centre crack in an infinite plate, 2D only.
     pub centre_crack: Option<CentreCrackSpec>,
-    /// Outward unit normal of the face a traction acts on (an axis direction, e.g. [1, 0]).
+    /// Outward normal of the face a traction acts on (any direction in the plane).
     pub normal: Option<Vec<f64>>,
     /// Time multiplier.
     #[serde(default)]

@@ -121,14 +121,14 @@ fn coords(src: &Source, key: &str, v: &[f64]) -> R<[f64; 3]> {
 pub(super) struct Face<'a> {
     /// Scenario key of the load, for errors.
     key: &'a dyn Fn(&str) -> String,
-    /// Outward unit normal, an axis direction.
+    /// Outward unit normal (any direction in the plane).
     normal: [f64; 3],
-    /// Cell size along the normal (m).
-    h: f64,
+    /// Cell sizes (m).
+    h: [f64; 3],
 }
 
 impl<'a> Face<'a> {
-    /// Checks the scenario's `normal`: present and an axis direction.
+    /// Checks the scenario's `normal`: present, finite and not zero (it is normalised).
     pub fn new<D: Dim>(
         src: &Source,
         key: &'a dyn Fn(&str) -> String,
@@ -144,26 +144,28 @@ impl<'a> Face<'a> {
                 "a traction needs the outward normal of its face, e.g. normal = [1.0, 0.0]",
             )
         })?;
-        let normal = vec3::<D>(src, &key("normal"), n)?;
-        let axis = (0..2)
-            .find(|&a| normal[a].abs() == 1.0 && normal[1 - a] == 0.0)
-            .ok_or_else(|| {
-                src.error(
-                    &key("normal"),
-                    "the normal must be an axis direction: [1, 0], [-1, 0], [0, 1] or [0, -1]",
-                )
-            })?;
+        let n = vec3::<D>(src, &key("normal"), n)?;
+        let len = n[0].hypot(n[1]);
+        if len == 0.0 {
+            return Err(src.error(&key("normal"), "the normal must not be zero"));
+        }
         Ok(Face {
             key,
-            normal,
-            h: D::to_xyz(h)[axis],
+            normal: [n[0] / len, n[1] / len, 0.0],
+            h: D::to_xyz(h),
         })
     }
 }
 
 /// Forces on the face particles `sel`: the traction s . n at each particle's face point
-/// (half a particle size out along n) times the face area it carries (its volume over its
-/// size along n). `ppc` is each particle's particles per cell per direction.
+/// times the face area it carries. The selected particles fill a layer under the face;
+/// their positions along n fall on k distinct rows, and the layer is as deep as the rows
+/// span plus one mean row spacing (a single row: the particle size along n), so each
+/// particle carries its volume over that depth and the areas add up to the face's, on a
+/// face along a grid line or turned in the grid (where the particles sit on a staircase
+/// and the rows are many and close). The face lies half a row spacing beyond the outermost
+/// row, and a particle's face point is its projection on it. `ppc` is each particle's
+/// particles per cell per direction.
 pub(super) fn tractions<D: Dim>(
     src: &Source,
     face: &Face,
@@ -173,12 +175,28 @@ pub(super) fn tractions<D: Dim>(
     ppc: &[f64],
 ) -> R<Vec<D::Vec>> {
     let n = face.normal;
+    let along = |p: u32| {
+        let x = D::to_xyz(particles.x[p as usize]);
+        x[0] * n[0] + x[1] * n[1]
+    };
+    let mut rows: Vec<f64> = sel.iter().map(|&p| along(p)).collect();
+    rows.sort_unstable_by(f64::total_cmp);
+    let tol = 1e-9 * face.h[0].min(face.h[1]);
+    rows.dedup_by(|a, b| (*a - *b).abs() <= tol);
+    let (first, last) = (rows[0], rows[rows.len() - 1]);
+    let spacing = if rows.len() > 1 {
+        (last - first) / (rows.len() - 1) as f64
+    } else {
+        let p = sel[0] as usize;
+        (face.h[0] * n[0].abs() + face.h[1] * n[1].abs()) / ppc[p]
+    };
+    let depth = last - first + spacing;
+    let outer = last + 0.5 * spacing;
     let mut forces = Vec::with_capacity(sel.len());
     for &p in sel {
-        let p = p as usize;
-        let x = D::to_xyz(particles.x[p]);
-        let size = face.h / ppc[p];
-        let at = [x[0] + 0.5 * size * n[0], x[1] + 0.5 * size * n[1]];
+        let x = D::to_xyz(particles.x[p as usize]);
+        let to_face = outer - along(p);
+        let at = [x[0] + to_face * n[0], x[1] + to_face * n[1]];
         let [sxx, syy, sxy] = field.stress(at).ok_or_else(|| {
             src.error(
                 &(face.key)("region"),
@@ -189,7 +207,7 @@ pub(super) fn tractions<D: Dim>(
                 ),
             )
         })?;
-        let area = particles.volume[p] / size;
+        let area = particles.volume[p as usize] / depth;
         let t = [sxx * n[0] + sxy * n[1], sxy * n[0] + syy * n[1], 0.0];
         forces.push(to_vec::<D>(t.map(|c| c * area)));
     }
