@@ -79,7 +79,7 @@ fn wrong_type_names_line_and_key() {
 
 #[test]
 fn missing_material() {
-    let e = error_with(&["body[0].material=\"titanium\""]);
+    let e = refused(&GOOD.replace("material = \"steel\"", "material = \"titanium\""));
     assert_error(
         &e,
         "body[0].material",
@@ -97,13 +97,13 @@ fn body_outside_the_grid() {
 #[test]
 fn non_positive_modulus_and_density() {
     assert_error(
-        &error_with(&["material[0].E=-1.0"]),
+        &refused(&GOOD.replace("E = 200e9", "E = -1.0")),
         "material[0].E",
         Some(12),
         "positive",
     );
     assert_error(
-        &error_with(&["material[0].rho=0.0"]),
+        &refused(&GOOD.replace("rho = 7800.0", "rho = 0.0")),
         "material[0].rho",
         Some(14),
         "positive",
@@ -112,13 +112,13 @@ fn non_positive_modulus_and_density() {
 
 #[test]
 fn poisson_ratio_at_or_above_half() {
-    let e = error_with(&["material[0].nu=0.5"]);
+    let e = refused(&GOOD.replace("nu = 0.3", "nu = 0.5"));
     assert_error(&e, "material[0].nu", Some(13), "nu < 0.5");
 }
 
 #[test]
 fn cfl_at_or_above_one() {
-    let e = error_with(&["simulation.cfl=1.0"]);
+    let e = refused(&GOOD.replace("cfl = 0.5", "cfl = 1.0"));
     assert_error(&e, "simulation.cfl", Some(5), "0 < cfl < 1");
 }
 
@@ -487,4 +487,31 @@ fn more_threads_than_cores_are_capped() {
     assert_eq!(fissure::run::thread_count(1000), cores);
     assert_eq!(fissure::run::thread_count(1), 1);
     assert_eq!(fissure::run::thread_count(0), cores);
+}
+
+/// An error in a value given by `--set` says so instead of pointing at the file's line of
+/// the value it replaced; an error in a file value keeps its line.
+#[test]
+fn errors_in_set_values_name_the_set() {
+    let e = error_with(&["material[0].nu=0.7"]);
+    assert_error(
+        &e,
+        "material[0].nu",
+        None,
+        "comes from --set material[0].nu=0.7",
+    );
+    assert_eq!(e.line, None, "{e}");
+    let e = error_with(&["material.0.E=-1"]);
+    assert_error(
+        &e,
+        "material[0].E",
+        None,
+        "comes from --set material.0.E=-1",
+    );
+    let e = error_with(&["simulation.duration=\"long\""]);
+    assert_error(&e, "simulation.duration", None, "comes from --set");
+    let e = error_with(&["simulation.duration=2e-4", "material[0].nu=0.7"]);
+    assert!(e.to_string().contains("--set material[0].nu=0.7"), "{e}");
+    let e = error_with(&["simulation.duration=2e-4", "grid.cell=[0.0, 0.002]"]);
+    assert!(!e.to_string().contains("--set simulation"), "{e}");
 }

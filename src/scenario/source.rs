@@ -14,6 +14,8 @@ pub struct Source {
     pub text: String,
     /// Parsed scenario.
     pub scenario: Scenario,
+    /// Keys set by `--set` (as `a.b[2].c`) with the argument that set each.
+    set: Vec<(String, String)>,
 }
 
 impl Source {
@@ -32,11 +34,26 @@ impl Source {
     /// Parses scenario `text` named `file`, after applying `overrides`.
     pub fn parse(file: &str, text: &str, overrides: &[String]) -> Result<Self, ScenarioError> {
         let text = apply_overrides(file, text, overrides)?;
-        let err = |line, key, message| ScenarioError {
-            file: file.to_string(),
-            line,
-            key,
-            message,
+        let set: Vec<(String, String)> = overrides
+            .iter()
+            .filter_map(|arg| {
+                let (path, _) = arg.split_once('=')?;
+                Some((canonical(&split_path(path.trim())), arg.clone()))
+            })
+            .collect();
+        let err = |line, key: Option<String>, message: String| match set_by(&set, key.as_deref()) {
+            Some(arg) => ScenarioError {
+                file: file.to_string(),
+                line: None,
+                key,
+                message: format!("{message} (the value comes from --set {arg})"),
+            },
+            None => ScenarioError {
+                file: file.to_string(),
+                line,
+                key,
+                message,
+            },
         };
         let de = toml::Deserializer::parse(&text)
             .map_err(|e| err(line_of(&text, e.span()), None, e.message().to_string()))?;
@@ -54,16 +71,27 @@ impl Source {
             file: file.to_string(),
             text,
             scenario,
+            set,
         })
     }
 
-    /// An error about `key` (dotted path with `[i]` indices), located on its line.
+    /// An error about `key` (dotted path with `[i]` indices), located on its line, or said
+    /// to come from the `--set` that gave its value.
     pub fn error(&self, key: &str, message: impl Into<String>) -> ScenarioError {
-        ScenarioError {
-            file: self.file.clone(),
-            line: find_line(&self.text, key),
-            key: Some(key.to_string()),
-            message: message.into(),
+        let message = message.into();
+        match set_by(&self.set, Some(key)) {
+            Some(arg) => ScenarioError {
+                file: self.file.clone(),
+                line: None,
+                key: Some(key.to_string()),
+                message: format!("{message} (the value comes from --set {arg})"),
+            },
+            None => ScenarioError {
+                file: self.file.clone(),
+                line: find_line(&self.text, key),
+                key: Some(key.to_string()),
+                message,
+            },
         }
     }
 
@@ -112,6 +140,35 @@ fn split_path(path: &str) -> Vec<PathPart> {
 enum PathPart {
     Key(String),
     Index(usize),
+}
+
+/// A key path written as the errors write it: `a.b[2].c`.
+fn canonical(parts: &[PathPart]) -> String {
+    let mut out = String::new();
+    for p in parts {
+        match p {
+            PathPart::Key(k) => {
+                if !out.is_empty() {
+                    out.push('.');
+                }
+                out.push_str(k);
+            }
+            PathPart::Index(i) => out.push_str(&format!("[{i}]")),
+        }
+    }
+    out
+}
+
+/// The `--set` argument that set `key` or a table holding it, if any.
+fn set_by<'a>(set: &'a [(String, String)], key: Option<&str>) -> Option<&'a str> {
+    let key = canonical(&split_path(key?));
+    set.iter()
+        .find(|(path, _)| {
+            key == *path
+                || key.starts_with(&format!("{path}."))
+                || key.starts_with(&format!("{path}["))
+        })
+        .map(|(_, arg)| arg.as_str())
 }
 
 /// Line of the deepest existing item on `path` in `text`.
