@@ -303,12 +303,14 @@ fn refuses_a_3d_snapshot_resumed_as_2d() {
 fn refuses_a_missing_file() {
     let err = resume(Path::new("no/such/snapshot.fsnap"), &RunOptions::default())
         .err()
-        .unwrap()
-        .to_string();
+        .unwrap();
+    // The launcher prints the whole chain; the cause must appear in it once.
+    let err = format!("{err:#}");
     assert!(
         err.contains("no/such/snapshot.fsnap") && err.contains("cannot read"),
         "{err}"
     );
+    assert_eq!(err.matches("os error").count(), 1, "{err}");
 }
 
 /// A header whose checksum is right but whose counts are absurd is refused before any

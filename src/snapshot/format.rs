@@ -117,12 +117,13 @@ pub struct Header {
 #[derive(Debug, Error)]
 pub enum SnapshotError {
     /// The file cannot be opened or read.
-    #[error("{path}: cannot read the snapshot: {source}")]
+    #[error("{path}: cannot read the snapshot: {cause}")]
     Io {
         /// File.
         path: PathBuf,
-        /// Cause.
-        source: std::io::Error,
+        /// Cause (in the message, not a separate source, so that an error chain prints it
+        /// once).
+        cause: std::io::Error,
     },
     /// The file is not a snapshot, is damaged, or cannot be used here.
     #[error("{path}: {message}")]
@@ -226,9 +227,9 @@ impl Reader {
     /// column lies inside the file (so no count in a hostile header can cause a large
     /// allocation).
     pub fn open(path: &Path) -> Result<Self> {
-        let io = |source| SnapshotError::Io {
+        let io = |cause| SnapshotError::Io {
             path: path.to_path_buf(),
-            source,
+            cause,
         };
         let bad = |message: String| SnapshotError::Invalid {
             path: path.to_path_buf(),
@@ -354,9 +355,9 @@ impl Reader {
             )));
         }
         let mut out = vec![T::zeroed(); count];
-        let io = |source| SnapshotError::Io {
+        let io = |cause| SnapshotError::Io {
             path: self.path.clone(),
-            source,
+            cause,
         };
         self.file
             .seek(SeekFrom::Start(self.data_start + c.offset))
@@ -390,9 +391,9 @@ impl Reader {
         let mut buf = Vec::new();
         for c in self.header.columns.clone() {
             buf.resize((c.len * c.elem.size()) as usize, 0u8);
-            let io = |source| SnapshotError::Io {
+            let io = |cause| SnapshotError::Io {
                 path: self.path.clone(),
-                source,
+                cause,
             };
             self.file
                 .seek(SeekFrom::Start(self.data_start + c.offset))
