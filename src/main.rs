@@ -163,11 +163,15 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
         eprintln!("{}", s.message.as_deref().unwrap_or("interrupted"));
         return ExitCode::from(INTERRUPTED);
     }
+    let steps = if s.steps_run == s.steps {
+        format!("{} steps", s.steps)
+    } else {
+        format!("{} steps (to step {})", s.steps_run, s.steps)
+    };
     println!(
-        "{}: {} particles, {} steps in {:.2} s ({:.3e} particle-steps/s, {} threads); outputs in {}",
+        "{}: {} particles, {steps} in {:.2} s ({:.3e} particle-steps/s, {} threads); outputs in {}",
         s.scenario,
         s.particles,
-        s.steps,
         s.wall_seconds,
         s.particle_steps_per_second,
         s.threads,
@@ -175,7 +179,7 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
     );
     if let Some(p) = &s.snapshot {
         println!(
-            "  newest snapshot {p} ({:.1} MB written in {:.2} s)",
+            "  newest snapshot {p}; snapshots of this invocation: {:.1} MB in {:.2} s",
             s.snapshot_bytes as f64 / 1e6,
             s.snapshot_seconds
         );

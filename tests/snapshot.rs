@@ -453,6 +453,11 @@ fn resume_until_extends_a_finished_run() {
     assert_eq!(more.summary.status, "completed");
     assert_eq!(more.summary.steps, fissure::run::step_count(3e-6, dt));
     assert!(more.summary.steps > first.summary.steps);
+    assert_eq!(
+        more.summary.steps_run,
+        more.summary.steps - first.summary.steps,
+        "the resumed invocation counts its own steps"
+    );
     std::fs::remove_dir_all(dir).ok();
 }
 

@@ -20,8 +20,10 @@ pub struct Summary {
     pub particles: usize,
     /// Grid node count.
     pub nodes: usize,
-    /// Steps taken.
+    /// Steps taken since the start of the run (before a resume too).
     pub steps: u64,
+    /// Steps taken by this invocation (fewer than `steps` after a resume).
+    pub steps_run: u64,
     /// Simulated time reached (s).
     pub time: f64,
     /// Time step (s).

@@ -367,6 +367,7 @@ fn drive<D: Dim>(
         particles: world.particles.len(),
         nodes: world.grid.geom.node_count(),
         steps: world.step,
+        steps_run: world.step - first_step,
         time: world.time,
         dt,
         dt_limit,
