@@ -515,3 +515,36 @@ fn errors_in_set_values_name_the_set() {
     let e = error_with(&["simulation.duration=2e-4", "grid.cell=[0.0, 0.002]"]);
     assert!(!e.to_string().contains("--set simulation"), "{e}");
 }
+
+/// A crack cut finer than any use (1e-12 m spacing) is refused at once instead of
+/// building 1e10 vertices; a long, finely cut crack is checked for self-crossing in about
+/// linear time, and a crossing near its end is still found and named by its segments.
+#[test]
+fn crack_vertex_counts_are_bounded_and_checked_fast() {
+    let e = error_with_text(
+        "[[crack]]\nline = { start = [0.006, 0.01], end = [0.014, 0.01], spacing = 1e-12 }\n",
+    );
+    assert_error(&e, "crack[0].line.spacing", Some(19), "more than 100000");
+    // 40,000 points along a fine zigzag inside the body, then a last segment turned back
+    // down across it: the first crossing in index order is with segment 39919, the first
+    // zigzag segment the new one passes below (every pair of segments is 8e9 tests).
+    let mut pts: Vec<String> = (0..40_000)
+        .map(|k| {
+            let x = 0.006 + 0.008 * k as f64 / 40_000.0;
+            let y = 0.01 + if k % 2 == 0 { 0.0 } else { 1e-6 };
+            format!("[{x:e}, {y:e}]")
+        })
+        .collect();
+    let fine = format!("[[crack]]\npoints = [{}]\n", pts.join(", "));
+    let src = Source::parse("bad.toml", &format!("{GOOD}{fine}"), &[]).unwrap();
+    assert!(build::<D2>(&src).is_ok(), "a long fine crack is accepted");
+    pts.push("[0.00600005, 0.0095]".into());
+    let crossed = format!("[[crack]]\npoints = [{}]\n", pts.join(", "));
+    let e = error_with_text(&crossed);
+    assert_error(
+        &e,
+        "crack[0].points",
+        Some(19),
+        "crosses itself (segments 39919 and 39999)",
+    );
+}

@@ -15,6 +15,9 @@ use std::collections::HashMap;
 
 type R<T> = Result<T, ScenarioError>;
 
+/// Most segments one 2D crack may have (a finer crack than a few per cell buys nothing).
+const MAX_VERTICES: usize = 100_000;
+
 /// How far (in cells, on every axis) a crack vertex may lie from the nearest particle:
 /// cracks that cut through a body must reach past its edge.
 const REACH_CELLS: f64 = 2.0;
@@ -237,6 +240,12 @@ fn vertices<D: Dim>(
             if pts.len() < 2 {
                 return Err(src.error(&key("points"), "a crack needs at least two points"));
             }
+            if pts.len() > MAX_VERTICES + 1 {
+                return Err(src.error(
+                    &key("points"),
+                    format!("at most {} points per crack", MAX_VERTICES + 1),
+                ));
+            }
             pts.iter()
                 .enumerate()
                 .map(|(j, p)| {
@@ -255,7 +264,18 @@ fn vertices<D: Dim>(
                 Some(s) => positive(src, &key("line.spacing"), s, "m")?,
                 None => 0.5 * geom.min_cell(),
             };
-            let n = (len / spacing).ceil().min(1e6) as usize;
+            let n = (len / spacing).ceil();
+            if n > MAX_VERTICES as f64 {
+                return Err(src.error(
+                    &key("line.spacing"),
+                    format!(
+                        "{spacing:e} m cuts the {len:e} m line into {n:e} segments, more than \
+                         {MAX_VERTICES}: give a spacing of at least {:e} m",
+                        len / MAX_VERTICES as f64
+                    ),
+                ));
+            }
+            let n = n as usize;
             (0..=n)
                 .map(|k| a + (b - a) * (k as f64 / n as f64))
                 .collect()
@@ -334,20 +354,64 @@ fn fold_back<D: Dim>(pts: &[D::Vec]) -> Option<usize> {
     })
 }
 
-/// The first pair of non-adjacent segments of a polyline that intersect, if any.
+/// The first pair (in index order) of non-adjacent segments of a polyline that intersect,
+/// if any. Segments are binned into square buckets about as wide as a segment on average
+/// (each in the buckets around points along it, every quarter bucket), so only segments
+/// sharing a bucket are tested: about linear in the vertex count, however long a few
+/// segments are.
 fn self_crossing<D: Dim>(pts: &[D::Vec]) -> Option<(usize, usize)> {
     let e = |k: usize| D::Elem::from_vertices(&[k as u32, k as u32 + 1]);
     let n = pts.len() - 1;
-    for a in 0..n {
-        for b in a + 2..n {
-            let (p, q) = (pts[b], pts[b + 1]);
-            // Touching counts as crossing here: a crack must not meet itself at all.
-            if D::crossing(p, q, pts, e(a)) != 0 || D::crossing(q, p, pts, e(a)) != 0 {
-                return Some((a, b));
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in pts {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    let length = |k: usize| D::dot(pts[k + 1] - pts[k], pts[k + 1] - pts[k]).sqrt();
+    let mean = (0..n).map(length).sum::<f64>() / n as f64;
+    let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let size = mean.max(extent / (n as f64).sqrt()).max(f64::MIN_POSITIVE);
+    let mut buckets: HashMap<[i64; 2], Vec<usize>> = HashMap::new();
+    let mut cells: Vec<[i64; 2]> = Vec::new();
+    for k in 0..n {
+        let (p, q) = (pts[k], pts[k + 1]);
+        // Every point of the segment lies within a quarter bucket of a sample, so in the
+        // sample's bucket or a neighbour: a point two segments share is in a bucket of both.
+        let samples = (4.0 * length(k) / size).ceil().max(1.0) as usize;
+        cells.clear();
+        for s in 0..=samples {
+            let x = p + (q - p) * (s as f64 / samples as f64);
+            let c = [0, 1].map(|a| ((x[a] - lo[a]) / size).floor() as i64);
+            for di in -1..=1 {
+                for dj in -1..=1 {
+                    cells.push([c[0] + di, c[1] + dj]);
+                }
+            }
+        }
+        cells.sort_unstable();
+        cells.dedup();
+        for c in &cells {
+            buckets.entry(*c).or_default().push(k);
+        }
+    }
+    let mut first: Option<(usize, usize)> = None;
+    for segs in buckets.values() {
+        for (i, &a) in segs.iter().enumerate() {
+            for &b in &segs[i + 1..] {
+                if b < a + 2 || first.is_some_and(|f| f <= (a, b)) {
+                    continue;
+                }
+                let (p, q) = (pts[b], pts[b + 1]);
+                // Touching counts as crossing here: a crack must not meet itself at all.
+                if D::crossing(p, q, pts, e(a)) != 0 || D::crossing(q, p, pts, e(a)) != 0 {
+                    first = Some((a, b));
+                }
             }
         }
     }
-    None
+    first
 }
 
 /// The `[fracture]` table, checked against the cracks: they must exist and have tips, and
