@@ -548,3 +548,15 @@ fn crack_vertex_counts_are_bounded_and_checked_fast() {
         "crosses itself (segments 39919 and 39999)",
     );
 }
+
+/// More material tables than a particle's material index can name are refused by their
+/// count before anything is built from them.
+#[test]
+fn too_many_materials_are_refused_by_count() {
+    let mut text = GOOD.to_string();
+    for k in 0..65_536 {
+        text += &format!("[[material]]\nname = \"m{k}\"\nE = 1e9\nnu = 0.3\nrho = 1000.0\n");
+    }
+    let e = refused(&text);
+    assert_error(&e, "material", None, "65537 materials: at most 65535");
+}

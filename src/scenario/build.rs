@@ -245,11 +245,23 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     }
     let geom = GridGeom::<D>::new(to_vec::<D>(gmin), to_vec::<D>(h), cells);
 
-    // Materials.
+    // Materials: the count is checked first and names through a set, so that a scenario
+    // with tens of thousands of tables is refused at once.
+    if sc.materials.len() > u16::MAX as usize {
+        return Err(src.error(
+            "material",
+            format!(
+                "{} materials: at most {} per scene",
+                sc.materials.len(),
+                u16::MAX
+            ),
+        ));
+    }
     let mut materials = Vec::new();
+    let mut names = std::collections::HashSet::new();
     for (i, m) in sc.materials.iter().enumerate() {
         let key = |k: &str| format!("material[{i}].{k}");
-        if materials.iter().any(|e: &Elastic| e.name == m.name) {
+        if !names.insert(m.name.as_str()) {
             return Err(src.error(&key("name"), format!("duplicate material `{}`", m.name)));
         }
         positive(src, &key("E"), m.youngs, "Pa")?;
@@ -273,9 +285,6 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             ));
         }
         materials.push(e);
-    }
-    if materials.len() > u16::MAX as usize {
-        return Err(src.error("material", "too many materials"));
     }
 
     // Bodies.
