@@ -198,11 +198,10 @@ fn disc(centre: DVec3, a: DVec3, b: DVec3, h: f64, half: Option<f64>) -> Surface
         vertices.extend((0..count).map(|i| at(r, i as f64 * step)));
         ring_of.push((first..first + count as u32).collect());
     }
+    // Fraction of the span at point i of ring k >= 1.
     let angle = |k: usize, i: usize| {
         let count = ring_of[k].len();
-        if k == 0 {
-            0.0
-        } else if half.is_some() {
+        if half.is_some() {
             i as f64 / (count - 1) as f64
         } else {
             i as f64 / count as f64
