@@ -49,10 +49,9 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     type Sym: SymTensor;
     /// Crack element: a [`Segment`] in 2D, a [`Triangle`] in 3D.
     type Elem: Element;
-    /// The fracture system of this dimension (J and K at crack fronts, stored in the crack
-    /// scratch), if it has one: 2D tips have it; 3D crack fronts do not yet, and a 3D
-    /// scenario with cracks is refused.
-    const FRACTURE: Option<FractureSystem<Self>>;
+    /// The fracture system of this dimension (J and K at crack tips in 2D, at every front
+    /// vertex in 3D, stored in the crack scratch).
+    const FRACTURE: FractureSystem<Self>;
 
     /// The zero vector.
     fn zero() -> Self::Vec;
@@ -149,7 +148,7 @@ impl Dim for D2 {
     type Mat = DMat2;
     type Sym = Sym2;
     type Elem = Segment;
-    const FRACTURE: Option<FractureSystem<Self>> = Some(crate::systems::fracture::run);
+    const FRACTURE: FractureSystem<Self> = crate::systems::fracture::run;
 
     #[inline(always)]
     fn zero() -> DVec2 {
@@ -262,7 +261,7 @@ impl Dim for D3 {
     type Mat = DMat3;
     type Sym = Sym3;
     type Elem = Triangle;
-    const FRACTURE: Option<FractureSystem<Self>> = None;
+    const FRACTURE: FractureSystem<Self> = crate::systems::fracture_front::run;
 
     #[inline(always)]
     fn zero() -> DVec3 {

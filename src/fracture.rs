@@ -11,7 +11,7 @@ pub struct FracturePlan {
     /// Add the area integral of Guo & Nairn 2D (2004) Eq. 8 (path independence in dynamics).
     pub area_term: bool,
     /// End of the window behind the tip, in cells, over which the crack opening that splits
-    /// G into K_I and K_II is fitted (it starts one cell behind the tip).
+    /// G into K_I and K_II (and K_III in 3D) is fitted (it starts one cell behind the tip).
     pub opening: f64,
     /// Further contour sizes (cells) on which J is also measured, for paths.csv.
     pub compare: Vec<usize>,
@@ -21,7 +21,8 @@ pub struct FracturePlan {
     pub k0: Option<f64>,
     /// Which K_I, K_II are reported (both are measured and written).
     pub k_method: KMethod,
-    /// Radius of the interaction integral's domain, in cells (of the larger cell size).
+    /// Radius of the interaction integral's domain, in cells (of the larger cell size); in
+    /// 3D the radius and half-length of the tube around the front.
     pub domain: f64,
 }
 
@@ -68,7 +69,7 @@ pub struct PathResult {
     pub area: [f64; 2],
 }
 
-/// J and K at one crack tip at one time (SI: J/m^2, Pa sqrt(m)).
+/// J and K at one crack tip (2D) or front vertex (3D) at one time (SI: J/m^2, Pa sqrt(m)).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TipResult {
     /// Step.
@@ -77,26 +78,28 @@ pub struct TipResult {
     pub time: f64,
     /// Crack index.
     pub crack: u32,
-    /// 0 for the crack's start vertex, 1 for its end vertex.
+    /// In 2D 0 for the crack's start vertex, 1 for its end vertex; in 3D the front vertex's
+    /// ordinal along the crack's fronts.
     pub tip: u32,
     /// Tip position (m).
     pub x: [f64; 3],
-    /// J components in global x and y (Eq. 7 or 8).
+    /// J components in global x and y (Eq. 7 or 8); in 3D J along the front's normal x1
+    /// (the energy release rate) and NaN (J_2 would need the crack-face term of Eq. 33).
     pub j: [f64; 2],
     /// Mode I, II and III stress intensity factors as reported (KIII = 0 in 2D): those of
     /// `FracturePlan::k_method`.
     pub k: [f64; 3],
-    /// K_I, K_II from the interaction integral.
-    pub k_interaction: [f64; 2],
-    /// K_I, K_II from G and the crack opening.
-    pub k_opening: [f64; 2],
+    /// K_I, K_II, K_III from the interaction integral (K_III = 0 in 2D).
+    pub k_interaction: [f64; 3],
+    /// K_I, K_II, K_III from G and the crack opening (K_III = 0 in 2D).
+    pub k_opening: [f64; 3],
     /// Radius of the interaction integral's domain (m); 0 when none fitted.
     pub domain: f64,
 }
 
 impl TipResult {
     /// Number of [`TipResult::values`].
-    pub const VALUES: usize = 13;
+    pub const VALUES: usize = 15;
 
     /// Position, J, the reported K, the interaction integral's and the opening split's K and
     /// the domain radius, in fracture.csv's column order.
@@ -112,8 +115,10 @@ impl TipResult {
             self.k[2],
             self.k_interaction[0],
             self.k_interaction[1],
+            self.k_interaction[2],
             self.k_opening[0],
             self.k_opening[1],
+            self.k_opening[2],
             self.domain,
         ]
     }
@@ -134,9 +139,9 @@ impl TipResult {
             x: [v[0], v[1], v[2]],
             j: [v[3], v[4]],
             k: [v[5], v[6], v[7]],
-            k_interaction: [v[8], v[9]],
-            k_opening: [v[10], v[11]],
-            domain: v[12],
+            k_interaction: [v[8], v[9], v[10]],
+            k_opening: [v[11], v[12], v[13]],
+            domain: v[14],
         }
     }
 }

@@ -231,7 +231,7 @@ fn gather(
     let handed = if tip.end == 1 { 1.0 } else { -1.0 };
     let thickness = world.settings.thickness;
     let mut out = Vec::new();
-    for i in near(world, tip.x, r_max) {
+    for i in near(world, DVec2::from(tip.x), r_max) {
         let d = [p.x[i][0] - tip.x[0], p.x[i][1] - tip.x[1]];
         if d[0].abs() >= r_max || d[1].abs() >= r_max || d[0].hypot(d[1]) >= r_max {
             continue;
@@ -264,7 +264,7 @@ fn gather(
             [p.volume[i] / thickness, p.mass[i] / thickness],
             [sl[0][0], sl[1][1], sl[0][1]],
             gu,
-            to_local(accel(world, cracks, i)),
+            to_local(accel(world, cracks, i).to_array()),
             [kap, mu],
         ));
     }
@@ -274,11 +274,11 @@ fn gather(
 /// The particles that can lie within `reach` of `x`, in ascending index order: those binned
 /// in the tiles around it (padded by a cell for the particles' moves since binning), or
 /// every particle before the first binning.
-pub(crate) fn near(world: &World<D2>, x: [f64; 2], reach: f64) -> Vec<usize> {
+pub(crate) fn near<D: Dim>(world: &World<D>, x: D::Vec, reach: f64) -> Vec<usize> {
     let geom = &world.grid.geom;
-    let pad = reach + geom.h[0].max(geom.h[1]);
-    // The whole third axis in 3D.
-    let at = |s: f64| D2::from_slice(&[x[0] + s * pad, x[1] + s * pad, s * f64::INFINITY][..D2::D]);
+    let pad = reach + (0..D::D).map(|a| geom.h[a]).fold(0.0, f64::max);
+    let at =
+        |s: f64| D::from_slice(&[x[0] + s * pad, x[1] + s * pad, x[D::D - 1] + s * pad][..D::D]);
     let (lo, hi) = geom.cell_range(at(-1.0), at(1.0));
     let n = world.particles.len();
     match world.tiles.particles_in_cells(lo, hi, n) {
@@ -294,18 +294,15 @@ fn seg_distance(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 
 /// Particle `i`'s acceleration interpolated from its grid entries (its own crack side's
 /// fields near a crack), global axes.
-fn accel(world: &World<D2>, cracks: &Cracks<D2>, i: usize) -> [f64; 2] {
+pub(crate) fn accel<D: Dim>(world: &World<D>, cracks: &Cracks<D>, i: usize) -> D::Vec {
     let g = &world.grid;
-    let mut a = [0.0; 2];
-    let mut visit = |entry: usize, w: f64| {
-        a[0] += g.accel[entry][0] * w;
-        a[1] += g.accel[entry][1] * w;
-    };
+    let mut a = D::zero();
+    let mut visit = |entry: usize, w: f64| a += g.accel[entry] * w;
     with_shape!(world.settings.shape, S, N => {
-        let st = Stencil::<N>::cached::<D2>(S, &world.tiles.stencils, i);
+        let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
         match cracks.scratch.fields.targets_of(i) {
-            Some(t) => st.for_each_target::<D2>(&g.geom.stride, t, |n, w, _| visit(n, w)),
-            None => st.for_each::<D2>(&g.geom.stride, |n, w, _| visit(n, w)),
+            Some(t) => st.for_each_target::<D>(&g.geom.stride, t, |n, w, _| visit(n, w)),
+            None => st.for_each::<D>(&g.geom.stride, |n, w, _| visit(n, w)),
         }
     });
     a

@@ -11,6 +11,8 @@ pub mod dim;
 pub mod disjoint;
 pub mod error;
 pub mod fracture;
+pub mod front;
+pub mod front_integral;
 pub mod geometry;
 pub mod grid;
 pub mod interaction;

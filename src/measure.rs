@@ -130,6 +130,16 @@ pub enum Measure {
         /// Time (s): interpolated linearly between the rows around it; None for the last row.
         at: Option<f64>,
     },
+    /// A value along a 3D crack front at the last measurement (`qty` 0..4 = K_I, K_II,
+    /// K_III, J_1): the one farthest from `reference` over the front's vertices.
+    Front {
+        /// Crack index.
+        crack: u32,
+        /// Which value.
+        qty: usize,
+        /// The reference the values are compared with.
+        reference: f64,
+    },
     /// How far K at a crack tip moves once settled: the largest |K(t) - K(end)| over the
     /// rows from `from` on, relative to |K(end)| (K as the vector (K_I, K_II)).
     KDrift {
@@ -244,6 +254,24 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             let (a, b) = (rows[k - 1], rows[k]);
             let w = (t - a.time) / (b.time - a.time);
             finite(value(a) + w * (value(b) - value(a)))
+        }
+        Measure::Front {
+            crack,
+            qty,
+            reference,
+        } => {
+            let rows = h.fracture.iter().filter(|r| r.crack == crack);
+            let last = rows.clone().map(|r| r.step).max()?;
+            rows.filter(|r| r.step == last)
+                .map(|r| [r.k[0], r.k[1], r.k[2], r.j[0]][qty])
+                .try_fold(None, |worst: Option<f64>, v| {
+                    let v = finite(v)?;
+                    Some(Some(match worst {
+                        Some(w) if (w - reference).abs() >= (v - reference).abs() => w,
+                        _ => v,
+                    }))
+                })
+                .flatten()
         }
         Measure::KDrift { crack, tip, from } => {
             let rows: Vec<&TipResult> = h

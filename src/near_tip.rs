@@ -112,11 +112,45 @@ pub fn unit_fields(r: f64, theta: f64, kappa: f64, mu: f64) -> ([[f64; 3]; 2], [
     )
 }
 
+/// Anti-plane (mode III) field of K_III = `k3` at (r, theta): the displacement along the
+/// front u_3 = (2 K_III / mu) sqrt(r / 2 pi) sin(theta/2), its gradient [du_3/dx, du_3/dy]
+/// and the stress [s_13, s_23] = mu times that gradient (Irwin 1957).
+pub fn antiplane(k3: f64, r: f64, theta: f64, mu: f64) -> (f64, [f64; 2], [f64; 2]) {
+    let (s, c) = (0.5 * theta).sin_cos();
+    let a = k3 / (2.0 * PI * r).sqrt();
+    let g = [-a * s / mu, a * c / mu];
+    (2.0 * r * a * s / mu, g, [mu * g[0], mu * g[1]])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     const MU: f64 = 80e9;
+
+    /// The anti-plane faces are free (s_23 = 0 at theta = +-pi), the ligament carries
+    /// s_23 = K_III / sqrt(2 pi r), the tearing between the faces is 4 K_III / mu
+    /// sqrt(r / 2 pi), and the gradient is the derivative of the displacement.
+    #[test]
+    fn antiplane_field() {
+        let (k3, r) = (0.8e6, 1.5e-3);
+        let a = k3 / (2.0 * PI * r).sqrt();
+        assert!((antiplane(k3, r, 0.0, MU).2[1] - a).abs() < 1e-12 * a);
+        assert!(antiplane(k3, r, PI, MU).2[1].abs() < 1e-9 * a);
+        let tear = antiplane(k3, r, PI, MU).0 - antiplane(k3, r, -PI, MU).0;
+        let want = 4.0 * k3 / MU * (r / (2.0 * PI)).sqrt();
+        assert!((tear - want).abs() < 1e-12 * want);
+        let u = |x: f64, y: f64| antiplane(k3, x.hypot(y), y.atan2(x), MU).0;
+        let (x, y, d): (f64, f64, f64) = (-4e-4, 7e-4, 1e-9);
+        let g = antiplane(k3, x.hypot(y), y.atan2(x), MU).1;
+        let fd = [
+            (u(x + d, y) - u(x - d, y)) / (2.0 * d),
+            (u(x, y + d) - u(x, y - d)) / (2.0 * d),
+        ];
+        for k in 0..2 {
+            assert!((g[k] - fd[k]).abs() < 1e-6 * g[k].abs(), "{g:?} vs {fd:?}");
+        }
+    }
 
     /// The faces theta = +-pi carry no traction (s_yy = s_xy = 0) and, ahead of the tip,
     /// s_yy = K_I / sqrt(2 pi r) and s_xy = K_II / sqrt(2 pi r).

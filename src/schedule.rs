@@ -138,7 +138,7 @@ impl Schedule {
             // `step_measuring` for the steps after which J is measured).
             s.push(StressBin { fraction });
         }
-        let fracture = fracture.filter(|_| cracks && D::FRACTURE.is_some());
+        let fracture = fracture.filter(|_| cracks);
         if fracture.is_some() {
             s.push(Fracture);
         }
@@ -220,9 +220,9 @@ impl Schedule {
 
     /// Runs the fracture system, timing it under its schedule entry.
     fn fracture_system<D: Dim>(&mut self, world: &mut World<D>) {
-        if let (Some(plan), Some(run)) = (&self.fracture, D::FRACTURE) {
+        if let Some(plan) = &self.fracture {
             let t0 = Instant::now();
-            run(world, plan);
+            D::FRACTURE(world, plan);
             if let Some(k) = self.systems.iter().position(|s| *s == System::Fracture) {
                 self.seconds[k] += t0.elapsed().as_secs_f64();
             }

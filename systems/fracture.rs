@@ -137,8 +137,8 @@ fn tip(
         x: D2::to_xyz(cracks.geometry.x[kt]),
         j: [f64::NAN; 2],
         k: [f64::NAN, f64::NAN, 0.0],
-        k_interaction: [f64::NAN; 2],
-        k_opening: [f64::NAN; 2],
+        k_interaction: [f64::NAN, f64::NAN, 0.0],
+        k_opening: [f64::NAN, f64::NAN, 0.0],
         domain: 0.0,
     };
 
@@ -195,7 +195,8 @@ fn tip(
     }
     let [d_i, d_ii] = opening_amplitudes(cracks, &walk, end, xt, dir, h, window);
     let mat = &world.materials[world.particles.material[main.nearest] as usize];
-    res.k_opening = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
+    let [o1, o2] = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
+    res.k_opening = [o1, o2, 0.0];
     let at = Tip {
         crack: c,
         end,
@@ -204,14 +205,16 @@ fn tip(
         dir,
     };
     let ik = interaction_k(world, cracks, at, plan.domain * h, h, 2.0 * h, mat);
-    res.k_interaction = ik.k;
+    res.k_interaction = [ik.k[0], ik.k[1], 0.0];
     res.domain = ik.radius;
-    let [k1, k2] = match plan.k_method {
-        KMethod::Mixity => k_from_mixity(mat, world.settings.plane, gr, ik.k),
+    res.k = match plan.k_method {
+        KMethod::Mixity => {
+            let [k1, k2] = k_from_mixity(mat, world.settings.plane, gr, ik.k);
+            [k1, k2, 0.0]
+        }
         KMethod::Interaction => res.k_interaction,
         KMethod::Opening => res.k_opening,
     };
-    res.k = [k1, k2, 0.0];
     (res, paths)
 }
 
@@ -296,7 +299,7 @@ fn contour_j(
     let mut nearest = (f64::INFINITY, 0usize);
     let half = 0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
     let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-    for i in near(world, centre, half + reach) {
+    for i in near(world, DVec2::from(centre), half + reach) {
         let x = xy(p.x[i]);
         if x[0] < lo[0] - reach
             || x[0] > hi[0] + reach

@@ -5,6 +5,7 @@ pub mod classify;
 pub mod contact;
 pub mod crack_advect;
 pub mod fracture;
+pub mod fracture_front;
 pub mod g2p;
 pub mod grid_update;
 pub mod p2g;

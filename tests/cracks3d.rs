@@ -236,3 +236,44 @@ fn reusing_the_3d_classification_changes_no_bit() {
     );
     assert!(bits(&fresh) == bits(&reused));
 }
+
+/// The front frame on a curved front (Guo & Nairn 3D (2006) Eqs. 24-26): on an inclined
+/// penny x2 is the penny's normal, x1 points radially out and x3 along the front, to the
+/// chord's accuracy (the front's turn between neighbours, 2 pi / m for m front vertices);
+/// on an open half-ellipse the ends use one-sided chords and x1 still points out.
+#[test]
+fn front_frames_follow_a_curved_front() {
+    let n = DVec3::new(1.0, 2.0, 2.0) / 3.0;
+    let centre = DVec3::new(0.02, 0.02, 0.02);
+    let c =
+        store("penny = { center = [0.02, 0.02, 0.02], normal = [1.0, 2.0, 2.0], radius = 0.006 }");
+    let front = &c.topology.fronts()[0];
+    let frames = fissure::front::front_line(&c, front).frames;
+    let m = frames.len() as f64;
+    assert_eq!(frames.len(), front.vertices.len());
+    for f in &frames {
+        let radial = (f.x - centre).normalize();
+        assert!(f.e[1].dot(n) > 1.0 - 1e-12, "x2 {:?}", f.e[1]);
+        assert!(
+            f.e[0].dot(radial) > (PI / m).cos() - 1e-9,
+            "x1 {:?}",
+            f.e[0]
+        );
+        assert!(
+            f.e[0].cross(f.e[1]).dot(f.e[2]) > 1.0 - 1e-12,
+            "right-handed"
+        );
+        assert!(f.e[2].dot(radial).abs() < (PI / m).sin() + 1e-9);
+    }
+    let c = store(
+        "ellipse = { center = [0.02, 0.02, 0.02], axes = [[0.007, 0.0, 0.0], [0.0, 0.0, 0.004]], half = true }",
+    );
+    let frames = fissure::front::front_line(&c, &c.topology.fronts()[0]).frames;
+    for f in &frames {
+        let d = f.x - centre;
+        // Outward from the ellipse: along the gradient of (x/a)^2 + (z/b)^2.
+        let out = DVec3::new(d.x / 49e-6, 0.0, d.z / 16e-6).normalize();
+        assert!(f.e[0].dot(out) > 0.9, "x1 {:?} at {:?}", f.e[0], d);
+        assert!(f.e[1].y.abs() > 1.0 - 1e-12);
+    }
+}

@@ -52,3 +52,30 @@ fn bitwise_identical_across_thread_counts_3d_with_a_crack() {
     let text = mixed_scene(3, "ugimp", "usavg").replace("duration = 1e-5", "duration = 2e-6");
     same_bits_for_thread_counts::<D3>(&(text + crack));
 }
+
+/// J and K along a 3D crack front are bitwise the same for any thread count.
+#[test]
+fn front_fracture_is_bitwise_identical_across_thread_counts() {
+    let crack = "[[crack]]\npenny = { center = [0.02, 0.007, 0.007], normal = [1.0, 0.3, 0.2], \
+                 radius = 0.003 }\n[fracture]\ndomain = 2\n";
+    let text =
+        mixed_scene(3, "ugimp", "usavg").replace("duration = 1e-5", "duration = 2e-6") + crack;
+    let src = common::source(&text);
+    let plan = fissure::scenario::build::<D3>(&src)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .fracture
+        .unwrap();
+    let tips = |threads: usize| {
+        let w = final_world::<D3>(&text, threads);
+        let tips = fissure::systems::fracture_front::measure(&w, &plan).tips;
+        assert!(tips.iter().any(|t| t.k[0].is_finite()), "no K measured");
+        tips.iter()
+            .flat_map(|t| t.values())
+            .map(f64::to_bits)
+            .collect::<Vec<u64>>()
+    };
+    let one = tips(1);
+    for threads in [2, 3] {
+        assert!(one == tips(threads), "front K differs at {threads} threads");
+    }
+}

@@ -404,7 +404,12 @@ fn bad_crack_surfaces_name_the_problem() {
         "[[crack]]\npenny = { center = [0.01, 0.01, 0.01], normal = [0.0, 0.0, 1.0], radius = 0.003 }\n\
          [fracture]\ncontour = 2\n",
     );
-    assert_error(&e, "fracture", Some(20), "not implemented yet");
+    assert_error(
+        &e,
+        "fracture.contour",
+        Some(21),
+        "the square J contour is 2D",
+    );
 }
 
 /// Inputs that used to be accepted although wrong: a name that is not one folder name, two

@@ -155,10 +155,12 @@ fn restart_is_bit_exact_3d_one_and_two_threads() {
     restart_is_bit_exact(&text, 19, 2, "3d-2");
 }
 
+/// With J and K along the crack's front: fracture.csv, one row per front vertex, resumes
+/// bit for bit too.
 #[test]
 fn restart_is_bit_exact_with_a_3d_crack() {
     let crack = "[[crack]]\npenny = { center = [0.02, 0.007, 0.007], normal = [1.0, 0.3, 0.2], \
-                 radius = 0.003 }\ncontact = { law = \"stick\" }\n";
+                 radius = 0.003 }\ncontact = { law = \"stick\" }\n[fracture]\ndomain = 2\n";
     let text = scene(3, "ugimp", "usavg")
         .replace("duration = 1e-5", "duration = 4e-6")
         .replace("[[probe]]", &format!("{crack}[[probe]]"));

@@ -93,8 +93,9 @@ fn vtu_offsets_and_pvd_are_consistent() {
     std::fs::remove_dir_all(dir).ok();
 }
 
-/// Crack files: the crack-plane vertices as points, the segments as line cells, packed
-/// arrays, and a collection listing one file per frame.
+/// Crack files: the crack-plane vertices as points, the segments as line cells, K at the
+/// tips (NaN without [fracture]), packed arrays, and a collection listing one file per
+/// frame.
 #[test]
 fn crack_vtu_holds_the_segments() {
     let text = common::block_2d(
@@ -137,7 +138,7 @@ fn crack_vtu_holds_the_segments() {
         assert_eq!(offset, next, "arrays are packed back to back");
         let len = u64::from_le_bytes(data[offset..offset + 8].try_into().unwrap()) as usize;
         let want = match array.attribute("Name").unwrap() {
-            "opening" | "Points" => 8 * 3 * 8,
+            "opening" | "Points" | "K" => 8 * 3 * 8,
             "crack" => 8 * 4,
             "connectivity" => 7 * 2 * 8,
             "offsets" => 7 * 8,

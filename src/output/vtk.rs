@@ -3,6 +3,7 @@
 
 use crate::crack::{Cracks, Element};
 use crate::dim::Dim;
+use crate::fracture::TipResult;
 use crate::particles::Particles;
 use crate::sym::SymTensor;
 use std::io::Write;
@@ -74,11 +75,31 @@ pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result
 }
 
 /// Writes the cracks of `c` as line cells (2D) or triangle cells (3D): the crack-plane
-/// vertices joined by the crack elements, with the opening (top minus bottom surface, m)
-/// and the crack index.
-pub fn write_cracks<D: Dim>(path: &Path, c: &Cracks<D>) -> std::io::Result<()> {
+/// vertices joined by the crack elements, with the opening (top minus bottom surface, m),
+/// the crack index and K (Pa sqrt(m)) of `tips`, the latest measurement, at the tip and
+/// front vertices (NaN elsewhere).
+pub fn write_cracks<D: Dim>(path: &Path, c: &Cracks<D>, tips: &[TipResult]) -> std::io::Result<()> {
     let n = c.geometry.x.len();
     let topo = &c.topology;
+    // K at the tip (2D) and front (3D) vertices from the latest measurement, NaN elsewhere.
+    let mut k = vec![[f64::NAN; 3]; n];
+    let mut ordinal = vec![0u32; topo.cracks().len()];
+    for f in topo.fronts() {
+        for &v in &f.vertices {
+            let tip = if D::D == 2 {
+                f.end
+            } else {
+                ordinal[f.crack as usize]
+            };
+            ordinal[f.crack as usize] += 1;
+            if let Some(t) = tips
+                .iter()
+                .find(|t| (t.crack, t.tip) == (u32::from(f.crack), tip))
+            {
+                k[v as usize] = t.k;
+            }
+        }
+    }
     let m = topo.elems().len();
     let per = <D::Elem as Element>::VERTICES;
     // VTK_LINE and VTK_TRIANGLE.
@@ -98,6 +119,10 @@ pub fn write_cracks<D: Dim>(path: &Path, c: &Cracks<D>) -> std::io::Result<()> {
         Array {
             attrs: r#"type="Int32" Name="crack" NumberOfComponents="1""#.into(),
             bytes: crack.iter().flat_map(|k| k.to_le_bytes()).collect(),
+        },
+        Array {
+            attrs: r#"type="Float64" Name="K" NumberOfComponents="3""#.into(),
+            bytes: f64s(k.into_iter().flatten()),
         },
     ];
     let points = Array {

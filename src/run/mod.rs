@@ -7,7 +7,7 @@ pub mod writers;
 
 use crate::dim::{D2, D3, Dim};
 use crate::error::{Unstable, UsageError};
-use crate::fracture::FracturePlan;
+use crate::fracture::{FracturePlan, TipResult};
 use crate::measure::{Expect, History, Measure, Row, path_difference};
 use crate::output::plot::{self, Series};
 use crate::output::summary::{PathReport, Summary};
@@ -211,6 +211,7 @@ fn drive<D: Dim>(
             &names,
             crack_names.as_deref(),
             fracture.as_ref().is_some_and(|f| !f.compare.is_empty()),
+            D::D == 3,
             &state.history,
         )?),
         None => None,
@@ -405,8 +406,12 @@ fn drive<D: Dim>(
             if let Some(cracks) = &crack_names {
                 let path = w.dir.join("fracture.png");
                 let k0 = fracture.as_ref().and_then(|f| f.k0);
-                plot_fracture(&path, &name, &state.history, &expects, cracks, k0)
-                    .map_err(|e| anyhow::anyhow!("cannot draw fracture.png: {e}"))?;
+                let drawn = if D::D == 3 {
+                    plot_front(&path, &name, &state.history, cracks, k0)
+                } else {
+                    plot_fracture(&path, &name, &state.history, &expects, cracks, k0)
+                };
+                drawn.map_err(|e| anyhow::anyhow!("cannot draw fracture.png: {e}"))?;
             }
         }
     }
@@ -508,6 +513,53 @@ fn plot_fracture(
         path,
         &format!("{name}: stress intensity factors"),
         "time (s)",
+        &axis,
+        &series,
+    )
+}
+
+/// K_I, K_II and K_III along every 3D crack front at the last measurement, against the
+/// front vertex's ordinal; divided by `k0` when given.
+fn plot_front(
+    path: &Path,
+    name: &str,
+    h: &History,
+    cracks: &[String],
+    k0: Option<f64>,
+) -> Result<(), String> {
+    let scale = 1.0 / k0.unwrap_or(1.0);
+    let last = h.fracture.last().map_or(0, |t| t.step);
+    let rows: Vec<&TipResult> = h.fracture.iter().filter(|t| t.step == last).collect();
+    let mut labels = Vec::new();
+    let mut points = Vec::new();
+    for (c, crack) in cracks.iter().enumerate() {
+        for (k, mode) in ["KI", "KII", "KIII"].iter().enumerate() {
+            labels.push(format!("{mode} {crack}"));
+            points.push(
+                (rows.iter())
+                    .filter(|t| t.crack as usize == c)
+                    .map(|t| (f64::from(t.tip), t.k[k] * scale))
+                    .collect::<Vec<_>>(),
+            );
+        }
+    }
+    let series: Vec<Series> = labels
+        .iter()
+        .zip(points)
+        .map(|(l, p)| Series {
+            label: l,
+            points: p,
+        })
+        .collect();
+    let axis = match k0 {
+        Some(k0) => format!("K / K0 (K0 = {k0:.4e} Pa sqrt(m))"),
+        None => "K (Pa sqrt(m))".to_string(),
+    };
+    let time = rows.first().map_or(0.0, |t| t.time);
+    plot::lines(
+        path,
+        &format!("{name}: K along the front at {time:.4e} s"),
+        "front vertex",
         &axis,
         &series,
     )

@@ -21,18 +21,23 @@ pub struct Writers {
     probes: BufWriter<File>,
     fracture: Option<(BufWriter<File>, Vec<String>)>,
     paths: Option<BufWriter<File>>,
+    /// Whether a tip is a 3D front vertex (named by its ordinal along the crack's front)
+    /// rather than a 2D crack end (named start or end).
+    front_vertices: bool,
 }
 
 impl Writers {
     /// Creates the output folder and the CSV files, holding the header and every row
     /// already recorded in `history` (none for a fresh run).
     /// `cracks` names the cracks when J and K are measured (then fracture.csv is written);
-    /// `paths` asks for paths.csv (J on compared contours).
+    /// `paths` asks for paths.csv (J on compared contours); `front_vertices` says the tips
+    /// are 3D front vertices.
     pub fn open(
         dir: &Path,
         probe_names: &[String],
         cracks: Option<&[String]>,
         paths: bool,
+        front_vertices: bool,
         history: &History,
     ) -> anyhow::Result<Self> {
         std::fs::create_dir_all(dir)
@@ -57,7 +62,8 @@ impl Writers {
                 writeln!(
                     f,
                     "step,time,crack,tip,x,y,z,J1,J2,KI,KII,KIII,\
-                     KI_interaction,KII_interaction,KI_opening,KII_opening,domain"
+                     KI_interaction,KII_interaction,KIII_interaction,\
+                     KI_opening,KII_opening,KIII_opening,domain"
                 )?;
                 Some((f, names.to_vec()))
             }
@@ -77,6 +83,7 @@ impl Writers {
             probes,
             fracture,
             paths,
+            front_vertices,
         };
         for row in &history.rows {
             w.row(row, history)?;
@@ -127,14 +134,12 @@ impl Writers {
             }
         }
         for t in tips {
-            write!(
-                f,
-                "{},{:.9e},{},{}",
-                t.step,
-                t.time,
-                names[t.crack as usize],
-                ["start", "end"][t.tip as usize],
-            )?;
+            write!(f, "{},{:.9e},{},", t.step, t.time, names[t.crack as usize])?;
+            if self.front_vertices {
+                write!(f, "{}", t.tip)?;
+            } else {
+                write!(f, "{}", ["start", "end"][t.tip as usize])?;
+            }
             for v in t.values() {
                 write!(f, ",{v:.9e}")?;
             }
@@ -157,7 +162,12 @@ impl Writers {
         vtk::write_collection(&self.dir.join("particles.pvd"), &list)?;
         if let Some(c) = &world.cracks {
             let crack_name = |k: usize| format!("cracks_{k:05}.vtu");
-            vtk::write_cracks(&self.dir.join(crack_name(state.frames.len() - 1)), c)?;
+            let last = state.history.fracture.last().map(|t| t.step);
+            let tips: Vec<TipResult> = (state.history.fracture.iter().rev())
+                .take_while(|t| Some(t.step) == last)
+                .copied()
+                .collect();
+            vtk::write_cracks(&self.dir.join(crack_name(state.frames.len() - 1)), c, &tips)?;
             let list: Vec<(f64, String)> = state
                 .frames
                 .iter()

@@ -540,11 +540,35 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 "`from` applies to K_drift and kinetic_fraction",
             ));
         }
-        let crack_measure = match tip_qty {
-            Some(qty) => Some(super::cracks::tip_measure(src, i, e, qty)?),
-            None if e.quantity == "J_path" => Some(super::cracks::path_measure(src, i, e)?),
-            None if e.quantity == "K_drift" => Some(super::cracks::drift_measure(src, i, e)?),
-            None => None,
+        let front_qty = ["KI_front", "KII_front", "KIII_front", "J1_front"]
+            .iter()
+            .position(|q| *q == e.quantity);
+        let tip_like = tip_qty.is_some() || ["J_path", "K_drift"].contains(&e.quantity.as_str());
+        if D::D == 3 && tip_like {
+            return Err(src.error(
+                &key("quantity"),
+                format!(
+                    "`{}` is measured at a 2D crack tip; along a 3D front use KI_front, \
+                     KII_front, KIII_front or J1_front",
+                    e.quantity
+                ),
+            ));
+        }
+        if D::D == 2 && front_qty.is_some() {
+            return Err(src.error(
+                &key("quantity"),
+                format!(
+                    "`{}` runs along a 3D crack front; at a 2D tip use KI, KII, J1 or J2",
+                    e.quantity
+                ),
+            ));
+        }
+        let crack_measure = match (tip_qty, front_qty) {
+            (Some(qty), _) => Some(super::cracks::tip_measure(src, i, e, qty)?),
+            (_, Some(qty)) => Some(super::cracks::front_measure(src, i, e, qty)?),
+            _ if e.quantity == "J_path" => Some(super::cracks::path_measure(src, i, e)?),
+            _ if e.quantity == "K_drift" => Some(super::cracks::drift_measure(src, i, e)?),
+            _ => None,
         };
         if let Some(measure) = crack_measure {
             positive(src, &key("tolerance"), e.tolerance, "relative")?;
@@ -554,7 +578,9 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     .crack
                     .iter()
                     .cloned()
-                    .chain([e.tip.clone().unwrap_or_else(|| "end".into())])
+                    .chain([e.tip.clone().unwrap_or_else(|| {
+                        if front_qty.is_some() { "front" } else { "end" }.into()
+                    })])
                     .chain(e.at.map(|t| format!("t={t:.3e}")))
                     .collect(),
                 measure,
@@ -577,7 +603,8 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     format!(
                         "unknown quantity `{other}` (final, max, min, frequency, wave_speed, \
                          momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2, \
-                         J_path, K_drift, kinetic_fraction)"
+                         J_path, K_drift, kinetic_fraction, KI_front, KII_front, KIII_front, \
+                         J1_front)"
                     ),
                 ));
             }

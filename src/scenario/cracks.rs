@@ -427,13 +427,6 @@ pub(super) fn fracture_plan<D: Dim>(
     let Some(cracks) = cracks else {
         return Err(src.error("fracture", "J and K need at least one [[crack]]"));
     };
-    if D::FRACTURE.is_none() {
-        return Err(src.error(
-            "fracture",
-            "J and K along 3D crack fronts are not implemented yet: remove [fracture] (the \
-             cracks themselves, contact and the crack opening work in 3D)",
-        ));
-    }
     if cracks.topology.fronts().is_empty() {
         return Err(src.error(
             "fracture",
@@ -467,10 +460,28 @@ pub(super) fn fracture_plan<D: Dim>(
         Ok(())
     };
     let n = f.contour.unwrap_or(2);
-    fits("fracture.contour", n)?;
     let compare = f.compare.clone().unwrap_or_default();
-    for &m in &compare {
-        fits("fracture.compare", m)?;
+    if D::D == 2 {
+        fits("fracture.contour", n)?;
+        for &m in &compare {
+            fits("fracture.compare", m)?;
+        }
+    } else {
+        // J along a 3D front comes from the tube's domain integral, which always carries the
+        // volume term; the square grid contour and its comparisons are 2D.
+        let grid_keys = [
+            ("contour", f.contour.is_some()),
+            ("compare", f.compare.is_some()),
+            ("compare_from", f.compare_from.is_some()),
+            ("area_term", f.area_term.is_some()),
+        ];
+        if let Some((key, _)) = grid_keys.iter().find(|k| k.1) {
+            return Err(src.error(
+                &format!("fracture.{key}"),
+                "the square J contour is 2D; along a 3D front J and K come from a tube of \
+                 radius `domain` cells",
+            ));
+        }
     }
     let compare_from = f.compare_from.unwrap_or(0.0);
     if compare_from.is_nan() || compare_from < 0.0 {
@@ -484,6 +495,9 @@ pub(super) fn fracture_plan<D: Dim>(
         ));
     }
     let k_method = match f.k_from.as_deref() {
+        // In 3D the tube's J carries the front's curvature exactly and the interaction
+        // integral does not (see `crate::front_integral`), so G comes from J by default.
+        None if D::D == 3 => KMethod::Mixity,
         None | Some("interaction") => KMethod::Interaction,
         Some("mixity") => KMethod::Mixity,
         Some("opening") => KMethod::Opening,
@@ -496,7 +510,7 @@ pub(super) fn fracture_plan<D: Dim>(
             ));
         }
     };
-    let domain = f.domain.unwrap_or(6.0);
+    let domain = f.domain.unwrap_or(if D::D == 2 { 6.0 } else { 3.0 });
     if !(domain.is_finite() && domain >= 2.0) {
         return Err(src.error(
             "fracture.domain",
@@ -574,6 +588,45 @@ pub(super) fn tip_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) ->
         tip,
         qty,
         at: e.at,
+    })
+}
+
+/// The measure of an expect along a 3D crack front (`qty` 0..4 = KI, KII, KIII, J1): the
+/// value farthest from the reference over the front's vertices, at the last measurement.
+pub(super) fn front_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) -> R<Measure> {
+    let key = |k: &str| format!("expect[{i}].{k}");
+    let sc = &src.scenario;
+    if sc.fracture.is_none() {
+        return Err(src.error(
+            &key("quantity"),
+            format!("`{}` needs a [fracture] table", e.quantity),
+        ));
+    }
+    for (k, given) in [("tip", e.tip.is_some()), ("at", e.at.is_some())] {
+        if given {
+            return Err(src.error(
+                &key(k),
+                format!(
+                    "`{}` covers every front vertex at the last measurement",
+                    e.quantity
+                ),
+            ));
+        }
+    }
+    let name = e
+        .crack
+        .as_deref()
+        .ok_or_else(|| src.error(&key("quantity"), "name the crack with `crack = ...`"))?;
+    let crack = sc
+        .cracks
+        .iter()
+        .enumerate()
+        .position(|(k, c)| c.name.clone().unwrap_or_else(|| format!("crack{k}")) == name)
+        .ok_or_else(|| src.error(&key("crack"), format!("no crack named `{name}`")))?;
+    Ok(Measure::Front {
+        crack: crack as u32,
+        qty,
+        reference: e.reference,
     })
 }
 

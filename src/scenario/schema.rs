@@ -446,11 +446,12 @@ pub struct FractureSpec {
     /// `opening` cells behind the tip (default 8; on a crack with two tips, at most half its
     /// length).
     pub opening: Option<f64>,
-    /// Which K_I, K_II are reported in the KI, KII columns and expects: "interaction"
-    /// (default: the interaction integral), "mixity" (G from J split in the interaction
-    /// integral's ratio K_II / K_I) or "opening" (G split by the crack opening).
+    /// Which K are reported in the KI, KII (, KIII) columns and expects: "interaction" (the
+    /// interaction integral; the 2D default), "mixity" (G from J split in the interaction
+    /// integral's ratios; the 3D default) or "opening" (G split by the crack opening).
     pub k_from: Option<String>,
-    /// Radius of the interaction integral's domain around the tip, in cells (default 6).
+    /// Radius of the interaction integral's domain around the tip, in cells (default 6 in
+    /// 2D; in 3D the radius and half-length of the tube around the front, default 3).
     pub domain: Option<f64>,
 }
 
@@ -477,7 +478,8 @@ pub struct ExpectSpec {
     /// angular_momentum_drift; KI, KII, J1, J2 (at a crack tip: the last value, or at `at`);
     /// J_path (largest difference of J on the `[fracture] compare` contours from the main
     /// one, relative to the main one's largest |J|); K_drift (largest |K(t) - K(end)| from
-    /// `from` on, relative to |K(end)|).
+    /// `from` on, relative to |K(end)|); in 3D KI_front, KII_front, KIII_front, J1_front
+    /// (the value farthest from the reference over a crack's front vertices, last row).
     pub quantity: String,
     /// Probe(s) the quantity is measured on (wave_speed takes two).
     #[serde(default)]

@@ -37,6 +37,12 @@ fn row_data(r: &Row) -> [f64; ROW_WIDTH] {
     ]
 }
 
+/// A crack tip's id in the `history.fracture.tip` column: the crack in the high 32 bits, the
+/// tip (2D: its end; 3D: its front vertex's ordinal) in the low ones.
+fn tip_id(crack: u32, tip: u32) -> u64 {
+    (u64::from(crack) << 32) | u64::from(tip)
+}
+
 /// Scalars per crack-tip result in the `history.fracture.data` column.
 const TIP_WIDTH: usize = 1 + TipResult::VALUES;
 
@@ -85,11 +91,7 @@ pub fn write<D: Dim>(
     let row_steps: Vec<u64> = h.rows.iter().map(|r| r.step).collect();
     let rows: Vec<f64> = h.rows.iter().flat_map(row_data).collect();
     let tip_steps: Vec<u64> = h.fracture.iter().map(|t| t.step).collect();
-    let tip_ids: Vec<u64> = h
-        .fracture
-        .iter()
-        .map(|t| 2 * u64::from(t.crack) + u64::from(t.tip))
-        .collect();
+    let tip_ids: Vec<u64> = h.fracture.iter().map(|t| tip_id(t.crack, t.tip)).collect();
     let tip_data: Vec<f64> = h.fracture.iter().flat_map(tip_data).collect();
     let path_steps: Vec<u64> = h.paths.iter().map(|p| p.step).collect();
     let path_ids: Vec<u64> = h
@@ -290,7 +292,7 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
         .zip(data.chunks_exact(TIP_WIDTH))
         .map(|((&step, &id), d)| {
             let v = d[1..].try_into().expect("chunks of TIP_WIDTH");
-            TipResult::from_values(step, d[0], (id / 2) as u32, (id % 2) as u32, v)
+            TipResult::from_values(step, d[0], (id >> 32) as u32, id as u32, v)
         })
         .collect();
     let path_steps: Vec<u64> = r.column_any("history.paths.step")?;

@@ -1,0 +1,143 @@
+//! `fracture` in 3D: J and K_I, K_II, K_III at every vertex of every crack front, from
+//! domain integrals over a tube around the front (`crate::front_integral`), and K split
+//! from G = J by the opening, sliding and tearing of the crack behind the front (Guo &
+//! Nairn 3D (2006) Eqs. 40, 46-57). Runs on output steps only; it reads the world and
+//! changes nothing.
+
+use crate::crack::{Cracks, Element};
+use crate::dim::{D3, Dim};
+use crate::fracture::{FracturePlan, KMethod, Measured, TipResult};
+use crate::front::{FrontFrame, front_line};
+use crate::front_integral::{Elastic3, Facet, Tube, front_integrals};
+use crate::world::World;
+
+/// J and K at every front vertex, into the crack scratch's `measured`.
+pub fn run(world: &mut World<D3>, plan: &FracturePlan) {
+    let measured = measure(world, plan);
+    if let Some(c) = world.cracks.as_mut() {
+        c.scratch.measured = measured;
+    }
+}
+
+/// What [`run`] stores: J and K at every vertex of every front, each crack's fronts
+/// numbered on from one to the next.
+pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
+    let mut m = Measured::default();
+    let Some(cracks) = &world.cracks else {
+        return m;
+    };
+    let geom = &world.grid.geom;
+    let h = (0..3).map(|a| geom.h[a]).fold(0.0, f64::max);
+    let tube = Tube {
+        radius: plan.domain * h,
+        step: h,
+        min_radius: 2.0 * h,
+        length: plan.domain * h,
+    };
+    let facets = facets(cracks);
+    let mut ordinal = vec![0u32; cracks.topology.cracks().len()];
+    for front in cracks.topology.fronts() {
+        let line = front_line(cracks, front);
+        for (k, frame) in line.frames.iter().enumerate() {
+            let c = front.crack as usize;
+            let near: Vec<Facet> = (facets.iter())
+                .filter(|f| (f.centroid - frame.x).length() < tube.radius + tube.length + h)
+                .copied()
+                .collect();
+            let elastic = |m: u16| {
+                let e = &world.materials[m as usize];
+                Elastic3 {
+                    mu: e.mu,
+                    nu: e.poisson,
+                }
+            };
+            let fi = front_integrals(world, cracks, &line, k, &near, tube, elastic);
+            let opening = opening(cracks, c, frame, h, plan.opening * h);
+            let (k_opening, k_mixity) = match fi.material.map(elastic) {
+                Some(el) => (
+                    k_split(
+                        el,
+                        fi.j,
+                        [opening[0] / el.c1(), opening[1] / el.c1(), opening[2] / 4.0],
+                    ),
+                    k_split(el, fi.j, fi.k),
+                ),
+                None => ([f64::NAN; 3], [f64::NAN; 3]),
+            };
+            m.tips.push(TipResult {
+                step: world.step,
+                time: world.time,
+                crack: c as u32,
+                tip: ordinal[c],
+                x: frame.x.to_array(),
+                j: [fi.j, f64::NAN],
+                k: match plan.k_method {
+                    KMethod::Interaction => fi.k,
+                    KMethod::Mixity => k_mixity,
+                    KMethod::Opening => k_opening,
+                },
+                k_interaction: fi.k,
+                k_opening,
+                domain: fi.radius,
+            });
+            ordinal[c] += 1;
+        }
+    }
+    m
+}
+
+/// Centroid and unit normal of every crack triangle.
+fn facets(cracks: &Cracks<D3>) -> Vec<Facet> {
+    let x = &cracks.geometry.x;
+    (cracks.topology.elems().iter())
+        .map(|e| Facet {
+            centroid: e
+                .vertices()
+                .iter()
+                .map(|&k| x[k as usize])
+                .sum::<glam::DVec3>()
+                / 3.0,
+            normal: D3::elem_normal(x, *e),
+        })
+        .collect()
+}
+
+/// Amplitudes of the opening (mode I), sliding (II) and tearing (III) displacements behind
+/// the front vertex, each fitted as c sqrt(r) over the crack's vertices from one cell to
+/// `window` behind it and within a cell of its normal plane (the top face less the bottom
+/// one, in front axes). NaN when no vertex lies there.
+fn opening(cracks: &Cracks<D3>, c: usize, frame: &FrontFrame, h: f64, window: f64) -> [f64; 3] {
+    let g = &cracks.geometry;
+    let (mut num, mut den) = ([0.0; 3], 0.0);
+    for &k in &cracks.topology.cracks()[c].vertices {
+        let d = frame.local(g.x[k as usize] - frame.x);
+        let r = -d[0];
+        if r < h || r > window || d[2].abs() > h || d[1].abs() > h {
+            continue;
+        }
+        let du = frame.local(g.top[k as usize] - g.bottom[k as usize]);
+        let s = r.sqrt();
+        for (n, u) in num.iter_mut().zip([du[1], du[0], du[2]]) {
+            *n += u * s;
+        }
+        den += r;
+    }
+    if den == 0.0 {
+        return [f64::NAN; 3];
+    }
+    num.map(|n| n / den)
+}
+
+/// K_I, K_II, K_III of a stationary front in proportion to `d`, scaled so that
+/// G = (A_I K_I^2 + A_II K_II^2 + A_III K_III^2) / (2 mu) with A_I = A_II = (kappa + 1)/4
+/// and A_III = 1 (Guo & Nairn 3D (2006) Eq. 40 at zero speed; Eqs. 49-57 are its three
+/// cases). NaN when `d` is zero or NaN.
+fn k_split(el: Elastic3, g: f64, d: [f64; 3]) -> [f64; 3] {
+    let a = 0.25 * el.c1();
+    let den = a * (d[0] * d[0] + d[1] * d[1]) + d[2] * d[2];
+    if den.is_nan() || den == 0.0 {
+        return [f64::NAN; 3];
+    }
+    let scale = (2.0 * el.mu * g.max(0.0) / den).sqrt();
+    d.map(|v| v * scale)
+}
