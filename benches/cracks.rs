@@ -2,15 +2,17 @@
 //! with 104 segments): `classify` per step, as a full pass and reusing its record (only
 //! the particles with no clearance redone), and the J-integral at the tip per output step;
 //! and frictionless `contact` (on updated velocities) per step on the ENF scene
-//! (`scenarios/enf_2d.toml`, the same beam with its arms sliding).
+//! (`scenarios/enf_2d.toml`, the same beam with its arms sliding). In 3D: `classify` and J
+//! and K along the front (60 vertices, a tube of 4 cells) on a 30 mm cube of 216,000
+//! particles with a 5 mm penny crack under tension.
 //!
 //! `cargo bench --bench cracks`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use fissure::dim::D2;
+use fissure::dim::{D2, D3};
 use fissure::scenario::{Source, build};
 use fissure::schedule::Schedule;
-use fissure::systems::{classify, contact, fracture};
+use fissure::systems::{classify, contact, fracture, fracture_front};
 use std::time::Duration;
 
 fn cracks(c: &mut Criterion) {
@@ -63,5 +65,70 @@ fn cracks(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, cracks);
+/// The penny-crack cube of the 3D benches.
+const PENNY: &str = r#"
+[simulation]
+dimension = 3
+shape = "ugimp"
+update = "usavg"
+duration = 1.0e-4
+[grid]
+min = [-0.002, -0.002, -0.002]
+max = [0.032, 0.032, 0.032]
+cell = [0.001, 0.001, 0.001]
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 8000.0
+[[body]]
+material = "steel"
+box = { min = [0.0, 0.0, 0.0], max = [0.03, 0.03, 0.03] }
+[[crack]]
+name = "penny"
+penny = { center = [0.015, 0.015, 0.015], normal = [0.0, 1.0, 0.0], radius = 0.005 }
+[[load]]
+region = { min = [0.0, 0.0295, 0.0], max = [0.03, 0.03, 0.03] }
+force = [0.0, 45000.0, 0.0]
+[[load]]
+region = { min = [0.0, 0.0, 0.0], max = [0.03, 0.0005, 0.03] }
+force = [0.0, -45000.0, 0.0]
+[fracture]
+domain = 4
+"#;
+
+fn cracks_3d(c: &mut Criterion) {
+    let src = Source::parse("penny.toml", PENNY, &[]).expect("the penny scene parses");
+    let scene = build::<D3>(&src).expect("the penny scene builds");
+    let plan = scene.fracture.clone().expect("the penny measures J");
+    let mut world = scene.world;
+    let mut schedule = Schedule::for_world(&world, None);
+    for _ in 0..20 {
+        schedule.step(&mut world).expect("stable");
+    }
+    let mut g = c.benchmark_group("cracks-penny-3d");
+    g.sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(5));
+    g.throughput(Throughput::Elements(world.particles.len() as u64));
+    let every_step = |world: &mut fissure::world::World<D3>, on: bool| {
+        let c = world.cracks.as_mut().expect("the penny scene has a crack");
+        c.scratch.classified.every_step = on;
+    };
+    every_step(&mut world, true);
+    g.bench_function("classify_full", |b| b.iter(|| classify::run(&mut world)));
+    every_step(&mut world, false);
+    g.bench_function("classify_reuse", |b| b.iter(|| classify::run(&mut world)));
+    let vertices = world
+        .cracks
+        .as_ref()
+        .map_or(0, |c| c.topology.fronts()[0].vertices.len());
+    g.throughput(Throughput::Elements(vertices as u64));
+    g.bench_function("front_j_k", |b| {
+        b.iter(|| fracture_front::measure(&world, &plan))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, cracks, cracks_3d);
 criterion_main!(benches);

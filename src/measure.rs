@@ -91,6 +91,33 @@ pub struct History {
     pub paths: Vec<PathResult>,
 }
 
+/// A reference that varies along a front as cos or sin of the angle about its centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Along {
+    /// sin(theta) rather than cos(theta).
+    pub sin: bool,
+    /// Unit direction of theta = 0.
+    pub zero: [f64; 3],
+    /// Unit direction of theta = 90 degrees (normal x zero).
+    pub quarter: [f64; 3],
+}
+
+impl Along {
+    /// The reference's factor at each of `points`: cos or sin of the angle about their mean.
+    pub fn factors(&self, points: &[[f64; 3]]) -> Vec<f64> {
+        let n = points.len().max(1) as f64;
+        let c: [f64; 3] = [0, 1, 2].map(|a| points.iter().map(|p| p[a]).sum::<f64>() / n);
+        let dot = |u: [f64; 3], p: &[f64; 3]| (0..3).map(|a| u[a] * (p[a] - c[a])).sum::<f64>();
+        points
+            .iter()
+            .map(|p| {
+                let t = dot(self.quarter, p).atan2(dot(self.zero, p));
+                if self.sin { t.sin() } else { t.cos() }
+            })
+            .collect()
+    }
+}
+
 /// What an expect measures.
 #[derive(Clone, Debug)]
 pub enum Measure {
@@ -131,7 +158,9 @@ pub enum Measure {
         at: Option<f64>,
     },
     /// A value along a 3D crack front at the last measurement (`qty` 0..4 = K_I, K_II,
-    /// K_III, J_1): the one farthest from `reference` over the front's vertices.
+    /// K_III, J_1): over the front's vertices, the one farthest from the reference there,
+    /// given as `reference` plus that difference (so that the error is the difference over
+    /// |reference|, the amplitude when the reference varies `along` the front).
     Front {
         /// Crack index.
         crack: u32,
@@ -139,6 +168,8 @@ pub enum Measure {
         qty: usize,
         /// The reference the values are compared with.
         reference: f64,
+        /// How the reference varies along the front, if it does.
+        along: Option<Along>,
     },
     /// How far K at a crack tip moves once settled: the largest |K(t) - K(end)| over the
     /// rows from `from` on, relative to |K(end)| (K as the vector (K_I, K_II)).
@@ -259,19 +290,23 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             crack,
             qty,
             reference,
+            along,
         } => {
             let rows = h.fracture.iter().filter(|r| r.crack == crack);
             let last = rows.clone().map(|r| r.step).max()?;
-            rows.filter(|r| r.step == last)
-                .map(|r| [r.k[0], r.k[1], r.k[2], r.j[0]][qty])
-                .try_fold(None, |worst: Option<f64>, v| {
-                    let v = finite(v)?;
-                    Some(Some(match worst {
-                        Some(w) if (w - reference).abs() >= (v - reference).abs() => w,
-                        _ => v,
-                    }))
+            let rows: Vec<&TipResult> = rows.filter(|r| r.step == last).collect();
+            let factors = match along {
+                Some(a) => a.factors(&rows.iter().map(|r| r.x).collect::<Vec<_>>()),
+                None => vec![1.0; rows.len()],
+            };
+            rows.iter()
+                .zip(factors)
+                .map(|(r, f)| [r.k[0], r.k[1], r.k[2], r.j[0]][qty] - reference * f)
+                .try_fold(0.0, |worst: f64, d| {
+                    let d = finite(d)?;
+                    Some(if d.abs() > worst.abs() { d } else { worst })
                 })
-                .flatten()
+                .map(|d| reference + d)
         }
         Measure::KDrift { crack, tip, from } => {
             let rows: Vec<&TipResult> = h
@@ -433,6 +468,50 @@ pub fn path_difference(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A front expect with a reference varying as cos(theta) about a ring's centre reads
+    /// the reference plus the largest departure from it, at whichever vertex that is, and
+    /// only the last measurement counts.
+    #[test]
+    fn front_measure_takes_the_worst_vertex_against_the_curve() {
+        use std::f64::consts::PI;
+        let along = Along {
+            sin: false,
+            zero: [0.0, 0.0, 1.0],
+            quarter: [1.0, 0.0, 0.0],
+        };
+        let (amp, centre) = (2.0e6, [0.3, -0.1, 0.2]);
+        let mut h = History::default();
+        for (step, dev) in [(1, 5.0e5), (2, 3.0e4)] {
+            for k in 0..12u32 {
+                let t = f64::from(k) * PI / 6.0;
+                let x = [
+                    centre[0] + 0.01 * t.sin(),
+                    centre[1],
+                    centre[2] + 0.01 * t.cos(),
+                ];
+                let off = if k == 7 { -dev } else { 0.1 * dev };
+                h.fracture.push(TipResult {
+                    step,
+                    crack: 0,
+                    tip: k,
+                    x,
+                    k: [0.0, amp * t.cos() + off, 0.0],
+                    ..TipResult::default()
+                });
+            }
+        }
+        let m = Measure::Front {
+            crack: 0,
+            qty: 1,
+            reference: amp,
+            along: Some(along),
+        };
+        let got = measure(&m, &h, &[]).unwrap();
+        assert!((got - (amp - 3.0e4)).abs() < 1e-6, "{got}");
+        let factors = along.factors(&h.fracture[..12].iter().map(|r| r.x).collect::<Vec<_>>());
+        assert!((factors[2] - 0.5).abs() < 1e-12 && (factors[6] + 1.0).abs() < 1e-12);
+    }
 
     #[test]
     fn frequency_of_a_sampled_sine() {

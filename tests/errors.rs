@@ -412,6 +412,75 @@ fn bad_crack_surfaces_name_the_problem() {
     );
 }
 
+/// Two cracks that cross are refused, naming both and the elements that meet; apart,
+/// they are accepted.
+#[test]
+fn crossing_cracks_are_refused() {
+    let pennies = |z: f64| {
+        format!(
+            "[[crack]]\nname = \"a\"\npenny = {{ center = [0.01, 0.01, 0.01], normal = [0.0, 0.0, 1.0], \
+             radius = 0.003 }}\n[[crack]]\nname = \"b\"\npenny = {{ center = [0.01, 0.01, {z}], \
+             normal = [1.0, 0.0, 0.0], radius = 0.003 }}\n"
+        )
+    };
+    let e = error_3d(&pennies(0.01));
+    assert_error(&e, "crack[1]", Some(21), "meets crack `a` (its triangle");
+    let e = error_with_text(
+        "[[crack]]\nname = \"a\"\nline = { start = [0.006, 0.01], end = [0.014, 0.01] }\n\
+         [[crack]]\nline = { start = [0.01, 0.006], end = [0.01, 0.014] }\n",
+    );
+    assert_error(&e, "crack[1].line", Some(22), "meets crack `a` (its segment");
+    let text = GOOD
+        .replace("dimension = 2", "dimension = 3")
+        .replace("[0.0, 0.0]", "[0.0, 0.0, 0.0]")
+        .replace("[0.02, 0.02]", "[0.02, 0.02, 0.02]")
+        .replace("[0.002, 0.002]", "[0.002, 0.002, 0.002]")
+        .replace("[0.004, 0.004]", "[0.004, 0.004, 0.004]")
+        .replace("[0.016, 0.016]", "[0.016, 0.016, 0.016]")
+        + &pennies(0.0145);
+    let src = Source::parse("ok.toml", &text, &[]).unwrap();
+    assert!(fissure::scenario::build::<fissure::dim::D3>(&src).is_ok(), "apart, they are fine");
+}
+
+/// Expects along a 3D front: the 2D tip quantities are refused in 3D and the front ones in
+/// 2D; a bad `along` names its key.
+#[test]
+fn bad_front_expects_name_the_key() {
+    let penny = "[[crack]]\nname = \"p\"\npenny = { center = [0.01, 0.01, 0.01], \
+                 normal = [0.0, 0.0, 1.0], radius = 0.003 }\n[fracture]\n";
+    let expect = |q: &str, more: &str| {
+        format!(
+            "{penny}[[expect]]\nquantity = \"{q}\"\ncrack = \"p\"\nreference = 1.0\n\
+             source = \"s\"\ntolerance = 0.1\n{more}"
+        )
+    };
+    let along = |a: &str| format!("along = {{ {a} }}\n");
+    let e = error_3d(&expect("KI", ""));
+    assert_error(&e, "expect[0].quantity", None, "use KI_front");
+    let e = error_3d(&expect(
+        "KII_front",
+        &along("shape = \"tan\", zero = [1.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0]"),
+    ));
+    assert_error(&e, "expect[0].along.shape", None, "unknown shape `tan`");
+    let e = error_3d(&expect(
+        "KII_front",
+        &along("shape = \"cos\", zero = [0.0, 0.0, 2.0], normal = [0.0, 0.0, 1.0]"),
+    ));
+    assert_error(&e, "expect[0].along.zero", None, "parallel");
+    let e = error_3d(&expect(
+        "KII_front",
+        &along("shape = \"cos\", zero = [1.0, 0.0], normal = [0.0, 0.0, 1.0]"),
+    ));
+    assert_error(&e, "expect[0].along.zero", None, "three components");
+    let e = error_3d(&expect("KI_front", "tip = \"end\"\n"));
+    assert_error(&e, "expect[0].tip", None, "every front vertex");
+    let e = error_with_text(
+        "[[expect]]\nquantity = \"KI_front\"\ncrack = \"p\"\nreference = 1.0\n\
+         source = \"s\"\ntolerance = 0.1\n",
+    );
+    assert_error(&e, "expect[0].quantity", None, "3D crack front");
+}
+
 /// Inputs that used to be accepted although wrong: a name that is not one folder name, two
 /// time-step settings, a modulus whose derived quantities overflow, two cracks of one
 /// name, a crack that folds back on itself.

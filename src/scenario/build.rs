@@ -554,6 +554,12 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 ),
             ));
         }
+        if e.along.is_some() && front_qty.is_none() {
+            return Err(src.error(
+                &key("along"),
+                "`along` applies to KI_front, KII_front, KIII_front and J1_front",
+            ));
+        }
         if D::D == 2 && front_qty.is_some() {
             return Err(src.error(
                 &key("quantity"),

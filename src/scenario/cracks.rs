@@ -1,7 +1,7 @@
 //! Building the crack store from `[[crack]]` tables, with every check a crack needs.
 
 use super::build::{positive, to_vec, vec3};
-use super::schema::{CrackSpec, ExpectSpec};
+use super::schema::{AlongSpec, CrackSpec, ExpectSpec};
 use super::source::Source;
 use super::surface;
 use crate::crack::{Contact, Cracks, Element, Law, MAX_CRACKS};
@@ -9,8 +9,9 @@ use crate::dim::Dim;
 use crate::error::ScenarioError;
 use crate::fracture::{FracturePlan, KMethod};
 use crate::grid::GridGeom;
-use crate::measure::Measure;
+use crate::measure::{Along, Measure};
 use crate::particles::Particles;
+use glam::DVec3;
 use std::collections::HashMap;
 
 type R<T> = Result<T, ScenarioError>;
@@ -86,6 +87,19 @@ pub(super) fn build<D: Dim>(
                     ),
                 ));
             }
+        }
+        if let Some((k, mine, theirs)) =
+            super::crack_meet::meets(&store, &piece.points, &piece.elems)
+        {
+            let what = if D::D == 2 { "segment" } else { "triangle" };
+            return Err(src.error(
+                &piece.key,
+                format!(
+                    "the crack meets crack `{}` (its {what} {mine} and their {what} {theirs}): \
+                     cracks must not cross or touch",
+                    store.topology.cracks()[k].name
+                ),
+            ));
         }
         let contact = contact(src, c, spec)?;
         let name = spec.name.clone().unwrap_or_else(|| format!("crack{c}"));
@@ -495,9 +509,10 @@ pub(super) fn fracture_plan<D: Dim>(
         ));
     }
     let k_method = match f.k_from.as_deref() {
-        // In 3D the tube's J carries the front's curvature exactly and the interaction
-        // integral does not (see `crate::front_integral`), so G comes from J by default.
-        None if D::D == 3 => KMethod::Mixity,
+        // In 3D the tube's J carries the front's curvature and the interaction integral
+        // does not (see `crate::front_integral`): by default G = J is split by the crack
+        // opening, the 3D paper's method.
+        None if D::D == 3 => KMethod::Opening,
         None | Some("interaction") => KMethod::Interaction,
         Some("mixity") => KMethod::Mixity,
         Some("opening") => KMethod::Opening,
@@ -623,10 +638,53 @@ pub(super) fn front_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) 
         .enumerate()
         .position(|(k, c)| c.name.clone().unwrap_or_else(|| format!("crack{k}")) == name)
         .ok_or_else(|| src.error(&key("crack"), format!("no crack named `{name}`")))?;
+    let along = match &e.along {
+        None => None,
+        Some(a) => Some(along(src, &key("along"), a)?),
+    };
     Ok(Measure::Front {
         crack: crack as u32,
         qty,
         reference: e.reference,
+        along,
+    })
+}
+
+/// The checked `along` of a front expect: a shape of cos or sin, and a `zero` direction
+/// with a component off the `normal` axis.
+fn along(src: &Source, key: &str, a: &AlongSpec) -> R<Along> {
+    let sin = match a.shape.as_str() {
+        "cos" => false,
+        "sin" => true,
+        other => {
+            return Err(src.error(
+                &format!("{key}.shape"),
+                format!("unknown shape `{other}`: give \"cos\" or \"sin\""),
+            ));
+        }
+    };
+    let unit = |name: &str, v: &[f64]| -> R<DVec3> {
+        let k = format!("{key}.{name}");
+        let v: [f64; 3] = v
+            .try_into()
+            .map_err(|_| src.error(&k, "give three components"))?;
+        let v = DVec3::from(v);
+        if !(v.is_finite() && v.length() > 0.0) {
+            return Err(src.error(&k, "must be a finite, non-zero direction"));
+        }
+        Ok(v.normalize())
+    };
+    let n = unit("normal", &a.normal)?;
+    let z = unit("zero", &a.zero)?;
+    let zero = z - z.dot(n) * n;
+    if zero.length() < 1e-6 {
+        return Err(src.error(&format!("{key}.zero"), "is parallel to `normal`"));
+    }
+    let zero = zero.normalize();
+    Ok(Along {
+        sin,
+        zero: zero.to_array(),
+        quarter: n.cross(zero).to_array(),
     })
 }
 

@@ -2,6 +2,7 @@
 //! World from them ([`build`]).
 
 pub mod build;
+mod crack_meet;
 mod cracks;
 mod region;
 pub mod schema;

@@ -448,11 +448,26 @@ pub struct FractureSpec {
     pub opening: Option<f64>,
     /// Which K are reported in the KI, KII (, KIII) columns and expects: "interaction" (the
     /// interaction integral; the 2D default), "mixity" (G from J split in the interaction
-    /// integral's ratios; the 3D default) or "opening" (G split by the crack opening).
+    /// integral's ratios) or "opening" (G split by the crack opening; the 3D default).
     pub k_from: Option<String>,
     /// Radius of the interaction integral's domain around the tip, in cells (default 6 in
     /// 2D; in 3D the radius and half-length of the tube around the front, default 3).
     pub domain: Option<f64>,
+}
+
+/// `along = { shape, zero, normal }` of a front expect: the reference at a front vertex is
+/// `reference` times cos(theta) or sin(theta), theta the vertex's angle about the front's
+/// centre (the mean of its vertices) from the direction `zero`, counterclockwise about
+/// `normal` (e.g. an inclined penny's K_II and K_III).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AlongSpec {
+    /// "cos" or "sin".
+    pub shape: String,
+    /// Direction of theta = 0 (projected onto the plane normal to `normal`).
+    pub zero: Vec<f64>,
+    /// Axis theta turns about.
+    pub normal: Vec<f64>,
 }
 
 /// `[checkpoint]`: when to write snapshots into `<out>/snapshots/` (any combination; none
@@ -492,6 +507,9 @@ pub struct ExpectSpec {
     pub at: Option<f64>,
     /// For K_drift: the start of the window (s).
     pub from: Option<f64>,
+    /// For the front quantities: how the reference varies along the front (default: it
+    /// does not).
+    pub along: Option<AlongSpec>,
     /// Reference value (SI).
     pub reference: f64,
     /// Where the reference comes from.

@@ -1,0 +1,95 @@
+//! Whether a new crack meets one already in the store. Cracks must not cross or touch:
+//! each crack splits the velocity field on its own, so where two meet a node's fields
+//! would be ambiguous.
+
+use crate::crack::{Cracks, Element};
+use crate::dim::Dim;
+
+/// Bounding box of a crack element (m).
+type Bounds = ([f64; 3], [f64; 3]);
+
+fn bounds<D: Dim>(v: &[D::Vec], e: &D::Elem) -> Bounds {
+    let mut b = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &k in e.vertices() {
+        for (a, x) in D::to_xyz(v[k as usize]).into_iter().enumerate() {
+            b.0[a] = b.0[a].min(x);
+            b.1[a] = b.1[a].max(x);
+        }
+    }
+    b
+}
+
+fn overlap(a: &Bounds, b: &Bounds) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
+}
+
+/// The edges of a crack element as vertex pairs: the segment itself in 2D, the three
+/// edges of a triangle in 3D.
+fn edges<D: Dim>(e: &D::Elem) -> Vec<[u32; 2]> {
+    let v = e.vertices();
+    if v.len() == 2 {
+        vec![[v[0], v[1]]]
+    } else {
+        (0..v.len()).map(|k| [v[k], v[(k + 1) % v.len()]]).collect()
+    }
+}
+
+/// Whether an edge of element `a` (vertices `va`) crosses element `b` (vertices `vb`), by
+/// the exact predicates of [`Dim::crossing`] (an end on `b`'s line or plane counts).
+fn edge_crosses<D: Dim>(va: &[D::Vec], a: &D::Elem, vb: &[D::Vec], b: D::Elem) -> bool {
+    edges::<D>(a)
+        .iter()
+        .any(|&[p, q]| D::crossing(va[p as usize], va[q as usize], vb, b) != 0)
+}
+
+/// The first crack of `store` that the new crack of `points` and `elems` meets, with the
+/// indices of the two elements that meet (the new crack's, then the other's within its
+/// crack), in index order.
+pub(super) fn meets<D: Dim>(
+    store: &Cracks<D>,
+    points: &[D::Vec],
+    elems: &[D::Elem],
+) -> Option<(usize, usize, usize)> {
+    let topo = &store.topology;
+    let vx = &store.geometry.x;
+    let mine: Vec<Bounds> = elems.iter().map(|e| bounds::<D>(points, e)).collect();
+    for c in 0..topo.cracks().len() {
+        // The other crack's elements sorted by the low x of their boxes, so that only those
+        // whose box can reach a new element's are tried.
+        let theirs: Vec<(Bounds, usize, D::Elem)> = (topo.elems().iter())
+            .zip(topo.elem_crack())
+            .filter(|(_, k)| **k as usize == c)
+            .enumerate()
+            .map(|(i, (e, _))| (bounds::<D>(vx, e), i, *e))
+            .collect();
+        let widest = theirs
+            .iter()
+            .map(|(b, _, _)| b.1[0] - b.0[0])
+            .fold(0.0, f64::max);
+        let mut order: Vec<usize> = (0..theirs.len()).collect();
+        order.sort_by(|&i, &j| theirs[i].0.0[0].total_cmp(&theirs[j].0.0[0]));
+        let low: Vec<f64> = order.iter().map(|&i| theirs[i].0.0[0]).collect();
+        let mut found: Option<(usize, usize)> = None;
+        for (ia, (ea, ba)) in elems.iter().zip(&mine).enumerate() {
+            let from = low.partition_point(|&x| x < ba.0[0] - widest);
+            let to = low.partition_point(|&x| x <= ba.1[0]);
+            for &j in &order[from..to] {
+                let (bb, ib, eb) = &theirs[j];
+                if overlap(ba, bb)
+                    && (edge_crosses::<D>(points, ea, vx, *eb)
+                        || edge_crosses::<D>(vx, eb, points, *ea))
+                    && found.is_none_or(|f| (ia, *ib) < f)
+                {
+                    found = Some((ia, *ib));
+                }
+            }
+            if found.is_some() {
+                break;
+            }
+        }
+        if let Some((ia, ib)) = found {
+            return Some((c, ia, ib));
+        }
+    }
+    None
+}
