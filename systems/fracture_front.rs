@@ -10,6 +10,7 @@ use crate::fracture::{FracturePlan, KMethod, Measured, TipResult};
 use crate::front::{FrontFrame, front_line};
 use crate::front_integral::{Elastic3, Facet, Tube, front_integrals};
 use crate::world::World;
+use rayon::prelude::*;
 
 /// J and K at every front vertex, into the crack scratch's `measured`.
 pub fn run(world: &mut World<D3>, plan: &FracturePlan) {
@@ -35,53 +36,59 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
         length: plan.domain * h,
     };
     let facets = facets(cracks);
+    let elastic = |m: u16| {
+        let e = &world.materials[m as usize];
+        Elastic3 {
+            mu: e.mu,
+            nu: e.poisson,
+        }
+    };
     let mut ordinal = vec![0u32; cracks.topology.cracks().len()];
     for front in cracks.topology.fronts() {
+        let c = front.crack as usize;
         let line = front_line(cracks, front);
-        for (k, frame) in line.frames.iter().enumerate() {
-            let c = front.crack as usize;
-            let near: Vec<Facet> = (facets.iter())
-                .filter(|f| (f.centroid - frame.x).length() < tube.radius + tube.length + h)
-                .copied()
-                .collect();
-            let elastic = |m: u16| {
-                let e = &world.materials[m as usize];
-                Elastic3 {
-                    mu: e.mu,
-                    nu: e.poisson,
-                }
-            };
-            let fi = front_integrals(world, cracks, &line, k, &near, tube, elastic);
-            let opening = opening(cracks, c, frame, h, plan.opening * h);
-            let (k_opening, k_mixity) = match fi.material.map(elastic) {
-                Some(el) => (
-                    k_split(
-                        el,
-                        fi.j,
-                        [opening[0] / el.c1(), opening[1] / el.c1(), opening[2] / 4.0],
+        // Each vertex is measured on its own, in parallel; the rows keep the front's order.
+        let rows: Vec<TipResult> = (0..line.frames.len())
+            .into_par_iter()
+            .map(|k| {
+                let frame = &line.frames[k];
+                let near: Vec<Facet> = (facets.iter())
+                    .filter(|f| (f.centroid - frame.x).length() < tube.radius + tube.length + h)
+                    .copied()
+                    .collect();
+                let fi = front_integrals(world, cracks, &line, k, &near, tube, elastic);
+                let opening = opening(cracks, c, frame, h, plan.opening * h);
+                let (k_opening, k_mixity) = match fi.material.map(elastic) {
+                    Some(el) => (
+                        k_split(
+                            el,
+                            fi.j,
+                            [opening[0] / el.c1(), opening[1] / el.c1(), opening[2] / 4.0],
+                        ),
+                        k_split(el, fi.j, fi.k),
                     ),
-                    k_split(el, fi.j, fi.k),
-                ),
-                None => ([f64::NAN; 3], [f64::NAN; 3]),
-            };
-            m.tips.push(TipResult {
-                step: world.step,
-                time: world.time,
-                crack: c as u32,
-                tip: ordinal[c],
-                x: frame.x.to_array(),
-                j: [fi.j, f64::NAN],
-                k: match plan.k_method {
-                    KMethod::Interaction => fi.k,
-                    KMethod::Mixity => k_mixity,
-                    KMethod::Opening => k_opening,
-                },
-                k_interaction: fi.k,
-                k_opening,
-                domain: fi.radius,
-            });
-            ordinal[c] += 1;
-        }
+                    None => ([f64::NAN; 3], [f64::NAN; 3]),
+                };
+                TipResult {
+                    step: world.step,
+                    time: world.time,
+                    crack: c as u32,
+                    tip: ordinal[c] + k as u32,
+                    x: frame.x.to_array(),
+                    j: [fi.j, f64::NAN],
+                    k: match plan.k_method {
+                        KMethod::Interaction => fi.k,
+                        KMethod::Mixity => k_mixity,
+                        KMethod::Opening => k_opening,
+                    },
+                    k_interaction: fi.k,
+                    k_opening,
+                    domain: fi.radius,
+                }
+            })
+            .collect();
+        ordinal[c] += rows.len() as u32;
+        m.tips.extend(rows);
     }
     m
 }

@@ -429,7 +429,12 @@ fn crossing_cracks_are_refused() {
         "[[crack]]\nname = \"a\"\nline = { start = [0.006, 0.01], end = [0.014, 0.01] }\n\
          [[crack]]\nline = { start = [0.01, 0.006], end = [0.01, 0.014] }\n",
     );
-    assert_error(&e, "crack[1].line", Some(22), "meets crack `a` (its segment");
+    assert_error(
+        &e,
+        "crack[1].line",
+        Some(22),
+        "meets crack `a` (its segment",
+    );
     let text = GOOD
         .replace("dimension = 2", "dimension = 3")
         .replace("[0.0, 0.0]", "[0.0, 0.0, 0.0]")
@@ -439,7 +444,10 @@ fn crossing_cracks_are_refused() {
         .replace("[0.016, 0.016]", "[0.016, 0.016, 0.016]")
         + &pennies(0.0145);
     let src = Source::parse("ok.toml", &text, &[]).unwrap();
-    assert!(fissure::scenario::build::<fissure::dim::D3>(&src).is_ok(), "apart, they are fine");
+    assert!(
+        fissure::scenario::build::<fissure::dim::D3>(&src).is_ok(),
+        "apart, they are fine"
+    );
 }
 
 /// Expects along a 3D front: the 2D tip quantities are refused in 3D and the front ones in
