@@ -91,11 +91,24 @@ pub struct History {
     pub paths: Vec<PathResult>,
 }
 
-/// A reference that varies along a front as cos or sin of the angle about its centre.
+/// How a reference varies along a front with the angle theta about its centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// cos(theta).
+    Cos,
+    /// sin(theta).
+    Sin,
+    /// Irwin's (sin^2 phi + r^2 cos^2 phi)^(1/4) (Irwin 1962) for an ellipse of axis ratio
+    /// r = b/a with its major axis along theta = 0, phi the parametric angle:
+    /// tan(phi) = tan(theta) / r.
+    Ellipse(f64),
+}
+
+/// A reference that varies along a front with the angle about its centre.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Along {
-    /// sin(theta) rather than cos(theta).
-    pub sin: bool,
+    /// The variation.
+    pub shape: Shape,
     /// Unit direction of theta = 0.
     pub zero: [f64; 3],
     /// Unit direction of theta = 90 degrees (normal x zero).
@@ -111,8 +124,16 @@ impl Along {
         points
             .iter()
             .map(|p| {
-                let t = dot(self.quarter, p).atan2(dot(self.zero, p));
-                if self.sin { t.sin() } else { t.cos() }
+                let (v, u) = (dot(self.quarter, p), dot(self.zero, p));
+                let t = v.atan2(u);
+                match self.shape {
+                    Shape::Cos => t.cos(),
+                    Shape::Sin => t.sin(),
+                    Shape::Ellipse(r) => {
+                        let phi = v.atan2(u * r);
+                        (phi.sin().powi(2) + r * r * phi.cos().powi(2)).powf(0.25)
+                    }
+                }
             })
             .collect()
     }
@@ -476,7 +497,7 @@ mod tests {
     fn front_measure_takes_the_worst_vertex_against_the_curve() {
         use std::f64::consts::PI;
         let along = Along {
-            sin: false,
+            shape: Shape::Cos,
             zero: [0.0, 0.0, 1.0],
             quarter: [1.0, 0.0, 0.0],
         };
@@ -511,6 +532,29 @@ mod tests {
         assert!((got - (amp - 3.0e4)).abs() < 1e-6, "{got}");
         let factors = along.factors(&h.fracture[..12].iter().map(|r| r.x).collect::<Vec<_>>());
         assert!((factors[2] - 0.5).abs() < 1e-12 && (factors[6] + 1.0).abs() < 1e-12);
+    }
+
+    /// On an ellipse of semi-axes a (along `zero`) and b, the ellipse shape at the point of
+    /// parametric angle phi is Irwin's (sin^2 phi + (b/a)^2 cos^2 phi)^(1/4).
+    #[test]
+    fn ellipse_shape_is_irwins() {
+        let (a, b) = (0.035, 0.02);
+        let along = Along {
+            shape: Shape::Ellipse(b / a),
+            zero: [1.0, 0.0, 0.0],
+            quarter: [0.0, 0.0, 1.0],
+        };
+        let phis: Vec<f64> = (0..24)
+            .map(|k| f64::from(k) * std::f64::consts::PI / 12.0)
+            .collect();
+        let pts: Vec<[f64; 3]> = phis
+            .iter()
+            .map(|p| [a * p.cos(), 0.1, b * p.sin()])
+            .collect();
+        for (f, p) in along.factors(&pts).iter().zip(&phis) {
+            let want = (p.sin().powi(2) + (b / a).powi(2) * p.cos().powi(2)).powf(0.25);
+            assert!((f - want).abs() < 1e-12, "phi {p}: {f} vs {want}");
+        }
     }
 
     #[test]

@@ -480,6 +480,11 @@ fn bad_front_expects_name_the_key() {
         &along("shape = \"cos\", zero = [1.0, 0.0], normal = [0.0, 0.0, 1.0]"),
     ));
     assert_error(&e, "expect[0].along.zero", None, "three components");
+    let e = error_3d(&expect(
+        "KI_front",
+        &along("shape = \"ellipse\", zero = [1.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0]"),
+    ));
+    assert_error(&e, "expect[0].along.ratio", None, "needs `ratio`");
     let e = error_3d(&expect("KI_front", "tip = \"end\"\n"));
     assert_error(&e, "expect[0].tip", None, "every front vertex");
     let e = error_with_text(

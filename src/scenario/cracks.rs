@@ -9,7 +9,7 @@ use crate::dim::Dim;
 use crate::error::ScenarioError;
 use crate::fracture::{FracturePlan, KMethod};
 use crate::grid::GridGeom;
-use crate::measure::{Along, Measure};
+use crate::measure::{Along, Measure, Shape};
 use crate::particles::Particles;
 use glam::DVec3;
 use std::collections::HashMap;
@@ -653,13 +653,23 @@ pub(super) fn front_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) 
 /// The checked `along` of a front expect: a shape of cos or sin, and a `zero` direction
 /// with a component off the `normal` axis.
 fn along(src: &Source, key: &str, a: &AlongSpec) -> R<Along> {
-    let sin = match a.shape.as_str() {
-        "cos" => false,
-        "sin" => true,
-        other => {
+    let shape = match (a.shape.as_str(), a.ratio) {
+        ("cos", None) => Shape::Cos,
+        ("sin", None) => Shape::Sin,
+        ("ellipse", Some(r)) if r > 0.0 && r <= 1.0 => Shape::Ellipse(r),
+        ("ellipse", _) => {
+            return Err(src.error(
+                &format!("{key}.ratio"),
+                "an ellipse needs `ratio` = b/a of its semi-axes, in (0, 1]",
+            ));
+        }
+        ("cos" | "sin", Some(_)) => {
+            return Err(src.error(&format!("{key}.ratio"), "`ratio` is for shape \"ellipse\""));
+        }
+        (other, _) => {
             return Err(src.error(
                 &format!("{key}.shape"),
-                format!("unknown shape `{other}`: give \"cos\" or \"sin\""),
+                format!("unknown shape `{other}`: give \"cos\", \"sin\" or \"ellipse\""),
             ));
         }
     };
@@ -682,7 +692,7 @@ fn along(src: &Source, key: &str, a: &AlongSpec) -> R<Along> {
     }
     let zero = zero.normalize();
     Ok(Along {
-        sin,
+        shape,
         zero: zero.to_array(),
         quarter: n.cross(zero).to_array(),
     })

@@ -458,16 +458,20 @@ pub struct FractureSpec {
 /// `along = { shape, zero, normal }` of a front expect: the reference at a front vertex is
 /// `reference` times cos(theta) or sin(theta), theta the vertex's angle about the front's
 /// centre (the mean of its vertices) from the direction `zero`, counterclockwise about
-/// `normal` (e.g. an inclined penny's K_II and K_III).
+/// `normal` (e.g. an inclined penny's K_II and K_III); or, with shape "ellipse" and
+/// `ratio` = b/a, Irwin's (sin^2 phi + (b/a)^2 cos^2 phi)^(1/4) for an elliptical front
+/// whose major axis is `zero`, phi its parametric angle (1 at the ends of the minor axis).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AlongSpec {
-    /// "cos" or "sin".
+    /// "cos", "sin" or "ellipse".
     pub shape: String,
     /// Direction of theta = 0 (projected onto the plane normal to `normal`).
     pub zero: Vec<f64>,
     /// Axis theta turns about.
     pub normal: Vec<f64>,
+    /// For "ellipse": the ratio b/a of the minor to the major semi-axis, in (0, 1].
+    pub ratio: Option<f64>,
 }
 
 /// `[checkpoint]`: when to write snapshots into `<out>/snapshots/` (any combination; none
