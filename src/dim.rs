@@ -83,7 +83,7 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     /// Gradient of the tensor-product shape function for stencil offsets (i, j, k).
     fn grad(w: &[[f64; 3]; 3], dw: &[[f64; 3]; 3], i: usize, j: usize, k: usize) -> Self::Vec;
     /// Whether the line from `p` to `q` crosses crack element `e` of vertices `v` (2D: the
-    /// segment e[0]-e[1]; 3D: the triangle e[0], e[1], e[2]): +1 if `p` is above it (left of
+    /// segment `e[0]`-`e[1]`; 3D: the triangle `e[0]`, `e[1]`, `e[2]`): +1 if `p` is above it (left of
     /// the segment's direction; on the side of the triangle's counterclockwise normal), -1
     /// if below, 0 if there is no crossing. Exact orientation predicates (Shewchuk's, from
     /// `robust`); a point exactly on the crack line or plane counts as above, so a line
@@ -382,7 +382,7 @@ impl Dim for D3 {
     }
 }
 
-/// Directions along which [`edge_side`] moves a line that meets an edge exactly.
+/// Directions along which `edge_side` moves a line that meets an edge exactly.
 pub const NUDGE: [DVec3; 2] = [
     DVec3::new(0.571_428_57, 0.301_953_12, 0.763_143_73),
     DVec3::new(-0.212_121_21, 0.927_835_05, 0.306_651_63),

@@ -46,7 +46,7 @@ pub struct Summary {
     pub bytes_per_node: usize,
     /// Energies at the end (J).
     pub energies: Energies,
-    /// Results of the scenario's [[expect]] blocks (only for a completed run).
+    /// Results of the scenario's `[[expect]]` blocks (only for a completed run).
     pub expects: Vec<ExpectResult>,
     /// Path dependence of J per crack tip and compared contour (`[fracture] compare`).
     pub paths: Vec<PathReport>,

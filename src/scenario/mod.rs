@@ -1,5 +1,5 @@
 //! Scenario files: format ([`schema`]), reading with overrides ([`source`]) and building a
-//! World from them ([`build`]).
+//! World from them (`build::build`).
 
 pub mod build;
 mod crack_meet;
