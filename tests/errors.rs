@@ -340,15 +340,19 @@ fn bad_regions_name_the_key() {
 }
 
 /// `GOOD` in 3D (a 12 mm cube in a 20 mm grid) with `extra` appended, and its error.
-fn error_3d(extra: &str) -> ScenarioError {
-    let text = GOOD
-        .replace("dimension = 2", "dimension = 3")
+/// The good scenario made 3D, with `extra` appended.
+fn text_3d(extra: &str) -> String {
+    GOOD.replace("dimension = 2", "dimension = 3")
         .replace("[0.0, 0.0]", "[0.0, 0.0, 0.0]")
         .replace("[0.02, 0.02]", "[0.02, 0.02, 0.02]")
         .replace("[0.002, 0.002]", "[0.002, 0.002, 0.002]")
         .replace("[0.004, 0.004]", "[0.004, 0.004, 0.004]")
         .replace("[0.016, 0.016]", "[0.016, 0.016, 0.016]")
-        + extra;
+        + extra
+}
+
+fn error_3d(extra: &str) -> ScenarioError {
+    let text = text_3d(extra);
     match Source::parse("bad.toml", &text, &[]) {
         Err(e) => e,
         Ok(src) => match fissure::scenario::build::<fissure::dim::D3>(&src) {
@@ -435,15 +439,7 @@ fn crossing_cracks_are_refused() {
         Some(22),
         "meets crack `a` (its segment",
     );
-    let text = GOOD
-        .replace("dimension = 2", "dimension = 3")
-        .replace("[0.0, 0.0]", "[0.0, 0.0, 0.0]")
-        .replace("[0.02, 0.02]", "[0.02, 0.02, 0.02]")
-        .replace("[0.002, 0.002]", "[0.002, 0.002, 0.002]")
-        .replace("[0.004, 0.004]", "[0.004, 0.004, 0.004]")
-        .replace("[0.016, 0.016]", "[0.016, 0.016, 0.016]")
-        + &pennies(0.0145);
-    let src = Source::parse("ok.toml", &text, &[]).unwrap();
+    let src = Source::parse("ok.toml", &text_3d(&pennies(0.0145)), &[]).unwrap();
     assert!(
         fissure::scenario::build::<fissure::dim::D3>(&src).is_ok(),
         "apart, they are fine"

@@ -497,6 +497,25 @@ fn plot_fracture(
             },
         }
     }
+    k_plot(
+        path,
+        &format!("{name}: stress intensity factors"),
+        "time (s)",
+        &labels,
+        points,
+        k0,
+    )
+}
+
+/// Draws K series (over `k0` when given, which the y axis then says) into a PNG.
+fn k_plot(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    labels: &[String],
+    points: Vec<Vec<(f64, f64)>>,
+    k0: Option<f64>,
+) -> Result<(), String> {
     let series: Vec<Series> = labels
         .iter()
         .zip(points)
@@ -509,13 +528,7 @@ fn plot_fracture(
         Some(k0) => format!("K / K0 (K0 = {k0:.4e} Pa sqrt(m))"),
         None => "K (Pa sqrt(m))".to_string(),
     };
-    plot::lines(
-        path,
-        &format!("{name}: stress intensity factors"),
-        "time (s)",
-        &axis,
-        &series,
-    )
+    plot::lines(path, title, x_label, &axis, &series)
 }
 
 /// K_I, K_II and K_III along every 3D crack front at the last measurement, against the
@@ -543,25 +556,14 @@ fn plot_front(
             );
         }
     }
-    let series: Vec<Series> = labels
-        .iter()
-        .zip(points)
-        .map(|(l, p)| Series {
-            label: l,
-            points: p,
-        })
-        .collect();
-    let axis = match k0 {
-        Some(k0) => format!("K / K0 (K0 = {k0:.4e} Pa sqrt(m))"),
-        None => "K (Pa sqrt(m))".to_string(),
-    };
     let time = rows.first().map_or(0.0, |t| t.time);
-    plot::lines(
+    k_plot(
         path,
         &format!("{name}: K along the front at {time:.4e} s"),
         "front vertex",
-        &axis,
-        &series,
+        &labels,
+        points,
+        k0,
     )
 }
 

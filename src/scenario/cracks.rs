@@ -547,8 +547,9 @@ pub(super) fn fracture_plan<D: Dim>(
     }))
 }
 
-/// The crack and tip (0 start, 1 end) an expect names, checked.
-fn expect_tip(src: &Source, i: usize, e: &ExpectSpec) -> R<(u32, u32)> {
+/// The index and name of the crack a fracture expect names, checked: the scenario must
+/// measure J and K, and the crack must exist.
+fn measured_crack<'a>(src: &Source, i: usize, e: &'a ExpectSpec) -> R<(usize, &'a str)> {
     let key = |k: &str| format!("expect[{i}].{k}");
     let sc = &src.scenario;
     if sc.fracture.is_none() {
@@ -567,6 +568,14 @@ fn expect_tip(src: &Source, i: usize, e: &ExpectSpec) -> R<(u32, u32)> {
         .enumerate()
         .position(|(k, c)| c.name.clone().unwrap_or_else(|| format!("crack{k}")) == name)
         .ok_or_else(|| src.error(&key("crack"), format!("no crack named `{name}`")))?;
+    Ok((c, name))
+}
+
+/// The crack and tip (0 start, 1 end) an expect names, checked.
+fn expect_tip(src: &Source, i: usize, e: &ExpectSpec) -> R<(u32, u32)> {
+    let key = |k: &str| format!("expect[{i}].{k}");
+    let sc = &src.scenario;
+    let (c, name) = measured_crack(src, i, e)?;
     let tip = match e.tip.as_deref().unwrap_or("end") {
         "start" => 0,
         "end" => 1,
@@ -610,13 +619,7 @@ pub(super) fn tip_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) ->
 /// value farthest from the reference over the front's vertices, at the last measurement.
 pub(super) fn front_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) -> R<Measure> {
     let key = |k: &str| format!("expect[{i}].{k}");
-    let sc = &src.scenario;
-    if sc.fracture.is_none() {
-        return Err(src.error(
-            &key("quantity"),
-            format!("`{}` needs a [fracture] table", e.quantity),
-        ));
-    }
+    let (crack, _) = measured_crack(src, i, e)?;
     for (k, given) in [("tip", e.tip.is_some()), ("at", e.at.is_some())] {
         if given {
             return Err(src.error(
@@ -628,16 +631,6 @@ pub(super) fn front_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) 
             ));
         }
     }
-    let name = e
-        .crack
-        .as_deref()
-        .ok_or_else(|| src.error(&key("quantity"), "name the crack with `crack = ...`"))?;
-    let crack = sc
-        .cracks
-        .iter()
-        .enumerate()
-        .position(|(k, c)| c.name.clone().unwrap_or_else(|| format!("crack{k}")) == name)
-        .ok_or_else(|| src.error(&key("crack"), format!("no crack named `{name}`")))?;
     let along = match &e.along {
         None => None,
         Some(a) => Some(along(src, &key("along"), a)?),
