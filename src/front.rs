@@ -23,22 +23,24 @@ pub struct FrontFrame {
 impl FrontFrame {
     /// Components of the global vector `v` in front axes (Eq. 28).
     pub fn local(&self, v: DVec3) -> [f64; 3] {
-        self.e.map(|a| a.dot(v))
+        to_local(&self.e, v)
     }
 
     /// The global tensor `m` (`m[i][j]`, row i) in front axes (Eqs. 29-30).
     pub fn local_tensor(&self, m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
-        let rows = m.map(DVec3::from);
-        // (R m)_aj = e_a . column j of m; then (R m R^T)_ab = (R m)_a . e_b.
-        let rm = self.e.map(|a| {
-            DVec3::new(
-                a.dot(DVec3::new(rows[0].x, rows[1].x, rows[2].x)),
-                a.dot(DVec3::new(rows[0].y, rows[1].y, rows[2].y)),
-                a.dot(DVec3::new(rows[0].z, rows[1].z, rows[2].z)),
-            )
-        });
-        rm.map(|r| self.e.map(|b| r.dot(b)))
+        tensor_to_local(&self.e, m)
     }
+}
+
+/// Components of the global vector `v` along the unit axes `e`.
+pub fn to_local(e: &[DVec3; 3], v: DVec3) -> [f64; 3] {
+    e.map(|a| a.dot(v))
+}
+
+/// The global tensor `m` (`m[i][j]`, row i) in the unit axes `e`: e_a . (m e_b).
+pub fn tensor_to_local(e: &[DVec3; 3], m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let rows = m.map(DVec3::from);
+    e.map(|a| e.map(|b| a.dot(DVec3::new(rows[0].dot(b), rows[1].dot(b), rows[2].dot(b)))))
 }
 
 /// The frames at the vertices of a front, in its order, and whether the front is closed.

@@ -25,7 +25,7 @@
 
 use crate::crack::Cracks;
 use crate::dim::{D3, Dim};
-use crate::front::{FrontFrame, FrontLine};
+use crate::front::{FrontFrame, FrontLine, tensor_to_local, to_local};
 use crate::interaction::{accel, near};
 use crate::near_tip;
 use crate::sym::SymTensor;
@@ -448,11 +448,6 @@ fn gather(
                 at.x2 = at.x2.abs().copysign(side);
             }
         }
-        let local = FrontFrame {
-            vertex: frame.vertex,
-            x: frame.x,
-            e: at.e,
-        };
         let st = p.stress[i].to_sym3();
         let s = [
             [st.xx, st.xy, st.xz],
@@ -461,11 +456,11 @@ fn gather(
         ];
         let mat = |m: &<D3 as Dim>::Mat| [0, 1, 2].map(|r| [0, 1, 2].map(|c| D3::entry(m, r, c)));
         let fields = Fields {
-            s: local.local_tensor(s),
-            gu: local.local_tensor(mat(&p.grad_u[i])),
-            gv: local.local_tensor(mat(&p.grad_v[i])),
-            v: local.local(p.v[i]),
-            a: local.local(accel(world, cracks, i)),
+            s: tensor_to_local(&at.e, s),
+            gu: tensor_to_local(&at.e, mat(&p.grad_u[i])),
+            gv: tensor_to_local(&at.e, mat(&p.grad_v[i])),
+            v: to_local(&at.e, p.v[i]),
+            a: to_local(&at.e, accel(world, cracks, i)),
             vol: p.volume[i],
             mass: p.mass[i],
         };
@@ -631,12 +626,7 @@ mod tests {
                     g[i][j] = du[i];
                 }
             }
-            let f = FrontFrame {
-                vertex: 0,
-                x: DVec3::ZERO,
-                e: axes(phi),
-            };
-            f.local_tensor(g)
+            tensor_to_local(&axes(phi), g)
         };
         let sym = |g: &M3| [0, 1, 2].map(|i| [0, 1, 2].map(|j| 0.5 * (g[i][j] + g[j][i])));
         let s_act = [[3.0, 0.4, -0.7], [0.4, -1.2, 0.9], [-0.7, 0.9, 2.1]];
@@ -695,12 +685,7 @@ mod tests {
                         div[i] += (sp[i][j] - sm[i][j]) / (2.0 * d);
                     }
                 }
-                let div = FrontFrame {
-                    vertex: 0,
-                    x: DVec3::ZERO,
-                    e,
-                }
-                .local(div);
+                let div = to_local(&e, div);
                 let equil = dot(div, [gu_act[0][0], gu_act[1][0], gu_act[2][0]]);
                 let want = compat + equil;
                 assert!(
