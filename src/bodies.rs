@@ -19,7 +19,7 @@ pub enum Geometry {
         /// Whether z counts (sphere).
         sphere: bool,
     },
-    /// Circular cylinder along a coordinate axis.
+    /// Circular cylinder along a coordinate axis, hollow (a tube) when `inner` > 0.
     Cylinder {
         /// Centre of the base (m).
         center: [f64; 3],
@@ -27,6 +27,8 @@ pub enum Geometry {
         axis: usize,
         /// Radius (m).
         radius: f64,
+        /// Radius of the bore (m), 0 for a solid cylinder.
+        inner: f64,
         /// Length (m).
         length: f64,
     },
@@ -56,6 +58,7 @@ impl Geometry {
                 center,
                 axis,
                 radius,
+                inner,
                 length,
             } => {
                 let along = x[*axis] - center[*axis];
@@ -63,7 +66,7 @@ impl Geometry {
                     .filter(|a| a != axis)
                     .map(|a| (x[a] - center[a]).powi(2))
                     .sum();
-                (0.0..=*length).contains(&along) && r2 <= radius * radius
+                (0.0..=*length).contains(&along) && r2 <= radius * radius && r2 >= inner * inner
             }
             Geometry::Polygon { points, z } => {
                 if let Some([z0, z1]) = z
@@ -98,6 +101,7 @@ impl Geometry {
                 axis,
                 radius,
                 length,
+                ..
             } => {
                 let mut lo = *center;
                 let mut hi = *center;

@@ -6,14 +6,16 @@ use crate::material::{Elastic, Plane};
 /// What to measure at crack tips, from the scenario's `[fracture]` table.
 #[derive(Clone, Debug)]
 pub struct FracturePlan {
-    /// Half-size of the square J contour in cells (n for an n x n contour).
+    /// The main path J is measured on, in cells: in 2D the half-size n of the n x n square
+    /// contour; in 3D the tube's radius and half-length `domain` (when that is whole).
     pub contour: usize,
     /// Add the area integral of Guo & Nairn 2D (2004) Eq. 8 (path independence in dynamics).
     pub area_term: bool,
     /// End of the window behind the tip, in cells, over which the crack opening that splits
     /// G into K_I and K_II (and K_III in 3D) is fitted (it starts one cell behind the tip).
     pub opening: f64,
-    /// Further contour sizes (cells) on which J is also measured, for paths.csv.
+    /// Further contour sizes (cells; in 3D tube radii, each with its half-length) on which
+    /// J is also measured, for paths.csv.
     pub compare: Vec<usize>,
     /// Start of the window over which the contours are compared (s).
     pub compare_from: f64,

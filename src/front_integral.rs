@@ -44,6 +44,10 @@ const FILLED: f64 = 0.98;
 pub struct FrontIntegrals {
     /// J along x1, the energy release rate (J/m^2); NaN when no tube fits.
     pub j: f64,
+    /// The part of `j` from the terms weighted by q itself rather than by its gradient: the
+    /// volume term of Eq. 33 (inertia) and the turn of the virtual advance along a curved
+    /// front (J/m^2). What remains is what a thin tube's surface integral gives.
+    pub j_volume: f64,
     /// K_I, K_II, K_III (Pa sqrt(m)); NaN when no tube fits.
     pub k: [f64; 3],
     /// Tube radius used (m): smaller than asked when the asked one reached past the body's
@@ -290,6 +294,7 @@ pub fn front_integrals(
 ) -> FrontIntegrals {
     let none = FrontIntegrals {
         j: f64::NAN,
+        j_volume: f64::NAN,
         k: [f64::NAN; 3],
         radius: 0.0,
         material: None,
@@ -300,9 +305,10 @@ pub fn front_integrals(
     let el = elastic(material);
     let mut r = tube.radius;
     while r >= tube.min_radius {
-        if let Some((i, j)) = integrate(&samples, r, tube.length) {
+        if let Some((i, [j, j_volume])) = integrate(&samples, r, tube.length) {
             return FrontIntegrals {
                 j,
+                j_volume,
                 k: el.k_of(i),
                 radius: r,
                 material: Some(material),
@@ -469,12 +475,12 @@ fn gather(
     (!out.is_empty()).then_some((out, nearest.1))
 }
 
-/// The interaction integrals of the three modes and J over the tube of radius `rad` and
-/// half-length `len`, or None when particles fill less than [`FILLED`] of its weighted
-/// volume.
-fn integrate(samples: &[Sample], rad: f64, len: f64) -> Option<([f64; 3], f64)> {
+/// The interaction integrals of the three modes, and J with its part from the terms in q
+/// itself, over the tube of radius `rad` and half-length `len`; None when particles fill
+/// less than [`FILLED`] of its weighted volume.
+fn integrate(samples: &[Sample], rad: f64, len: f64) -> Option<([f64; 3], [f64; 2])> {
     let (ir, is) = (1.0 / (rad * rad), 1.0 / (len * len));
-    let (mut filled, mut sums) = (0.0, [0.0; 4]);
+    let (mut filled, mut sums, mut volume) = (0.0, [0.0; 4], 0.0);
     for p in samples {
         let rr = p.r * p.r * ir;
         let ss = p.s * p.s * is;
@@ -488,6 +494,7 @@ fn integrate(samples: &[Sample], rad: f64, len: f64) -> Option<([f64; 3], f64)> 
             qr * qs,
         ];
         filled += p.vol * w[2];
+        volume += w[2] * p.c[0][2];
         for (sum, c) in sums.iter_mut().zip(&p.c) {
             *sum += w[0] * c[0] + w[1] * c[1] + w[2] * c[2];
         }
@@ -497,7 +504,7 @@ fn integrate(samples: &[Sample], rad: f64, len: f64) -> Option<([f64; 3], f64)> 
     (filled >= FILLED * PI * rad * rad / 3.0 * along).then(|| {
         (
             [sums[1], sums[2], sums[3]].map(|m| m / along),
-            sums[0] / along,
+            [sums[0] / along, volume / along],
         )
     })
 }
@@ -719,7 +726,7 @@ mod tests {
         let e_prime = 2.0 * MU / (1.0 - NU);
         let g = (k[0] * k[0] + k[1] * k[1]) / e_prime + k[2] * k[2] / (2.0 * MU);
         for rad in [1.0e-3, 1.8e-3] {
-            let (i, j) = integrate(&samples, rad, 1.0e-3).expect("filled");
+            let (i, [j, _]) = integrate(&samples, rad, 1.0e-3).expect("filled");
             let got = el.k_of(i);
             for m in 0..3 {
                 assert!(

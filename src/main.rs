@@ -184,6 +184,23 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
             s.snapshot_seconds
         );
     }
+    for t in &s.tubes {
+        let part = |what: &str, v: &str| (!v.is_empty()).then(|| format!("{what} at vertices {v}"));
+        let parts: Vec<String> = [
+            part("no tube fits inside the body (J and K NaN)", &t.unfitted),
+            part("the tube was shrunk", &t.shrunk),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        println!(
+            "  note: crack `{}` ({} front vertices, tubes of {:.3e} m): {}",
+            t.crack,
+            t.vertices,
+            t.radius,
+            parts.join("; ")
+        );
+    }
     for e in &s.expects {
         println!(
             "  {} {:<22} value {:>12} reference {:>12.5e} error {:>10} tol {:.2e}",

@@ -179,9 +179,10 @@ pub enum Measure {
         at: Option<f64>,
     },
     /// A value along a 3D crack front at the last measurement (`qty` 0..4 = K_I, K_II,
-    /// K_III, J_1): over the front's vertices, the one farthest from the reference there,
-    /// given as `reference` plus that difference (so that the error is the difference over
-    /// |reference|, the amplitude when the reference varies `along` the front).
+    /// K_III, J_1): over the front's vertices (or at the one `near` a point), the one
+    /// farthest from the reference there, given as `reference` plus that difference (so
+    /// that the error is the difference over |reference|, the amplitude when the reference
+    /// varies `along` the front).
     Front {
         /// Crack index.
         crack: u32,
@@ -191,6 +192,8 @@ pub enum Measure {
         reference: f64,
         /// How the reference varies along the front, if it does.
         along: Option<Along>,
+        /// Only the vertex nearest this point (m), if given.
+        near: Option<[f64; 3]>,
     },
     /// How far K at a crack tip moves once settled: the largest |K(t) - K(end)| over the
     /// rows from `from` on, relative to |K(end)| (K as the vector (K_I, K_II)).
@@ -202,13 +205,16 @@ pub enum Measure {
         /// Start of the window (s).
         from: f64,
     },
-    /// Path dependence of J with the area term at a crack tip: the largest
-    /// [`path_difference`] of the compared contours against the main one.
+    /// Path dependence of J with the area (3D: volume) term at a crack tip: the largest
+    /// [`path_difference`] of the compared contours against the main one; along a 3D front
+    /// the largest over its vertices, or at the one `near` a point.
     PathDifference {
         /// Crack index.
         crack: u32,
-        /// 0 start, 1 end.
-        tip: u32,
+        /// 2D: 0 start, 1 end; None along a 3D front.
+        tip: Option<u32>,
+        /// 3D: only the front vertex nearest this point (m), if given.
+        near: Option<[f64; 3]>,
         /// Main contour size (cells).
         main: u32,
         /// Compared contour sizes (cells).
@@ -312,16 +318,19 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             qty,
             reference,
             along,
+            near,
         } => {
-            let rows = h.fracture.iter().filter(|r| r.crack == crack);
-            let last = rows.clone().map(|r| r.step).max()?;
-            let rows: Vec<&TipResult> = rows.filter(|r| r.step == last).collect();
+            let rows = last_rows(h, crack)?;
             let factors = match along {
                 Some(a) => a.factors(&rows.iter().map(|r| r.x).collect::<Vec<_>>()),
                 None => vec![1.0; rows.len()],
             };
+            let nearest = near.map(|p| nearest_row(&rows, p));
             rows.iter()
                 .zip(factors)
+                .enumerate()
+                .filter(|(k, _)| nearest.is_none_or(|n| n == Some(*k)))
+                .map(|(_, rf)| rf)
                 .map(|(r, f)| [r.k[0], r.k[1], r.k[2], r.j[0]][qty] - reference * f)
                 .try_fold(0.0, |worst: f64, d| {
                     let d = finite(d)?;
@@ -345,14 +354,36 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
         Measure::PathDifference {
             crack,
             tip,
+            near,
             main,
             ref compare,
             from,
-        } => compare
-            .iter()
-            .map(|&n| path_difference(h, crack, tip, main, n, from, true))
-            .try_fold(0.0, |worst: f64, d| d.map(|d| worst.max(d)))
-            .and_then(finite),
+        } => {
+            let tips: Vec<u32> = match (tip, near) {
+                (Some(t), _) => vec![t],
+                (None, Some(p)) => {
+                    let rows = last_rows(h, crack)?;
+                    vec![rows[nearest_row(&rows, p)?].tip]
+                }
+                (None, None) => {
+                    let mut t: Vec<u32> = (h.paths.iter())
+                        .filter(|p| p.crack == crack)
+                        .map(|p| p.tip)
+                        .collect();
+                    t.sort_unstable();
+                    t.dedup();
+                    t
+                }
+            };
+            (tips.iter())
+                .flat_map(|&t| compare.iter().map(move |&n| (t, n)))
+                .map(|(t, n)| path_difference(h, crack, t, main, n, from, true))
+                .try_fold(None, |worst: Option<f64>, d| {
+                    d.map(|d| Some(worst.map_or(d, |w| w.max(d))))
+                })
+                .flatten()
+                .and_then(finite)
+        }
         Measure::Max(p) => h.probes[p].iter().copied().reduce(f64::max),
         Measure::Min(p) => h.probes[p].iter().copied().reduce(f64::min),
         Measure::Frequency(p) => frequency(&h.time, &h.probes[p]),
@@ -429,6 +460,20 @@ pub fn frequency(t: &[f64], s: &[f64]) -> Option<f64> {
     Some((crossings.len() - 1) as f64 / (crossings[crossings.len() - 1] - crossings[0]))
 }
 
+/// A crack's rows of the last fracture measurement (one per tip or front vertex); None
+/// without any.
+fn last_rows(h: &History, crack: u32) -> Option<Vec<&TipResult>> {
+    let rows = h.fracture.iter().filter(|r| r.crack == crack);
+    let last = rows.clone().map(|r| r.step).max()?;
+    Some(rows.filter(|r| r.step == last).collect())
+}
+
+/// The index of the row nearest point `p` (the first of equals); None without rows.
+fn nearest_row(rows: &[&TipResult], p: [f64; 3]) -> Option<usize> {
+    let d2 = |k: usize| (0..3).map(|a| (rows[k].x[a] - p[a]).powi(2)).sum::<f64>();
+    (0..rows.len()).min_by(|&a, &b| d2(a).total_cmp(&d2(b)))
+}
+
 /// First time the change from the initial value reaches half of its plateau, the mean
 /// change over the last tenth of the samples (linear interpolation between samples).
 pub fn arrival(t: &[f64], s: &[f64]) -> Option<f64> {
@@ -449,8 +494,9 @@ pub fn arrival(t: &[f64], s: &[f64]) -> Option<f64> {
 }
 
 /// How far J on contour `n` is from J on contour `main` at a crack tip, over the rows from
-/// time `from` on: max |J_n - J_main| / max |J_main| (J as a vector), with or without the
-/// area term. None without rows for both contours.
+/// time `from` on: max |J_n - J_main| / max |J_main| (J as a vector, or J1 alone where J2
+/// is not measured, as along a 3D front), with or without the area term. None without rows
+/// for both contours, or where J1 is NaN (a tube that does not fit).
 pub fn path_difference(
     h: &History,
     crack: u32,
@@ -473,14 +519,25 @@ pub fn path_difference(
         .filter(|p| p.contour == n)
         .map(|p| (p.step, p))
         .collect();
+    let norm = |v: [f64; 2]| {
+        if v[1].is_nan() {
+            v[0].abs()
+        } else {
+            v[0].hypot(v[1])
+        }
+    };
     let (mut diff, mut size, mut pairs) = (0.0f64, 0.0f64, 0);
     for m in rows().filter(|p| p.contour == main) {
         let Some(o) = other.get(&m.step) else {
             continue;
         };
         let (a, b) = (j(m), j(o));
-        diff = diff.max((b[0] - a[0]).hypot(b[1] - a[1]));
-        size = size.max(a[0].hypot(a[1]));
+        let (d, s) = (norm([b[0] - a[0], b[1] - a[1]]), norm(a));
+        if d.is_nan() || s.is_nan() {
+            return None;
+        }
+        diff = diff.max(d);
+        size = size.max(s);
         pairs += 1;
     }
     (pairs > 0 && size > 0.0).then(|| diff / size)
@@ -491,8 +548,8 @@ mod tests {
     use super::*;
 
     /// A front expect with a reference varying as cos(theta) about a ring's centre reads
-    /// the reference plus the largest departure from it, at whichever vertex that is, and
-    /// only the last measurement counts.
+    /// the reference plus the largest departure from it, at whichever vertex that is, or at
+    /// the vertex nearest a point, and only the last measurement counts.
     #[test]
     fn front_measure_takes_the_worst_vertex_against_the_curve() {
         use std::f64::consts::PI;
@@ -522,14 +579,21 @@ mod tests {
                 });
             }
         }
-        let m = Measure::Front {
+        let mut m = Measure::Front {
             crack: 0,
             qty: 1,
             reference: amp,
             along: Some(along),
+            near: None,
         };
         let got = measure(&m, &h, &[]).unwrap();
         assert!((got - (amp - 3.0e4)).abs() < 1e-6, "{got}");
+        let Measure::Front { near, .. } = &mut m else {
+            unreachable!()
+        };
+        *near = Some([centre[0] + 0.011, centre[1], centre[2] + 0.001]);
+        let got = measure(&m, &h, &[]).unwrap();
+        assert!((got - (amp + 3.0e3)).abs() < 1e-6, "vertex 3 alone: {got}");
         let factors = along.factors(&h.fracture[..12].iter().map(|r| r.x).collect::<Vec<_>>());
         assert!((factors[2] - 0.5).abs() < 1e-12 && (factors[6] + 1.0).abs() < 1e-12);
     }

@@ -1,12 +1,13 @@
 //! `fracture` in 3D: J and K_I, K_II, K_III at every vertex of every crack front, from
 //! domain integrals over a tube around the front (`crate::front_integral`), and K split
 //! from G = J by the opening, sliding and tearing of the crack behind the front (Guo &
-//! Nairn 3D (2006) Eqs. 40, 46-57). Runs on output steps only; it reads the world and
-//! changes nothing.
+//! Nairn 3D (2006) Eqs. 40, 46-57). With `[fracture] compare`, also J on tubes of the main
+//! and the compared sizes, none shrunk, with their volume terms apart (paths.csv). Runs on
+//! output steps only; it reads the world and changes nothing.
 
 use crate::crack::{Cracks, Element};
 use crate::dim::{D3, Dim};
-use crate::fracture::{FracturePlan, KMethod, Measured, TipResult};
+use crate::fracture::{FracturePlan, KMethod, Measured, PathResult, TipResult};
 use crate::front::{FrontFrame, front_line};
 use crate::front_integral::{Elastic3, Facet, Tube, front_integrals};
 use crate::world::World;
@@ -43,20 +44,61 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
             nu: e.poisson,
         }
     };
+    // Path independence: J on tubes of the main and the compared sizes, none shrunk.
+    let paths: Vec<Tube> = if plan.compare.is_empty() {
+        Vec::new()
+    } else {
+        std::iter::once(plan.contour)
+            .chain(plan.compare.iter().copied())
+            .map(|n| {
+                let r = n as f64 * h;
+                Tube {
+                    radius: r,
+                    step: h,
+                    min_radius: r,
+                    length: r,
+                }
+            })
+            .collect()
+    };
+    let reach = paths.iter().fold(tube.radius, |r, t| r.max(t.radius));
     let mut ordinal = vec![0u32; cracks.topology.cracks().len()];
     for front in cracks.topology.fronts() {
         let c = front.crack as usize;
         let line = front_line(cracks, front);
         // Each vertex is measured on its own, in parallel; the rows keep the front's order.
-        let rows: Vec<TipResult> = (0..line.frames.len())
+        let rows: Vec<(TipResult, Vec<PathResult>)> = (0..line.frames.len())
             .into_par_iter()
             .map(|k| {
                 let frame = &line.frames[k];
-                let near: Vec<Facet> = (facets.iter())
-                    .filter(|f| (f.centroid - frame.x).length() < tube.radius + tube.length + h)
-                    .copied()
-                    .collect();
+                let tip = ordinal[c] + k as u32;
+                let within = |r: f64| -> Vec<Facet> {
+                    (facets.iter())
+                        .filter(|f| (f.centroid - frame.x).length() < 2.0 * r + h)
+                        .copied()
+                        .collect()
+                };
+                let near = within(tube.radius);
                 let fi = front_integrals(world, cracks, &line, k, &near, tube, elastic);
+                let wide = if paths.is_empty() {
+                    near
+                } else {
+                    within(reach)
+                };
+                let path_rows = (paths.iter())
+                    .map(|&t| {
+                        let p = front_integrals(world, cracks, &line, k, &wide, t, elastic);
+                        PathResult {
+                            step: world.step,
+                            time: world.time,
+                            crack: c as u32,
+                            tip,
+                            contour: (t.radius / h).round() as u32,
+                            line: [p.j - p.j_volume, f64::NAN],
+                            area: [p.j_volume, f64::NAN],
+                        }
+                    })
+                    .collect();
                 let opening = opening(cracks, c, frame, h, plan.opening * h);
                 let (k_opening, k_mixity) = match fi.material.map(elastic) {
                     Some(el) => (
@@ -69,11 +111,11 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                     ),
                     None => ([f64::NAN; 3], [f64::NAN; 3]),
                 };
-                TipResult {
+                let row = TipResult {
                     step: world.step,
                     time: world.time,
                     crack: c as u32,
-                    tip: ordinal[c] + k as u32,
+                    tip,
                     x: frame.x.to_array(),
                     j: [fi.j, f64::NAN],
                     k: match plan.k_method {
@@ -84,11 +126,15 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                     k_interaction: fi.k,
                     k_opening,
                     domain: fi.radius,
-                }
+                };
+                (row, path_rows)
             })
             .collect();
         ordinal[c] += rows.len() as u32;
-        m.tips.extend(rows);
+        for (row, path_rows) in rows {
+            m.tips.push(row);
+            m.paths.extend(path_rows);
+        }
     }
     m
 }
@@ -138,13 +184,34 @@ fn opening(cracks: &Cracks<D3>, c: usize, frame: &FrontFrame, h: f64, window: f6
 /// K_I, K_II, K_III of a stationary front in proportion to `d`, scaled so that
 /// G = (A_I K_I^2 + A_II K_II^2 + A_III K_III^2) / (2 mu) with A_I = A_II = (kappa + 1)/4
 /// and A_III = 1 (Guo & Nairn 3D (2006) Eq. 40 at zero speed; Eqs. 49-57 are its three
-/// cases). NaN when `d` is zero or NaN.
+/// cases). NaN when `d` is zero or NaN, or G is NaN (no tube fitted).
 fn k_split(el: Elastic3, g: f64, d: [f64; 3]) -> [f64; 3] {
     let a = 0.25 * el.c1();
     let den = a * (d[0] * d[0] + d[1] * d[1]) + d[2] * d[2];
-    if den.is_nan() || den == 0.0 {
+    if den.is_nan() || den == 0.0 || g.is_nan() {
         return [f64::NAN; 3];
     }
     let scale = (2.0 * el.mu * g.max(0.0) / den).sqrt();
     d.map(|v| v * scale)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Split in proportion to the displacements of a known (K_I, K_II, K_III), G gives that
+    /// K back, G = (K_I^2 + K_II^2) / E' + K_III^2 / (2 mu) with E' = 2 mu / (1 - nu); with
+    /// no G (a tube that did not fit) it gives NaN, not zero.
+    #[test]
+    fn split_recovers_k_and_keeps_nan() {
+        let el = Elastic3 { mu: 80e9, nu: 0.3 };
+        let k = [2.0e6, -0.7e6, 1.1e6];
+        let e_prime = 2.0 * el.mu / (1.0 - el.nu);
+        let g = (k[0] * k[0] + k[1] * k[1]) / e_prime + k[2] * k[2] / (2.0 * el.mu);
+        let got = k_split(el, g, k.map(|v| 3.0e-13 * v));
+        for m in 0..3 {
+            assert!((got[m] - k[m]).abs() < 1e-9 * k[0], "mode {m}: {got:?}");
+        }
+        assert!(k_split(el, f64::NAN, k).iter().all(|v| v.is_nan()));
+    }
 }

@@ -277,3 +277,75 @@ fn front_frames_follow_a_curved_front() {
         assert!(f.e[1].y.abs() > 1.0 - 1e-12);
     }
 }
+
+/// A penny crack whose front passes 0.2 mm from the body's face: at the vertices within
+/// half a cell of the face no tube of 2 cells fits (J and K NaN, domain 0); those more than
+/// 4 cells from it get the whole tube of 3 cells asked for; summary.json lists exactly the
+/// vertices whose tube was shrunk or did not fit.
+#[test]
+fn tubes_near_a_face_shrink_or_are_reported() {
+    let text = r#"
+[simulation]
+dimension = 3
+duration = 2e-7
+[grid]
+min = [0.0, 0.0, 0.0]
+max = [0.028, 0.028, 0.028]
+cell = [0.001, 0.001, 0.001]
+[[material]]
+name = "m"
+E = 1e9
+nu = 0.3
+rho = 1000.0
+[[body]]
+material = "m"
+box = { min = [0.002, 0.002, 0.002], max = [0.026, 0.026, 0.026] }
+[[crack]]
+name = "p"
+penny = { center = [0.0072, 0.014, 0.014], normal = [0.0, 1.0, 0.0], radius = 0.005 }
+[fracture]
+domain = 3
+"#;
+    let out = common::run_text(text);
+    let last = out.history.fracture.last().unwrap().step;
+    let rows: Vec<_> = (out.history.fracture.iter())
+        .filter(|t| t.step == last)
+        .collect();
+    let (mut near, mut far) = (0, 0);
+    for t in &rows {
+        let d = t.x[0] - 0.002;
+        if d < 0.5e-3 {
+            assert!(
+                t.domain == 0.0 && t.j[0].is_nan() && t.k[0].is_nan(),
+                "{t:?}"
+            );
+            near += 1;
+        } else if d > 4e-3 {
+            assert_eq!(t.domain, 3e-3, "vertex {} at {d:e} m from the face", t.tip);
+            far += 1;
+        }
+    }
+    assert!(near >= 3 && far > rows.len() / 2, "{near} near, {far} far");
+    let list = |keep: &dyn Fn(f64) -> bool| {
+        let v: Vec<String> = (rows.iter())
+            .filter(|t| keep(t.domain))
+            .map(|t| t.tip.to_string())
+            .collect();
+        v
+    };
+    let tubes = &out.summary.tubes;
+    assert_eq!(tubes.len(), 1);
+    let expand = |s: &str| -> Vec<String> {
+        (s.split(", ").filter(|p| !p.is_empty()))
+            .flat_map(|p| match p.split_once('-') {
+                Some((a, b)) => {
+                    let (a, b): (u32, u32) = (a.parse().unwrap(), b.parse().unwrap());
+                    (a..=b).map(|k| k.to_string()).collect::<Vec<_>>()
+                }
+                None => vec![p.to_string()],
+            })
+            .collect()
+    };
+    assert_eq!(expand(&tubes[0].unfitted), list(&|d| d == 0.0));
+    assert_eq!(expand(&tubes[0].shrunk), list(&|d| d > 0.0 && d < 3e-3));
+}

@@ -130,10 +130,18 @@ fn time_step_above_the_stability_limit() {
     assert_error(&e, "simulation.dt", Some(5), "above the stability limit");
 }
 
+/// A body with no particle, also once clipped, and a tube whose bore is not inside it.
 #[test]
 fn empty_body() {
     let e = error_with(&["body[0].box.max=[0.0045, 0.0045]"]);
     assert_error(&e, "body[0]", None, "no particle");
+    let e = error_with(&["body[0].clip={ point = [0.0, 0.017], normal = [0.0, 1.0] }"]);
+    assert_error(&e, "body[0]", None, "clipped away");
+    let e = error_3d(
+        "[[body]]\nmaterial = \"steel\"\ncylinder = { center = [0.01, 0.01, 0.005], \
+         axis = \"z\", radius = 0.003, inner_radius = 0.003, length = 0.01 }\n",
+    );
+    assert_error(&e, "body[1].cylinder.inner_radius", None, "bore's radius");
 }
 
 #[test]
@@ -447,7 +455,8 @@ fn crossing_cracks_are_refused() {
 }
 
 /// Expects along a 3D front: the 2D tip quantities are refused in 3D and the front ones in
-/// 2D; a bad `along` names its key.
+/// 2D; a bad `along` or `near` names its key, a crack without a front is refused, and so
+/// are compared tubes below 2 cells or set against a main tube of a fractional size.
 #[test]
 fn bad_front_expects_name_the_key() {
     let penny = "[[crack]]\nname = \"p\"\npenny = { center = [0.01, 0.01, 0.01], \
@@ -483,11 +492,40 @@ fn bad_front_expects_name_the_key() {
     assert_error(&e, "expect[0].along.ratio", None, "needs `ratio`");
     let e = error_3d(&expect("KI_front", "tip = \"end\"\n"));
     assert_error(&e, "expect[0].tip", None, "every front vertex");
+    let e = error_3d(&expect("KI_front", "near = [0.01, 0.01, 0.019]\n"));
+    assert_error(&e, "expect[0].near", None, "within two cells");
+    let paths = |fracture: &str, more: &str| {
+        expect("J_path", more).replace("[fracture]\n", &format!("[fracture]\n{fracture}"))
+    };
+    let e = error_3d(&paths("compare = [1]\n", ""));
+    assert_error(&e, "fracture.compare", None, "at least 2 cells");
+    let e = error_3d(&paths("compare = [4]\ndomain = 2.5\n", ""));
+    assert_error(&e, "fracture.domain", None, "whole number of cells");
+    let e = error_3d(&paths("compare = [4]\n", "tip = \"end\"\n"));
+    assert_error(&e, "expect[0].tip", None, "no named tips");
+    let e = error_3d(&paths("compare = [4]\n", "near = [0.0, 0.0, 0.0]\n"));
+    assert_error(&e, "expect[0].near", None, "within two cells");
+    let rect = text_3d(&expect("KI_front", "").replace(
+        "[fracture]\n",
+        "[[crack]]\nname = \"r\"\nrectangle = { center = [0.01, 0.01, 0.014], \
+         axes = [[0.005, 0.0, 0.0], [0.0, 0.005, 0.0]] }\n[fracture]\n",
+    ))
+    .replace("crack = \"p\"\nreference", "crack = \"r\"\nreference");
+    let src = Source::parse("bad.toml", &rect, &[]).unwrap();
+    match fissure::scenario::build::<fissure::dim::D3>(&src) {
+        Ok(_) => panic!("a crack without a front has nothing to measure"),
+        Err(e) => assert_error(&e, "expect[0].crack", None, "has no front"),
+    }
     let e = error_with_text(
         "[[expect]]\nquantity = \"KI_front\"\ncrack = \"p\"\nreference = 1.0\n\
          source = \"s\"\ntolerance = 0.1\n",
     );
     assert_error(&e, "expect[0].quantity", None, "3D crack front");
+    let e = error_with_text(
+        "[[expect]]\nquantity = \"momentum_drift\"\nnear = [0.0, 0.0]\n\
+         reference = 1.0\nsource = \"s\"\ntolerance = 0.1\n",
+    );
+    assert_error(&e, "expect[0].near", None, "applies to KI_front");
 }
 
 /// Inputs that used to be accepted although wrong: a name that is not one folder name, two

@@ -155,15 +155,45 @@ fn restart_is_bit_exact_3d_one_and_two_threads() {
     restart_is_bit_exact(&text, 19, 2, "3d-2");
 }
 
-/// With J and K along the crack's front: fracture.csv, one row per front vertex, resumes
-/// bit for bit too.
+/// With J and K along the crack's front and J on a compared tube: fracture.csv, one row
+/// per front vertex, and paths.csv, one per vertex and tube, resume bit for bit too. On
+/// the main tube, where it was not shrunk, J in paths.csv (its two parts summed) is J1 of
+/// fracture.csv, to the rounding of that sum.
 #[test]
 fn restart_is_bit_exact_with_a_3d_crack() {
     let crack = "[[crack]]\npenny = { center = [0.02, 0.007, 0.007], normal = [1.0, 0.3, 0.2], \
-                 radius = 0.003 }\ncontact = { law = \"stick\" }\n[fracture]\ndomain = 2\n";
+                 radius = 0.003 }\ncontact = { law = \"stick\" }\n[fracture]\ndomain = 2\n\
+                 compare = [3]\n";
     let text = scene(3, "ugimp", "usavg")
         .replace("duration = 1e-5", "duration = 4e-6")
         .replace("[[probe]]", &format!("{crack}[[probe]]"));
+    let dir = scratch("3d-paths");
+    let h = run(&source(&text), &opts(&dir, 1)).unwrap().history;
+    assert_eq!(
+        h.paths.len(),
+        2 * h.fracture.len(),
+        "two tubes per front vertex"
+    );
+    let mut compared = 0;
+    for t in h
+        .fracture
+        .iter()
+        .filter(|t| t.domain == 2e-3 && t.j[0] != 0.0)
+    {
+        let p = (h.paths.iter())
+            .find(|p| p.step == t.step && p.tip == t.tip && p.contour == 2)
+            .unwrap();
+        let j = p.line[0] + p.area[0];
+        let scale = p.line[0].abs() + p.area[0].abs();
+        assert!((j - t.j[0]).abs() <= 1e-12 * scale, "{j} vs {}", t.j[0]);
+        assert!(
+            p.line[1].is_nan() && p.area[1].is_nan(),
+            "J2 is not measured"
+        );
+        compared += 1;
+    }
+    assert!(compared > 10, "{compared} rows compared");
+    std::fs::remove_dir_all(dir).ok();
     restart_is_bit_exact(&text, 17, 2, "3d-crack");
 }
 

@@ -50,6 +50,9 @@ pub struct Summary {
     pub expects: Vec<ExpectResult>,
     /// Path dependence of J per crack tip and compared contour (`[fracture] compare`).
     pub paths: Vec<PathReport>,
+    /// Along 3D fronts: where the tube around a vertex was shrunk to stay inside the body,
+    /// or none fitted (last measurement).
+    pub tubes: Vec<TubeReport>,
     /// Snapshot this run continued from.
     pub resumed_from: Option<String>,
     /// Newest snapshot written (or resumed from).
@@ -66,16 +69,32 @@ pub struct Summary {
 pub struct PathReport {
     /// Crack name.
     pub crack: String,
-    /// "start" or "end".
+    /// "start" or "end"; along a 3D front, the worst of its vertices.
     pub tip: String,
-    /// Main contour size (cells).
+    /// Main contour size (cells; in 3D the tube's radius).
     pub main: u32,
-    /// Compared contour size (cells).
+    /// Compared contour size (cells; in 3D the tube's radius).
     pub contour: u32,
     /// Start of the window (s).
     pub from: f64,
-    /// Relative difference with the area term (Eq. 8).
+    /// Relative difference with the area term (Eq. 8; in 3D the volume term of Eq. 33).
     pub with_area: Option<f64>,
     /// Relative difference without it.
     pub without_area: Option<f64>,
+}
+
+/// The front vertices of one crack whose tube, at the last measurement, was shrunk to stay
+/// inside the body, or did not fit at all (J and K NaN there).
+#[derive(Clone, Debug, Serialize)]
+pub struct TubeReport {
+    /// Crack name.
+    pub crack: String,
+    /// Radius asked for (m), `[fracture] domain` cells.
+    pub radius: f64,
+    /// Front vertices of the crack.
+    pub vertices: usize,
+    /// Vertices measured on a smaller tube, as ranges ("0-2, 7").
+    pub shrunk: String,
+    /// Vertices where no tube of 2 cells or more fits.
+    pub unfitted: String,
 }

@@ -2,15 +2,16 @@
 //! the summary. A run starts from a scenario ([`run`]) or from a snapshot ([`resume`]).
 
 pub mod checkpoint;
+mod reports;
 pub mod state;
 pub mod writers;
 
 use crate::dim::{D2, D3, Dim};
 use crate::error::{Unstable, UsageError};
-use crate::fracture::{FracturePlan, TipResult};
-use crate::measure::{Expect, History, Measure, Row, path_difference};
+use crate::fracture::TipResult;
+use crate::measure::{Expect, History, Measure, Row};
 use crate::output::plot::{self, Series};
-use crate::output::summary::{PathReport, Summary};
+use crate::output::summary::Summary;
 use crate::scenario::build::MAX_STEPS;
 use crate::scenario::{Scene, Source, build};
 use crate::schedule::Schedule;
@@ -390,7 +391,8 @@ fn drive<D: Dim>(
         bytes_per_node: crate::grid::Grid::<D>::bytes_per_node(),
         energies: world.energies(),
         expects: results,
-        paths: path_reports(&world, fracture.as_ref(), &state.history),
+        paths: reports::paths(&world, fracture.as_ref(), &state.history),
+        tubes: reports::tubes(&world, fracture.as_ref(), &state.history),
         resumed_from: resumed_from.map(|p| p.display().to_string()),
         snapshot: snapshot.as_ref().map(|s| s.0.display().to_string()),
         snapshot_seconds: checkpoints.as_ref().map_or(0.0, |c| c.seconds),
@@ -601,49 +603,6 @@ fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
         "energy (J)",
         &series,
     )
-}
-
-/// The path-dependence report of summary.json: every crack tip against every compared
-/// contour.
-fn path_reports<D: Dim>(
-    world: &World<D>,
-    plan: Option<&FracturePlan>,
-    history: &History,
-) -> Vec<PathReport> {
-    let (Some(plan), Some(cracks)) = (plan, &world.cracks) else {
-        return Vec::new();
-    };
-    let mut out = Vec::new();
-    let topo = &cracks.topology;
-    for front in topo.fronts() {
-        let (c, tip) = (front.crack as u32, front.end);
-        let crack = &topo.cracks()[c as usize];
-        {
-            for &n in &plan.compare {
-                let diff = |area| {
-                    path_difference(
-                        history,
-                        c,
-                        tip,
-                        plan.contour as u32,
-                        n as u32,
-                        plan.compare_from,
-                        area,
-                    )
-                };
-                out.push(PathReport {
-                    crack: crack.name.clone(),
-                    tip: ["start", "end"][tip as usize].into(),
-                    main: plan.contour as u32,
-                    contour: n as u32,
-                    from: plan.compare_from,
-                    with_area: diff(true),
-                    without_area: diff(false),
-                });
-            }
-        }
-    }
-    out
 }
 
 #[cfg(test)]

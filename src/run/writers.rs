@@ -72,7 +72,8 @@ impl Writers {
         let paths = match (paths, &fracture) {
             (true, Some(_)) => {
                 let mut f = create("paths.csv")?;
-                writeln!(f, "step,time,crack,tip,contour,J1,J2,J1_area,J2_area")?;
+                let part = if front_vertices { "volume" } else { "area" };
+                writeln!(f, "step,time,crack,tip,contour,J1,J2,J1_{part},J2_{part}")?;
                 Some(f)
             }
             _ => None,
@@ -111,10 +112,18 @@ impl Writers {
     }
 
     /// Appends J and K at crack tips to fracture.csv, and J on the compared contours (with
-    /// the area term, and the area term alone) to paths.csv (SI: J/m^2, Pa sqrt(m)).
+    /// the area term, and the area term alone; in 3D tubes, with the volume term and it
+    /// alone, J2 not measured) to paths.csv (SI: J/m^2, Pa sqrt(m)).
     pub fn fracture(&mut self, tips: &[TipResult], paths: &[PathResult]) -> anyhow::Result<()> {
         let Some((f, names)) = &mut self.fracture else {
             return Ok(());
+        };
+        let tip = |t: u32| -> String {
+            if self.front_vertices {
+                t.to_string()
+            } else {
+                ["start", "end"][t as usize].into()
+            }
         };
         if let Some(pf) = &mut self.paths {
             for p in paths {
@@ -124,7 +133,7 @@ impl Writers {
                     p.step,
                     p.time,
                     names[p.crack as usize],
-                    ["start", "end"][p.tip as usize],
+                    tip(p.tip),
                     p.contour,
                     p.line[0] + p.area[0],
                     p.line[1] + p.area[1],
@@ -134,12 +143,14 @@ impl Writers {
             }
         }
         for t in tips {
-            write!(f, "{},{:.9e},{},", t.step, t.time, names[t.crack as usize])?;
-            if self.front_vertices {
-                write!(f, "{}", t.tip)?;
-            } else {
-                write!(f, "{}", ["start", "end"][t.tip as usize])?;
-            }
+            write!(
+                f,
+                "{},{:.9e},{},{}",
+                t.step,
+                t.time,
+                names[t.crack as usize],
+                tip(t.tip)
+            )?;
             for v in t.values() {
                 write!(f, ",{v:.9e}")?;
             }

@@ -543,7 +543,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let front_qty = ["KI_front", "KII_front", "KIII_front", "J1_front"]
             .iter()
             .position(|q| *q == e.quantity);
-        let tip_like = tip_qty.is_some() || ["J_path", "K_drift"].contains(&e.quantity.as_str());
+        let tip_like = tip_qty.is_some() || e.quantity == "K_drift";
         if D::D == 3 && tip_like {
             return Err(src.error(
                 &key("quantity"),
@@ -554,11 +554,17 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 ),
             ));
         }
-        if e.along.is_some() && front_qty.is_none() {
-            return Err(src.error(
-                &key("along"),
-                "`along` applies to KI_front, KII_front, KIII_front and J1_front",
-            ));
+        let path_3d = D::D == 3 && e.quantity == "J_path";
+        for (k, given, also) in [
+            ("along", e.along.is_some(), ""),
+            ("near", e.near.is_some() && !path_3d, " (and J_path in 3D)"),
+        ] {
+            if given && front_qty.is_none() {
+                return Err(src.error(
+                    &key(k),
+                    format!("`{k}` applies to KI_front, KII_front, KIII_front and J1_front{also}"),
+                ));
+            }
         }
         if D::D == 2 && front_qty.is_some() {
             return Err(src.error(
@@ -572,7 +578,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let crack_measure = match (tip_qty, front_qty) {
             (Some(qty), _) => Some(super::cracks::tip_measure(src, i, e, qty)?),
             (_, Some(qty)) => Some(super::cracks::front_measure(src, i, e, qty)?),
-            _ if e.quantity == "J_path" => Some(super::cracks::path_measure(src, i, e)?),
+            _ if e.quantity == "J_path" => Some(super::cracks::path_measure::<D>(src, i, e)?),
             _ if e.quantity == "K_drift" => Some(super::cracks::drift_measure(src, i, e)?),
             _ => None,
         };
@@ -681,6 +687,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     let checkpoint = checkpoint_plan(src)?;
     let cracks = super::cracks::build::<D>(src, &particles, &geom)?;
     let fracture = super::cracks::fracture_plan(src, cracks.as_ref(), &geom)?;
+    super::cracks::check_front_expects(src, &expects, cracks.as_ref(), geom.min_cell())?;
     if fracture.is_some() {
         particles.grad_u = vec![D::mat_zero(); particles.len()];
         particles.grad_v = vec![D::mat_zero(); particles.len()];
@@ -797,10 +804,18 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
         if D::D != 3 {
             return Err(src.error(&key("cylinder"), "cylinder is 3D; use disc in 2D"));
         }
+        let radius = positive(src, &key("cylinder.radius"), c.radius, "m")?;
+        if !(0.0..radius).contains(&c.inner_radius) {
+            return Err(src.error(
+                &key("cylinder.inner_radius"),
+                format!("the bore's radius must lie in [0, radius = {radius:e}) m"),
+            ));
+        }
         return Ok(Geometry::Cylinder {
             center: vec3::<D>(src, &key("cylinder.center"), &c.center)?,
             axis: axis_index::<D>(src, &key("cylinder.axis"), &c.axis)?,
-            radius: positive(src, &key("cylinder.radius"), c.radius, "m")?,
+            radius,
+            inner: c.inner_radius,
             length: positive(src, &key("cylinder.length"), c.length, "m")?,
         });
     }
@@ -877,11 +892,16 @@ fn add_body<D: Dim>(
             "body would need more than 2e8 particles",
         ));
     }
-    let pts = fill(&g, D::D, origin, h, geom.cells, body.ppc);
+    let mut pts = fill(&g, D::D, origin, h, geom.cells, body.ppc);
+    if let Some(clip) = &body.clip {
+        let clip = super::region::region::<D>(src, &key("clip"), clip)?;
+        pts.retain(|x| clip.contains(*x, D::D, 0.0));
+    }
     if pts.is_empty() {
         return Err(src.error(
             &format!("body[{b}]"),
-            "body contains no particle (is it smaller than a particle spacing, or outside the grid?)",
+            "body contains no particle (is it smaller than a particle spacing, outside the grid, or \
+             clipped away?)",
         ));
     }
     let n = body.ppc as f64;

@@ -5,11 +5,11 @@ use super::schema::{AlongSpec, CrackSpec, ExpectSpec};
 use super::source::Source;
 use super::surface;
 use crate::crack::{Contact, Cracks, Element, Law, MAX_CRACKS};
-use crate::dim::Dim;
+use crate::dim::{D3, Dim};
 use crate::error::ScenarioError;
 use crate::fracture::{FracturePlan, KMethod};
 use crate::grid::GridGeom;
-use crate::measure::{Along, Measure, Shape};
+use crate::measure::{Along, Expect, Measure, Shape};
 use crate::particles::Particles;
 use glam::DVec3;
 use std::collections::HashMap;
@@ -444,7 +444,12 @@ pub(super) fn fracture_plan<D: Dim>(
     if cracks.topology.fronts().is_empty() {
         return Err(src.error(
             "fracture",
-            "J and K are measured at crack tips, and no crack has one (see `tips`)",
+            if D::D == 2 {
+                "J and K are measured at crack tips, and no crack has one (see `tips`)"
+            } else {
+                "J and K are measured along crack fronts, and no crack has one (a rectangle \
+                 cuts through)"
+            },
         ));
     }
     let fits = |key: &str, n: usize| -> R<()> {
@@ -482,11 +487,9 @@ pub(super) fn fracture_plan<D: Dim>(
         }
     } else {
         // J along a 3D front comes from the tube's domain integral, which always carries the
-        // volume term; the square grid contour and its comparisons are 2D.
+        // volume term; the square grid contour is 2D. Compared tubes are sized in cells.
         let grid_keys = [
             ("contour", f.contour.is_some()),
-            ("compare", f.compare.is_some()),
-            ("compare_from", f.compare_from.is_some()),
             ("area_term", f.area_term.is_some()),
         ];
         if let Some((key, _)) = grid_keys.iter().find(|k| k.1) {
@@ -494,6 +497,12 @@ pub(super) fn fracture_plan<D: Dim>(
                 &format!("fracture.{key}"),
                 "the square J contour is 2D; along a 3D front J and K come from a tube of \
                  radius `domain` cells",
+            ));
+        }
+        if compare.iter().any(|&m| m < 2) {
+            return Err(src.error(
+                "fracture.compare",
+                "compared tubes around a 3D front are at least 2 cells in radius",
             ));
         }
     }
@@ -532,8 +541,16 @@ pub(super) fn fracture_plan<D: Dim>(
             "the interaction integral's domain radius is in cells: give at least 2",
         ));
     }
+    // In 3D the compared tubes are set against the main one, of `domain` cells.
+    if D::D == 3 && !compare.is_empty() && (domain.fract() != 0.0 || domain > 1e3) {
+        return Err(src.error(
+            "fracture.domain",
+            "tubes compared with `compare` are set against the main one: give `domain` as \
+             a whole number of cells",
+        ));
+    }
     Ok(Some(FracturePlan {
-        contour: n,
+        contour: if D::D == 2 { n } else { domain as usize },
         k_method,
         domain,
         area_term: f.area_term.unwrap_or(true),
@@ -635,12 +652,71 @@ pub(super) fn front_measure(src: &Source, i: usize, e: &ExpectSpec, qty: usize) 
         None => None,
         Some(a) => Some(along(src, &key("along"), a)?),
     };
+    let near = match &e.near {
+        None => None,
+        Some(p) => Some(vec3::<D3>(src, &key("near"), p)?),
+    };
     Ok(Measure::Front {
         crack: crack as u32,
         qty,
         reference: e.reference,
         along,
+        near,
     })
+}
+
+/// Checks the expects along 3D fronts against the built cracks: the crack has a front, and
+/// a `near` point lies within two cells of one of its vertices.
+pub(super) fn check_front_expects<D: Dim>(
+    src: &Source,
+    expects: &[Expect],
+    cracks: Option<&Cracks<D>>,
+    cell: f64,
+) -> R<()> {
+    for (i, e) in expects.iter().enumerate() {
+        let (Measure::Front { crack, near, .. }
+        | Measure::PathDifference {
+            crack,
+            near,
+            tip: None,
+            ..
+        }) = e.measure
+        else {
+            continue;
+        };
+        let Some(store) = cracks else { continue };
+        let topo = &store.topology;
+        let c = crack as usize;
+        let front: Vec<u32> = topo
+            .fronts()
+            .iter()
+            .filter(|f| f.crack as usize == c)
+            .flat_map(|f| f.vertices.iter().copied())
+            .collect();
+        let name = &topo.cracks()[c].name;
+        if front.is_empty() {
+            return Err(src.error(
+                &format!("expect[{i}].crack"),
+                format!("crack `{name}` has no front to measure (a rectangle cuts through)"),
+            ));
+        }
+        let Some(p) = near else { continue };
+        let p = DVec3::from(p);
+        let nearest = front
+            .iter()
+            .map(|&v| DVec3::from(D::to_xyz(store.geometry.x[v as usize])).distance(p))
+            .fold(f64::INFINITY, f64::min);
+        if nearest > 2.0 * cell {
+            return Err(src.error(
+                &format!("expect[{i}].near"),
+                format!(
+                    "no front vertex of crack `{name}` lies within two cells of this point; \
+                     the nearest is {nearest:.4e} m away"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The checked `along` of a front expect: a shape of cos or sin, and a `zero` direction
@@ -705,9 +781,27 @@ pub(super) fn drift_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure
 }
 
 /// The measure of a `J_path` expect: J with the area term on the compared contours against
-/// the main one at a crack tip, from `[fracture] compare_from` on.
-pub(super) fn path_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure> {
-    let (crack, tip) = expect_tip(src, i, e)?;
+/// the main one at a crack tip (3D: J with the volume term on the compared tubes, at every
+/// front vertex or the one `near` a point), from `[fracture] compare_from` on.
+pub(super) fn path_measure<D: Dim>(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure> {
+    let key = |k: &str| format!("expect[{i}].{k}");
+    let (crack, tip, near) = if D::D == 2 {
+        let (crack, tip) = expect_tip(src, i, e)?;
+        (crack, Some(tip), None)
+    } else {
+        if e.tip.is_some() {
+            return Err(src.error(
+                &key("tip"),
+                "a 3D front has no named tips: `J_path` covers every front vertex, or the \
+                 one `near` a point",
+            ));
+        }
+        let near = match &e.near {
+            Some(p) => Some(vec3::<D3>(src, &key("near"), p)?),
+            None => None,
+        };
+        (measured_crack(src, i, e)?.0 as u32, None, near)
+    };
     if e.at.is_some() {
         return Err(src.error(
             &format!("expect[{i}].at"),
@@ -725,10 +819,16 @@ pub(super) fn path_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure>
             "`J_path` compares contours: list them in `[fracture] compare`",
         ));
     }
+    let main = if D::D == 2 {
+        f.and_then(|f| f.contour).unwrap_or(2) as u32
+    } else {
+        f.and_then(|f| f.domain).unwrap_or(3.0) as u32
+    };
     Ok(Measure::PathDifference {
         crack,
         tip,
-        main: f.and_then(|f| f.contour).unwrap_or(2) as u32,
+        near,
+        main,
         compare,
         from: f.and_then(|f| f.compare_from).unwrap_or(0.0),
     })

@@ -153,7 +153,7 @@ pub struct RoundSpec {
     pub radius: f64,
 }
 
-/// A 3D circular cylinder.
+/// A 3D circular cylinder, or a tube when `inner_radius` is given.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CylinderSpec {
@@ -163,6 +163,9 @@ pub struct CylinderSpec {
     pub axis: String,
     /// Radius (m).
     pub radius: f64,
+    /// Radius of the bore of a tube (m); default 0, a solid cylinder.
+    #[serde(default)]
+    pub inner_radius: f64,
     /// Length along the axis (m).
     pub length: f64,
 }
@@ -192,7 +195,8 @@ pub struct BodySpec {
     pub velocity: Option<Vec<f64>>,
     /// Initial rigid spin (rad/s): one value (about z) in 2D, a vector in 3D.
     pub angular_velocity: Option<Vec<f64>>,
-    /// Centre of the initial spin (m); default the centre of the body's bounding box.
+    /// Centre of the initial spin (m); default the centre of the geometry's bounding box
+    /// (before any `clip`).
     pub spin_center: Option<Vec<f64>>,
     /// Box geometry.
     #[serde(rename = "box")]
@@ -205,6 +209,9 @@ pub struct BodySpec {
     pub cylinder: Option<CylinderSpec>,
     /// Polygon geometry (2D, or extruded in 3D).
     pub polygon: Option<PolygonSpec>,
+    /// Keep only the part of the geometry inside this region (e.g. the half-space on one
+    /// side of a symmetry plane).
+    pub clip: Option<RegionSpec>,
 }
 
 fn default_ppc() -> usize {
@@ -435,7 +442,8 @@ pub struct FractureSpec {
     /// Include the area term of Guo & Nairn 2D (2004) Eq. 8 (default true).
     pub area_term: Option<bool>,
     /// Further contour sizes (cells) on which J is also measured, its line and area parts
-    /// apart, for the path-independence record paths.csv.
+    /// apart, for the path-independence record paths.csv; in 3D tube radii (each with its
+    /// half-length, at least 2), set against the main tube of `domain` cells.
     pub compare: Option<Vec<usize>>,
     /// Start of the window (s) over which summary.json and `J_path` expects compare the
     /// contours (default 0), e.g. once the first stress wave has passed the tip.
@@ -496,9 +504,11 @@ pub struct ExpectSpec {
     /// One of: final, max, min, frequency, wave_speed, momentum_drift, energy_drift,
     /// angular_momentum_drift; KI, KII, J1, J2 (at a crack tip: the last value, or at `at`);
     /// J_path (largest difference of J on the `[fracture] compare` contours from the main
-    /// one, relative to the main one's largest |J|); K_drift (largest |K(t) - K(end)| from
+    /// one, relative to the main one's largest |J|; in 3D the worst front vertex, or the
+    /// one `near` a point); K_drift (largest |K(t) - K(end)| from
     /// `from` on, relative to |K(end)|); in 3D KI_front, KII_front, KIII_front, J1_front
-    /// (the value farthest from the reference over a crack's front vertices, last row).
+    /// (the value farthest from the reference over a crack's front vertices, or at the
+    /// vertex `near` a point, last row).
     pub quantity: String,
     /// Probe(s) the quantity is measured on (wave_speed takes two).
     #[serde(default)]
@@ -514,6 +524,9 @@ pub struct ExpectSpec {
     /// For the front quantities: how the reference varies along the front (default: it
     /// does not).
     pub along: Option<AlongSpec>,
+    /// For the front quantities: only the front vertex nearest this point (m), e.g. the
+    /// deepest point of a surface crack (default: every front vertex).
+    pub near: Option<Vec<f64>>,
     /// Reference value (SI).
     pub reference: f64,
     /// Where the reference comes from.

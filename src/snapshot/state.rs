@@ -37,8 +37,9 @@ fn row_data(r: &Row) -> [f64; ROW_WIDTH] {
     ]
 }
 
-/// A crack tip's id in the `history.fracture.tip` column: the crack in the high 32 bits, the
-/// tip (2D: its end; 3D: its front vertex's ordinal) in the low ones.
+/// A crack tip's id in the `history.fracture.tip` and `history.paths.id` columns: the crack
+/// in the high 32 bits, the tip (2D: its end; 3D: its front vertex's ordinal) in the low
+/// ones.
 fn tip_id(crack: u32, tip: u32) -> u64 {
     (u64::from(crack) << 32) | u64::from(tip)
 }
@@ -94,16 +95,8 @@ pub fn write<D: Dim>(
     let tip_ids: Vec<u64> = h.fracture.iter().map(|t| tip_id(t.crack, t.tip)).collect();
     let tip_data: Vec<f64> = h.fracture.iter().flat_map(tip_data).collect();
     let path_steps: Vec<u64> = h.paths.iter().map(|p| p.step).collect();
-    let path_ids: Vec<u64> = h
-        .paths
-        .iter()
-        .flat_map(|p| {
-            [
-                2 * u64::from(p.crack) + u64::from(p.tip),
-                u64::from(p.contour),
-            ]
-        })
-        .collect();
+    let path_ids: Vec<u64> = h.paths.iter().map(|p| tip_id(p.crack, p.tip)).collect();
+    let path_contours: Vec<u64> = h.paths.iter().map(|p| u64::from(p.contour)).collect();
     let path_data: Vec<f64> = h.paths.iter().flat_map(path_data).collect();
     let probe_names: Vec<String> = (0..h.probes.len())
         .map(|k| format!("history.probe.{k}"))
@@ -144,7 +137,8 @@ pub fn write<D: Dim>(
     c.add("history.fracture.tip", &tip_ids);
     c.add("history.fracture.data", &tip_data);
     c.add("history.paths.step", &path_steps);
-    c.add("history.paths.tip", &path_ids);
+    c.add("history.paths.id", &path_ids);
+    c.add("history.paths.contour", &path_contours);
     c.add("history.paths.data", &path_data);
     c.add("history.rows.step", &row_steps);
     c.add("history.rows.data", &rows);
@@ -296,18 +290,19 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
         })
         .collect();
     let path_steps: Vec<u64> = r.column_any("history.paths.step")?;
-    let path_ids: Vec<u64> = r.column("history.paths.tip", path_steps.len() * 2)?;
+    let path_ids: Vec<u64> = r.column("history.paths.id", path_steps.len())?;
+    let contours: Vec<u64> = r.column("history.paths.contour", path_steps.len())?;
     let data: Vec<f64> = r.column("history.paths.data", path_steps.len() * PATH_WIDTH)?;
     history.paths = path_steps
         .iter()
-        .zip(path_ids.chunks_exact(2))
+        .zip(path_ids.iter().zip(&contours))
         .zip(data.chunks_exact(PATH_WIDTH))
-        .map(|((&step, id), d)| PathResult {
+        .map(|((&step, (&id, &contour)), d)| PathResult {
             step,
             time: d[0],
-            crack: (id[0] / 2) as u32,
-            tip: (id[0] % 2) as u32,
-            contour: id[1] as u32,
+            crack: (id >> 32) as u32,
+            tip: id as u32,
+            contour: contour as u32,
             line: [d[1], d[2]],
             area: [d[3], d[4]],
         })

@@ -1,0 +1,141 @@
+//! The fracture reports of summary.json: path dependence of J, and the tubes around a 3D
+//! front that did not fit inside the body.
+
+use crate::dim::Dim;
+use crate::fracture::{FracturePlan, TipResult};
+use crate::measure::{History, path_difference};
+use crate::output::summary::{PathReport, TubeReport};
+use crate::world::World;
+
+/// The path-dependence report of summary.json: every crack tip against every compared
+/// contour; along a 3D front, the worst of its vertices against every compared tube.
+pub(super) fn paths<D: Dim>(
+    world: &World<D>,
+    plan: Option<&FracturePlan>,
+    history: &History,
+) -> Vec<PathReport> {
+    let (Some(plan), Some(cracks)) = (plan, &world.cracks) else {
+        return Vec::new();
+    };
+    let topo = &cracks.topology;
+    // (crack, tip label, the tips reported together)
+    let groups: Vec<(u32, String, Vec<u32>)> = if D::D == 2 {
+        (topo.fronts().iter())
+            .map(|f| {
+                (
+                    f.crack as u32,
+                    ["start", "end"][f.end as usize].into(),
+                    vec![f.end],
+                )
+            })
+            .collect()
+    } else {
+        (0..topo.cracks().len() as u32)
+            .map(|c| {
+                let mut tips: Vec<u32> = (history.paths.iter())
+                    .filter(|p| p.crack == c)
+                    .map(|p| p.tip)
+                    .collect();
+                tips.sort_unstable();
+                tips.dedup();
+                (c, "front (worst vertex)".into(), tips)
+            })
+            .filter(|g| !g.2.is_empty())
+            .collect()
+    };
+    let mut out = Vec::new();
+    for (c, label, tips) in groups {
+        for &n in &plan.compare {
+            let diff = |area| {
+                tips.iter()
+                    .map(|&t| {
+                        let (main, n) = (plan.contour as u32, n as u32);
+                        path_difference(history, c, t, main, n, plan.compare_from, area)
+                    })
+                    .try_fold(0.0, |worst: f64, d| d.map(|d| worst.max(d)))
+            };
+            out.push(PathReport {
+                crack: topo.cracks()[c as usize].name.clone(),
+                tip: label.clone(),
+                main: plan.contour as u32,
+                contour: n as u32,
+                from: plan.compare_from,
+                with_area: diff(true),
+                without_area: diff(false),
+            });
+        }
+    }
+    out
+}
+
+/// The tubes of the last measurement along each 3D front that were shrunk to stay inside
+/// the body, or that did not fit at all (J and K NaN there).
+pub(super) fn tubes<D: Dim>(
+    world: &World<D>,
+    plan: Option<&FracturePlan>,
+    history: &History,
+) -> Vec<TubeReport> {
+    let (Some(plan), Some(cracks), true) = (plan, &world.cracks, D::D == 3) else {
+        return Vec::new();
+    };
+    let h = (0..D::D).map(|a| world.grid.geom.h[a]).fold(0.0, f64::max);
+    let asked = plan.domain * h;
+    let last = history.fracture.last().map(|t| t.step);
+    let rows: Vec<&TipResult> = (history.fracture.iter().rev())
+        .take_while(|t| Some(t.step) == last)
+        .collect();
+    let mut out = Vec::new();
+    for (c, crack) in cracks.topology.cracks().iter().enumerate() {
+        let mut mine: Vec<&&TipResult> = rows.iter().filter(|t| t.crack == c as u32).collect();
+        mine.sort_by_key(|t| t.tip);
+        let unfitted: Vec<u32> = (mine.iter())
+            .filter(|t| t.domain == 0.0)
+            .map(|t| t.tip)
+            .collect();
+        let shrunk: Vec<u32> = (mine.iter())
+            .filter(|t| t.domain > 0.0 && t.domain < asked)
+            .map(|t| t.tip)
+            .collect();
+        if !(unfitted.is_empty() && shrunk.is_empty()) {
+            out.push(TubeReport {
+                crack: crack.name.clone(),
+                radius: asked,
+                vertices: mine.len(),
+                shrunk: ranges(&shrunk),
+                unfitted: ranges(&unfitted),
+            });
+        }
+    }
+    out
+}
+
+/// Sorted vertex numbers as ranges: 0-2, 7, 61-63.
+fn ranges(v: &[u32]) -> String {
+    let mut out: Vec<String> = Vec::new();
+    let mut k = 0;
+    while k < v.len() {
+        let mut e = k;
+        while e + 1 < v.len() && v[e + 1] == v[e] + 1 {
+            e += 1;
+        }
+        out.push(if e == k {
+            v[k].to_string()
+        } else {
+            format!("{}-{}", v[k], v[e])
+        });
+        k = e + 1;
+    }
+    out.join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ranges;
+
+    #[test]
+    fn vertex_ranges() {
+        assert_eq!(ranges(&[0, 1, 2, 7, 61, 62, 63]), "0-2, 7, 61-63");
+        assert_eq!(ranges(&[4]), "4");
+        assert_eq!(ranges(&[]), "");
+    }
+}
