@@ -57,6 +57,17 @@ pub struct FrontIntegrals {
     pub material: Option<u16>,
 }
 
+impl FrontIntegrals {
+    /// No tube fitted: J and K NaN, radius 0.
+    pub const NONE: FrontIntegrals = FrontIntegrals {
+        j: f64::NAN,
+        j_volume: f64::NAN,
+        k: [f64::NAN; 3],
+        radius: 0.0,
+        material: None,
+    };
+}
+
 /// A crack triangle near the vertex: its centroid and unit normal (towards the top face),
 /// which decide the face a particle behind the front lies on.
 #[derive(Clone, Copy, Debug)]
@@ -292,13 +303,7 @@ pub fn front_integrals(
     tube: Tube,
     elastic: impl Fn(u16) -> Elastic3,
 ) -> FrontIntegrals {
-    let none = FrontIntegrals {
-        j: f64::NAN,
-        j_volume: f64::NAN,
-        k: [f64::NAN; 3],
-        radius: 0.0,
-        material: None,
-    };
+    let none = FrontIntegrals::NONE;
     let Some((samples, material)) = gather(world, cracks, line, k, facets, tube, &elastic) else {
         return none;
     };

@@ -2,16 +2,21 @@
 //! domain integrals over a tube around the front (`crate::front_integral`), and K split
 //! from G = J by the opening, sliding and tearing of the crack behind the front (Guo &
 //! Nairn 3D (2006) Eqs. 40, 46-57). With `[fracture] compare`, also J on tubes of the main
-//! and the compared sizes, none shrunk, with their volume terms apart (paths.csv). Runs on
-//! output steps only; it reads the world and changes nothing.
+//! and the compared sizes, none shrunk, with their volume terms apart (paths.csv). A tube
+//! stays clear of other cracks: it is shrunk (a compared one given up) until its reach,
+//! sqrt(2) times its radius, is short of the nearest of their triangles. Runs on output
+//! steps only; it reads the world and changes nothing.
 
 use crate::crack::{Cracks, Element};
 use crate::dim::{D3, Dim};
 use crate::fracture::{FracturePlan, KMethod, Measured, PathResult, TipResult};
 use crate::front::{FrontFrame, front_line};
-use crate::front_integral::{Elastic3, Facet, Tube, front_integrals};
+use crate::front_integral::{Elastic3, Facet, FrontIntegrals, Tube, front_integrals};
+use crate::geometry::point_triangle;
 use crate::world::World;
+use glam::DVec3;
 use rayon::prelude::*;
+use std::f64::consts::SQRT_2;
 
 /// J and K at every front vertex, into the crack scratch's `measured`.
 pub fn run(world: &mut World<D3>, plan: &FracturePlan) {
@@ -37,6 +42,7 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
         length: plan.domain * h,
     };
     let facets = facets(cracks);
+    let elem_crack = cracks.topology.elem_crack();
     let elastic = |m: u16| {
         let e = &world.materials[m as usize];
         Elastic3 {
@@ -73,13 +79,23 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                 let frame = &line.frames[k];
                 let tip = ordinal[c] + k as u32;
                 let within = |r: f64| -> Vec<Facet> {
-                    (facets.iter())
-                        .filter(|f| (f.centroid - frame.x).length() < 2.0 * r + h)
-                        .copied()
+                    (facets.iter().zip(elem_crack))
+                        .filter(|&(f, &e)| {
+                            e as usize == c && (f.centroid - frame.x).length() < 2.0 * r + h
+                        })
+                        .map(|(f, _)| *f)
                         .collect()
                 };
+                // A tube reaches sqrt(2) R from the vertex; it stays clear of other cracks.
+                let room = room(cracks, c, frame.x, SQRT_2 * reach + h) / SQRT_2;
+                let fits = |t: &Tube| t.radius <= room;
+                let mut own = tube;
+                while !fits(&own) && own.radius >= own.min_radius {
+                    own.radius -= h;
+                    own.length -= h;
+                }
                 let near = within(tube.radius);
-                let fi = front_integrals(world, cracks, &line, k, &near, tube, elastic);
+                let fi = front_integrals(world, cracks, &line, k, &near, own, elastic);
                 let wide = if paths.is_empty() {
                     near
                 } else {
@@ -87,7 +103,11 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                 };
                 let path_rows = (paths.iter())
                     .map(|&t| {
-                        let p = front_integrals(world, cracks, &line, k, &wide, t, elastic);
+                        let p = if fits(&t) {
+                            front_integrals(world, cracks, &line, k, &wide, t, elastic)
+                        } else {
+                            FrontIntegrals::NONE
+                        };
                         PathResult {
                             step: world.step,
                             time: world.time,
@@ -137,6 +157,21 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
         }
     }
     m
+}
+
+/// How far `x` lies from the nearest triangle of a crack other than `c`, looking no further
+/// than `reach` (m; `f64::INFINITY` when none is that near).
+fn room(cracks: &Cracks<D3>, c: usize, x: DVec3, reach: f64) -> f64 {
+    let topo = &cracks.topology;
+    let v = &cracks.geometry.x;
+    (topo.elems().iter().zip(topo.elem_crack()))
+        .filter(|&(_, &e)| e as usize != c)
+        .map(|(t, _)| {
+            let [a, b, d] = [0, 1, 2].map(|i| v[t.vertices()[i] as usize]);
+            point_triangle(x, a, b, d)
+        })
+        .filter(|&d| d < reach)
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Centroid and unit normal of every crack triangle.

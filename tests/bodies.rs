@@ -64,25 +64,27 @@ fn cylinder_volume() {
     assert!((mass - 1000.0 * vol).abs() < 1e-12 * mass);
 }
 
-/// A tube (r = 20 mm, bore 12 mm, L = 50 mm along z) clipped to the half y >= its axis:
-/// pi (r^2 - r_i^2) L / 2, and nothing below the clipping plane.
+/// A tube (r = 20 mm, bore 12 mm, L = 20 mm along z) clipped to the half y >= its axis:
+/// pi (r^2 - r_i^2) L / 2 within 1 % (0.5 mm particle spacing, 16 across the wall), and
+/// nothing below the clipping plane.
 #[test]
 fn clipped_tube_volume() {
     let text = scene(
         3,
-        0.002,
-        "cylinder = { center = [0.05, 0.05, 0.02], axis = \"z\", radius = 0.02, \
-         inner_radius = 0.012, length = 0.05 }\n\
-         clip = { point = [0.0, 0.05, 0.0], normal = [0.0, 1.0, 0.0] }",
-    );
+        0.001,
+        "cylinder = { center = [0.025, 0.025, 0.015], axis = \"z\", radius = 0.02, \
+         inner_radius = 0.012, length = 0.02 }\n\
+         clip = { point = [0.0, 0.025, 0.0], normal = [0.0, 1.0, 0.0] }",
+    )
+    .replace("max = [1e-1, 1e-1, 1e-1]", "max = [5e-2, 5e-2, 5e-2]");
     let w = build::<D3>(&source(&text)).unwrap().world;
     let vol: f64 = w.particles.volume.iter().sum();
-    let want = 0.5 * std::f64::consts::PI * (0.02f64.powi(2) - 0.012f64.powi(2)) * 0.05;
+    let want = 0.5 * std::f64::consts::PI * (0.02f64.powi(2) - 0.012f64.powi(2)) * 0.02;
     assert!(
         (vol - want).abs() / want < 0.01,
         "half-tube volume {vol} vs {want}"
     );
-    assert!(w.particles.x.iter().all(|x| x.y > 0.05));
+    assert!(w.particles.x.iter().all(|x| x.y > 0.025));
 }
 
 /// A sphere r = 30 mm: 4/3 pi r^3; an extruded square polygon: side^2 * depth.

@@ -349,3 +349,53 @@ domain = 3
     assert_eq!(expand(&tubes[0].unfitted), list(&|d| d == 0.0));
     assert_eq!(expand(&tubes[0].shrunk), list(&|d| d > 0.0 && d < 3e-3));
 }
+
+/// Two parallel pennies 5 mm apart, one above the other: a tube of 3 cells (reach
+/// sqrt(2) x 3 mm = 4.2 mm) around one front stays clear of the other crack, so none is
+/// shrunk for it; with the second crack 3 mm away, tubes shrink to 2 cells (reach 2.8 mm),
+/// and at 2.5 mm no tube of 2 cells or more fits (J and K NaN). Each crack's own tubes are
+/// otherwise unchanged.
+#[test]
+fn tubes_stay_clear_of_other_cracks() {
+    let scene = |gap: f64| {
+        format!(
+            r#"
+[simulation]
+dimension = 3
+duration = 2e-7
+[grid]
+min = [0.0, 0.0, 0.0]
+max = [0.032, 0.032, 0.032]
+cell = [0.001, 0.001, 0.001]
+[[material]]
+name = "m"
+E = 1e9
+nu = 0.3
+rho = 1000.0
+[[body]]
+material = "m"
+box = {{ min = [0.002, 0.002, 0.002], max = [0.03, 0.03, 0.03] }}
+[[crack]]
+name = "low"
+penny = {{ center = [0.016, 0.014, 0.016], normal = [0.0, 1.0, 0.0], radius = 0.005 }}
+[[crack]]
+name = "high"
+penny = {{ center = [0.016, {y}, 0.016], normal = [0.0, 1.0, 0.0], radius = 0.005 }}
+[fracture]
+domain = 3
+"#,
+            y = 0.014 + gap
+        )
+    };
+    let radii = |gap: f64| -> Vec<f64> {
+        let h = common::history(&scene(gap));
+        let last = h.fracture.last().unwrap().step;
+        (h.fracture.iter())
+            .filter(|t| t.step == last && t.crack == 0)
+            .map(|t| t.domain)
+            .collect()
+    };
+    assert!(radii(0.005).iter().all(|&r| r == 3e-3));
+    assert!(radii(0.003).iter().all(|&r| r == 2e-3));
+    assert!(radii(0.0025).iter().all(|&r| r == 0.0));
+}

@@ -590,8 +590,10 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     .crack
                     .iter()
                     .cloned()
-                    .chain([e.tip.clone().unwrap_or_else(|| {
-                        if front_qty.is_some() { "front" } else { "end" }.into()
+                    .chain([e.tip.clone().unwrap_or_else(|| match &e.near {
+                        Some(p) if D::D == 3 => format!("near {p:?}"),
+                        _ if D::D == 3 => "front".into(),
+                        _ => "end".into(),
                     })])
                     .chain(e.at.map(|t| format!("t={t:.3e}")))
                     .collect(),
