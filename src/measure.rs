@@ -365,15 +365,7 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
                     let rows = last_rows(h, crack)?;
                     vec![rows[nearest_row(&rows, p)?].tip]
                 }
-                (None, None) => {
-                    let mut t: Vec<u32> = (h.paths.iter())
-                        .filter(|p| p.crack == crack)
-                        .map(|p| p.tip)
-                        .collect();
-                    t.sort_unstable();
-                    t.dedup();
-                    t
-                }
+                (None, None) => path_tips(h, crack),
             };
             (tips.iter())
                 .flat_map(|&t| compare.iter().map(move |&n| (t, n)))
@@ -458,6 +450,17 @@ pub fn frequency(t: &[f64], s: &[f64]) -> Option<f64> {
         return None;
     }
     Some((crossings.len() - 1) as f64 / (crossings[crossings.len() - 1] - crossings[0]))
+}
+
+/// The tips (3D: front vertices) of a crack that J was compared at, in order.
+pub fn path_tips(h: &History, crack: u32) -> Vec<u32> {
+    let mut t: Vec<u32> = (h.paths.iter())
+        .filter(|p| p.crack == crack)
+        .map(|p| p.tip)
+        .collect();
+    t.sort_unstable();
+    t.dedup();
+    t
 }
 
 /// A crack's rows of the last fracture measurement (one per tip or front vertex); None

@@ -278,19 +278,17 @@ fn front_frames_follow_a_curved_front() {
     }
 }
 
-/// A penny crack whose front passes 0.2 mm from the body's face: at the vertices within
-/// half a cell of the face no tube of 2 cells fits (J and K NaN, domain 0); those more than
-/// 4 cells from it get the whole tube of 3 cells asked for; summary.json lists exactly the
-/// vertices whose tube was shrunk or did not fit.
-#[test]
-fn tubes_near_a_face_shrink_or_are_reported() {
-    let text = r#"
+/// A 28 mm cube of 1 mm cells, 2 mm inside its grid, at rest for two steps, with `cracks`
+/// and J and K on tubes of 3 cells.
+fn cube_with(cracks: &str) -> String {
+    format!(
+        r#"
 [simulation]
 dimension = 3
 duration = 2e-7
 [grid]
 min = [0.0, 0.0, 0.0]
-max = [0.028, 0.028, 0.028]
+max = [0.032, 0.032, 0.032]
 cell = [0.001, 0.001, 0.001]
 [[material]]
 name = "m"
@@ -299,14 +297,24 @@ nu = 0.3
 rho = 1000.0
 [[body]]
 material = "m"
-box = { min = [0.002, 0.002, 0.002], max = [0.026, 0.026, 0.026] }
-[[crack]]
-name = "p"
-penny = { center = [0.0072, 0.014, 0.014], normal = [0.0, 1.0, 0.0], radius = 0.005 }
-[fracture]
+box = {{ min = [0.002, 0.002, 0.002], max = [0.03, 0.03, 0.03] }}
+{cracks}[fracture]
 domain = 3
-"#;
-    let out = common::run_text(text);
+"#
+    )
+}
+
+/// A penny crack whose front passes 0.2 mm from the body's face: at the vertices within
+/// half a cell of the face no tube of 2 cells fits (J and K NaN, domain 0); those more than
+/// 4 cells from it get the whole tube of 3 cells asked for; summary.json lists exactly the
+/// vertices whose tube was shrunk or did not fit.
+#[test]
+fn tubes_near_a_face_shrink_or_are_reported() {
+    let text = cube_with(
+        "[[crack]]\nname = \"p\"\npenny = { center = [0.0072, 0.014, 0.014], \
+         normal = [0.0, 1.0, 0.0], radius = 0.005 }\n",
+    );
+    let out = common::run_text(&text);
     let last = out.history.fracture.last().unwrap().step;
     let rows: Vec<_> = (out.history.fracture.iter())
         .filter(|t| t.step == last)
@@ -358,34 +366,13 @@ domain = 3
 #[test]
 fn tubes_stay_clear_of_other_cracks() {
     let scene = |gap: f64| {
-        format!(
-            r#"
-[simulation]
-dimension = 3
-duration = 2e-7
-[grid]
-min = [0.0, 0.0, 0.0]
-max = [0.032, 0.032, 0.032]
-cell = [0.001, 0.001, 0.001]
-[[material]]
-name = "m"
-E = 1e9
-nu = 0.3
-rho = 1000.0
-[[body]]
-material = "m"
-box = {{ min = [0.002, 0.002, 0.002], max = [0.03, 0.03, 0.03] }}
-[[crack]]
-name = "low"
-penny = {{ center = [0.016, 0.014, 0.016], normal = [0.0, 1.0, 0.0], radius = 0.005 }}
-[[crack]]
-name = "high"
-penny = {{ center = [0.016, {y}, 0.016], normal = [0.0, 1.0, 0.0], radius = 0.005 }}
-[fracture]
-domain = 3
-"#,
+        cube_with(&format!(
+            "[[crack]]\nname = \"low\"\npenny = {{ center = [0.016, 0.014, 0.016], \
+             normal = [0.0, 1.0, 0.0], radius = 0.005 }}\n[[crack]]\nname = \"high\"\n\
+             penny = {{ center = [0.016, {y}, 0.016], normal = [0.0, 1.0, 0.0], \
+             radius = 0.005 }}\n",
             y = 0.014 + gap
-        )
+        ))
     };
     let radii = |gap: f64| -> Vec<f64> {
         let h = common::history(&scene(gap));

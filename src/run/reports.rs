@@ -3,7 +3,7 @@
 
 use crate::dim::Dim;
 use crate::fracture::{FracturePlan, TipResult};
-use crate::measure::{History, path_difference};
+use crate::measure::{History, path_difference, path_tips};
 use crate::output::summary::{PathReport, TubeReport};
 use crate::world::World;
 
@@ -31,15 +31,7 @@ pub(super) fn paths<D: Dim>(
             .collect()
     } else {
         (0..topo.cracks().len() as u32)
-            .map(|c| {
-                let mut tips: Vec<u32> = (history.paths.iter())
-                    .filter(|p| p.crack == c)
-                    .map(|p| p.tip)
-                    .collect();
-                tips.sort_unstable();
-                tips.dedup();
-                (c, "front (worst vertex)".into(), tips)
-            })
+            .map(|c| (c, "front (worst vertex)".into(), path_tips(history, c)))
             .filter(|g| !g.2.is_empty())
             .collect()
     };
