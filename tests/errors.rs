@@ -130,6 +130,31 @@ fn time_step_above_the_stability_limit() {
     assert_error(&e, "simulation.dt", Some(5), "above the stability limit");
 }
 
+/// A scene larger than the machine's free memory (a 3D body of 16^3 particles per cell
+/// over 100^3 cells, about 2 TB) is refused before anything is allocated, with the
+/// estimate; no machine this runs on has that much free.
+#[test]
+fn a_scene_too_large_for_memory_is_refused_at_once() {
+    let text = text_3d("")
+        .replace(
+            "cell = [0.002, 0.002, 0.002]",
+            "cell = [0.0002, 0.0002, 0.0002]",
+        )
+        .replace(
+            "box = { min = [0.004, 0.004, 0.004]",
+            "ppc = 16\nbox = { min = [0.0, 0.0, 0.0]",
+        )
+        .replace(
+            "max = [0.016, 0.016, 0.016] }",
+            "max = [0.02, 0.02, 0.02] }",
+        );
+    let src = Source::parse("bad.toml", &text, &[]).unwrap();
+    match fissure::scenario::build::<fissure::dim::D3>(&src) {
+        Ok(_) => panic!("a 2 TB scene must be refused"),
+        Err(e) => assert_error(&e, "grid.cell", None, "this machine has"),
+    }
+}
+
 /// A body with no particle, also once clipped, and a tube whose bore is not inside it.
 #[test]
 fn empty_body() {

@@ -291,6 +291,19 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     if sc.bodies.is_empty() {
         return Err(src.error("body", "the scenario has no [[body]]"));
     }
+    // The particles the bodies can hold at most (their bounding boxes filled), before any
+    // is made, so that a scene too large for the machine is refused at once.
+    let mut most = 0.0;
+    for (b, body) in sc.bodies.iter().enumerate() {
+        let (lo, hi) = geometry::<D>(src, b, body)?.bounds();
+        let mut n = 1.0;
+        for a in 0..D::D {
+            let span = (hi[a].min(gmax[a]) - lo[a].max(gmin[a])).max(0.0);
+            n *= (span / h[a] + 2.0) * body.ppc.clamp(1, 16) as f64;
+        }
+        most += n;
+    }
+    super::memory::check(src, D::D, most, node_count, super::memory::available())?;
     let mut particles = Particles::<D>::default();
     let shape = sim.shape;
     let mut used = vec![false; materials.len()];
