@@ -1,0 +1,108 @@
+//! The scenario parser and builder never panic: on arbitrary bytes, and on the shipped
+//! scenarios with bytes deleted, replaced, inserted or lines repeated, they either build
+//! the scene or return an error. 64 cases each by default; PROPTEST_CASES=100000 for a
+//! longer fuzzing session.
+
+use fissure::dim::{D2, D3};
+use fissure::scenario::{Source, build};
+use proptest::prelude::*;
+use std::sync::OnceLock;
+
+/// The texts of the shipped scenarios (the fast ones, in `scenarios/`).
+fn shipped() -> &'static [String] {
+    static TEXTS: OnceLock<Vec<String>> = OnceLock::new();
+    TEXTS.get_or_init(|| {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+        let mut paths: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        paths.sort();
+        paths
+            .iter()
+            .map(|p| std::fs::read_to_string(p).unwrap())
+            .collect()
+    })
+}
+
+/// Parses `text` and, when its grid is small enough to build in a moment, builds it.
+fn parse_and_build(text: &str) {
+    let Ok(src) = Source::parse("fuzz.toml", text, &[]) else {
+        return;
+    };
+    let g = &src.scenario.grid;
+    let nodes: f64 = (g.min.iter().zip(&g.max).zip(&g.cell))
+        .map(|((lo, hi), h)| ((hi - lo) / h).abs() + 1.0)
+        .product();
+    // Mutations can ask for huge scenes, which the builder accepts while they fit in
+    // memory; only small ones are built here, to keep the test quick.
+    if !(nodes.is_finite() && nodes < 2e5) {
+        return;
+    }
+    let _ = match src.scenario.simulation.dimension {
+        3 => build::<D3>(&src).map(|_| ()),
+        _ => build::<D2>(&src).map(|_| ()),
+    };
+}
+
+/// One edit of `text` at the fraction `at` of its length: 0 deletes up to `len` bytes,
+/// 1 replaces one byte by `byte`, 2 inserts `chunk`, 3 repeats the line there.
+fn mutate(text: &str, op: u8, at: f64, len: usize, byte: u8, chunk: &str) -> String {
+    let mut b = text.as_bytes().to_vec();
+    let i = ((b.len() as f64 * at) as usize).min(b.len().saturating_sub(1));
+    match op {
+        0 => {
+            let end = (i + len).min(b.len());
+            b.drain(i..end);
+        }
+        1 => {
+            if !b.is_empty() {
+                b[i] = byte;
+            }
+        }
+        2 => {
+            b.splice(i..i, chunk.bytes());
+        }
+        _ => {
+            let start = b[..i]
+                .iter()
+                .rposition(|&c| c == b'\n')
+                .map_or(0, |k| k + 1);
+            let end = b[i..]
+                .iter()
+                .position(|&c| c == b'\n')
+                .map_or(b.len(), |k| i + k + 1);
+            let line = b[start..end].to_vec();
+            b.splice(start..start, line);
+        }
+    }
+    String::from_utf8_lossy(&b).into_owned()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(
+        std::env::var("PROPTEST_CASES").ok().and_then(|c| c.parse().ok()).unwrap_or(64)
+    ))]
+
+    #[test]
+    fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..2048)) {
+        parse_and_build(&String::from_utf8_lossy(&bytes));
+    }
+
+    #[test]
+    fn mutated_scenarios_never_panic(
+        which in any::<usize>(),
+        edits in proptest::collection::vec(
+            (0u8..4, 0.0f64..1.0, 1usize..40, any::<u8>(), "[ -~\n]{0,24}"),
+            1..6,
+        ),
+    ) {
+        let texts = shipped();
+        let mut text = texts[which % texts.len()].clone();
+        for (op, at, len, byte, chunk) in &edits {
+            text = mutate(&text, *op, *at, *len, *byte, chunk);
+        }
+        parse_and_build(&text);
+    }
+}
