@@ -197,6 +197,46 @@ fn restart_is_bit_exact_with_a_3d_crack() {
     restart_is_bit_exact(&text, 17, 2, "3d-crack");
 }
 
+/// Resumed into another folder, a run's collection files list the frames written before
+/// the stop in the first folder, by a relative path, and every file they list exists; the
+/// resumed folder holds only its own frames.
+#[test]
+fn collections_after_a_resume_elsewhere_point_to_existing_frames() {
+    let dir = scratch("elsewhere");
+    let crack = "[[crack]]\nline = { start = [0.02, 0.0005], end = [0.02, 0.0135], spacing = 5e-4 }\ntips = []\n";
+    let text = scene(2, "ugimp", "usavg").replace("[[probe]]", &format!("{crack}[[probe]]"));
+    let src = source(&text);
+    let part = run(
+        &src,
+        &RunOptions {
+            pause_after: Some(29),
+            ..opts(&dir.join("a"), 1)
+        },
+    )
+    .unwrap();
+    let snap = part.snapshot.expect("a stopped run writes a snapshot");
+    resume(&snap, &opts(&dir.join("b").join("c"), 1)).unwrap();
+    for pvd in ["particles.pvd", "cracks.pvd"] {
+        let text = std::fs::read_to_string(dir.join("b/c").join(pvd)).unwrap();
+        let files: Vec<&str> = text
+            .split("file=\"")
+            .skip(1)
+            .map(|s| s.split('"').next().unwrap())
+            .collect();
+        assert!(files.len() > 2, "{pvd}: {text}");
+        assert!(files[0].starts_with("../../a/"), "{pvd}: {}", files[0]);
+        for f in &files {
+            assert!(
+                dir.join("b/c").join(f).exists(),
+                "{pvd} lists {f}, which is not there"
+            );
+        }
+        let own = files.iter().filter(|f| !f.contains('/')).count();
+        assert!(own > 0 && own < files.len(), "{pvd}: frames of both runs");
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
+
 /// Periodic snapshots land on multiples of `every_steps`, the last step gets one, and only
 /// the newest `keep` remain.
 #[test]

@@ -217,6 +217,12 @@ fn drive<D: Dim>(
         )?),
         None => None,
     };
+    // A snapshot lies in <run folder>/snapshots/; frames before it stay in that folder.
+    if let (Some(w), Some(from)) = (&mut writers, resumed_from.as_ref())
+        && let Some(run_dir) = from.parent().and_then(Path::parent)
+    {
+        w.frames_in(run_dir, state.frames.len());
+    }
     // Takes what the fracture system measured to fracture.csv and the history.
     let take = |world: &mut World<D>, state: &mut RunState, w: &mut Option<Writers>| {
         let Some(c) = world.cracks.as_mut() else {

@@ -24,6 +24,9 @@ pub struct Writers {
     /// Whether a tip is a 3D front vertex (named by its ordinal along the crack's front)
     /// rather than a 2D crack end (named start or end).
     front_vertices: bool,
+    /// After a resume into another folder: the frames written before it (their count) and
+    /// the folder they are in, relative to this one, which the collection files point to.
+    earlier: Option<(usize, String)>,
 }
 
 impl Writers {
@@ -85,6 +88,7 @@ impl Writers {
             fracture,
             paths,
             front_vertices,
+            earlier: None,
         };
         for row in &history.rows {
             w.row(row, history)?;
@@ -159,16 +163,34 @@ impl Writers {
         Ok(())
     }
 
+    /// After a resume from the run in folder `from` into this one: its first `frames` VTK
+    /// frames stay there, and the collection files point to them (nothing changes when
+    /// the two folders are one, or `from` does not hold them).
+    pub fn frames_in(&mut self, from: &Path, frames: usize) {
+        let (Ok(from), Ok(here)) = (from.canonicalize(), self.dir.canonicalize()) else {
+            return;
+        };
+        if from != here && (frames == 0 || from.join(frame_name(0)).exists()) {
+            self.earlier = Some((frames, relative(&here, &from)));
+        }
+    }
+
+    /// The name of frame `k` of kind `kind` ("particles", "cracks") in the collection file.
+    fn listed(&self, kind: &str, k: usize) -> String {
+        let name = format!("{kind}_{k:05}.vtu");
+        match &self.earlier {
+            Some((n, dir)) if k < *n => format!("{dir}{name}"),
+            _ => name,
+        }
+    }
+
     /// Writes a VTK frame of `world` and the collection file listing every frame so far.
     pub fn frame<D: Dim>(&mut self, world: &World<D>, state: &mut RunState) -> anyhow::Result<()> {
         let name = frame_name(state.frames.len());
         vtk::write_particles(&self.dir.join(&name), &world.particles)?;
         state.frames.push(world.time);
-        let list: Vec<(f64, String)> = state
-            .frames
-            .iter()
-            .enumerate()
-            .map(|(k, &t)| (t, frame_name(k)))
+        let list: Vec<(f64, String)> = (state.frames.iter().enumerate())
+            .map(|(k, &t)| (t, self.listed("particles", k)))
             .collect();
         vtk::write_collection(&self.dir.join("particles.pvd"), &list)?;
         if let Some(c) = &world.cracks {
@@ -179,11 +201,8 @@ impl Writers {
                 .copied()
                 .collect();
             vtk::write_cracks(&self.dir.join(crack_name(state.frames.len() - 1)), c, &tips)?;
-            let list: Vec<(f64, String)> = state
-                .frames
-                .iter()
-                .enumerate()
-                .map(|(k, &t)| (t, crack_name(k)))
+            let list: Vec<(f64, String)> = (state.frames.iter().enumerate())
+                .map(|(k, &t)| (t, self.listed("cracks", k)))
                 .collect();
             vtk::write_collection(&self.dir.join("cracks.pvd"), &list)?;
         }
@@ -206,4 +225,19 @@ impl Writers {
 
 fn frame_name(k: usize) -> String {
     format!("particles_{k:05}.vtu")
+}
+
+/// The path from folder `from` to folder `to` (both absolute), ending in a separator:
+/// up to their common ancestor, then down.
+fn relative(from: &Path, to: &Path) -> String {
+    let (a, b): (Vec<_>, Vec<_>) = (from.components().collect(), to.components().collect());
+    let common = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut out = PathBuf::new();
+    for _ in common..a.len() {
+        out.push("..");
+    }
+    for c in &b[common..] {
+        out.push(c);
+    }
+    format!("{}/", out.display())
 }
