@@ -139,13 +139,20 @@ fn report(e: anyhow::Error) -> ExitCode {
     }
 }
 
-/// A flag set by Ctrl-C or SIGTERM, so the run stops cleanly after the current step and
-/// writes a snapshot; a second signal exits at once.
-fn stop_flag() -> Arc<AtomicBool> {
+/// A flag set by Ctrl-C or SIGTERM, so the run stops cleanly after the current step (or
+/// before the first, during set-up) and writes a snapshot; a second signal exits at once,
+/// leaving a summary.json in `out` that says so.
+fn stop_flag(out: &Path) -> Arc<AtomicBool> {
     let flag = Arc::new(AtomicBool::new(false));
     let f = flag.clone();
+    let summary = out.join("summary.json");
     let installed = ctrlc::set_handler(move || {
         if f.swap(true, Ordering::SeqCst) {
+            let text = "{\n  \"status\": \"interrupted\",\n  \"message\": \"aborted by a second \
+                        signal, without a clean stop: no snapshot of this invocation\"\n}\n";
+            if summary.parent().is_some_and(Path::is_dir) {
+                std::fs::write(&summary, text).ok();
+            }
             std::process::exit(i32::from(INTERRUPTED));
         }
         eprintln!("\nstopping after this step (signal again to abort at once)");
@@ -237,7 +244,7 @@ fn cmd_run(
         progress: true,
         until,
         pause_after: None,
-        stop: Some(stop_flag()),
+        stop: Some(stop_flag(&out)),
     };
     match run(&src, &opts) {
         Ok(o) => finish(&o, &out),
@@ -259,7 +266,7 @@ fn cmd_resume(path: &Path, out: Option<PathBuf>, threads: usize, until: Option<f
         progress: true,
         until,
         pause_after: None,
-        stop: Some(stop_flag()),
+        stop: Some(stop_flag(&out)),
     };
     match resume(path, &opts) {
         Ok(o) => finish(&o, &out),

@@ -573,3 +573,89 @@ fn inspect_reports_checksums_and_exit_codes() {
     assert_eq!(missing.status.code(), Some(2));
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// A stop asked for during set-up (the flag already set when the run starts) ends the run
+/// before its first step: summary.json says "interrupted" and why, and no snapshot is
+/// written, for there is nothing to resume.
+#[test]
+fn a_stop_during_set_up_ends_the_run_before_its_first_step() {
+    let dir = scratch("early");
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+    let out = run(
+        &source(&scene(2, "linear", "usf")),
+        &RunOptions {
+            stop: Some(stop),
+            ..opts(&dir, 1)
+        },
+    )
+    .unwrap();
+    assert_eq!(out.summary.status, "interrupted");
+    assert_eq!(out.summary.steps, 0);
+    assert!(out.snapshot.is_none());
+    let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    assert!(summary.contains("during set-up"), "{summary}");
+    assert!(
+        !dir.join("snapshots").exists()
+            || std::fs::read_dir(dir.join("snapshots"))
+                .unwrap()
+                .next()
+                .is_none()
+    );
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// Two signals in a row: the second aborts at once, and summary.json says so instead of
+/// being missing (exit code 130).
+#[cfg(unix)]
+#[test]
+fn a_second_signal_aborts_and_leaves_a_summary() {
+    let dir = scratch("twice");
+    let file = dir.join("long.toml");
+    std::fs::write(
+        &file,
+        scene(3, "ugimp", "usavg").replace("duration = 1e-5", "duration = 1.0"),
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+        .args([
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait until the run is stepping (its first frame is written).
+    let started = std::time::Instant::now();
+    while !out_dir.join("particles_00001.vtu").exists() {
+        assert!(started.elapsed().as_secs() < 60, "the run never got going");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let pid = child.id().to_string();
+    for _ in 0..2 {
+        std::process::Command::new("kill")
+            .args(["-INT", &pid])
+            .status()
+            .unwrap();
+    }
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if started.elapsed().as_secs() > 120 {
+            child.kill().ok();
+            panic!("the run did not stop on two signals");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    assert_eq!(status.code(), Some(130));
+    let summary = std::fs::read_to_string(out_dir.join("summary.json")).unwrap();
+    assert!(
+        summary.contains("\"interrupted\"") && summary.contains("second signal"),
+        "{summary}"
+    );
+    std::fs::remove_dir_all(dir).ok();
+}

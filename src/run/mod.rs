@@ -270,9 +270,18 @@ fn drive<D: Dim>(
         ProgressBar::hidden()
     };
     let first_step = world.step;
-    let mut stop = Stop::Completed;
+    // A signal during set-up stops the run before its first step: nothing to save.
+    let early = opts
+        .stop
+        .as_ref()
+        .is_some_and(|s| s.load(Ordering::Relaxed));
+    let mut stop = if early {
+        Stop::Interrupted
+    } else {
+        Stop::Completed
+    };
     let t0 = Instant::now();
-    while world.step < steps {
+    while !early && world.step < steps {
         // A step that ends at a history row with J to measure keeps its own stencils.
         let next = world.step + 1;
         let ends_at_row = row_due(
@@ -346,6 +355,11 @@ fn drive<D: Dim>(
         Stop::Interrupted => (
             "interrupted",
             Some(match &snapshot {
+                _ if early => format!(
+                    "stopped on request during set-up, before step {}: nothing was run, so \
+                     no snapshot",
+                    world.step + 1
+                ),
                 Some((p, _)) => format!(
                     "stopped on request at step {} (t = {:.6e} s); snapshot {}; continue with `fissure resume {}`",
                     world.step,
