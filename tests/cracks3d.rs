@@ -102,17 +102,19 @@ fn a_closed_crack_surface_under_compression_carries_the_load() {
     assert!(e.strain < 1e-20 * e.kinetic, "open crack: {}", e.strain);
 }
 
-/// The crack store of a one-crack 3D scene over a large block (the crack well inside).
-fn store(crack: &str) -> fissure::crack::Cracks<D3> {
-    let text = format!(
+/// A cube body at rest over a grid `size` (m) on a side of `cell` cells, `inset` inside
+/// it, for `duration` (s), with `rest` (cracks, fracture) appended.
+fn cube(size: f64, cell: f64, inset: f64, duration: f64, rest: &str) -> String {
+    let v = |x: f64| format!("[{x:e}, {x:e}, {x:e}]");
+    format!(
         r#"
 [simulation]
 dimension = 3
-duration = 1e-6
+duration = {duration:e}
 [grid]
 min = [0.0, 0.0, 0.0]
-max = [0.04, 0.04, 0.04]
-cell = [0.002, 0.002, 0.002]
+max = {size}
+cell = {cell}
 [[material]]
 name = "m"
 E = 1e9
@@ -120,11 +122,18 @@ nu = 0.3
 rho = 1000.0
 [[body]]
 material = "m"
-box = {{ min = [0.004, 0.004, 0.004], max = [0.036, 0.036, 0.036] }}
-[[crack]]
-{crack}
-"#
-    );
+box = {{ min = {lo}, max = {hi} }}
+{rest}"#,
+        size = v(size),
+        cell = v(cell),
+        lo = v(inset),
+        hi = v(size - inset),
+    )
+}
+
+/// The crack store of a one-crack 3D scene over a large block (the crack well inside).
+fn store(crack: &str) -> fissure::crack::Cracks<D3> {
+    let text = cube(0.04, 0.002, 0.004, 1e-6, &format!("[[crack]]\n{crack}\n"));
     build::<D3>(&source(&text))
         .unwrap_or_else(|e| panic!("{e}"))
         .world
@@ -281,26 +290,12 @@ fn front_frames_follow_a_curved_front() {
 /// A 28 mm cube of 1 mm cells, 2 mm inside its grid, at rest for two steps, with `cracks`
 /// and J and K on tubes of 3 cells.
 fn cube_with(cracks: &str) -> String {
-    format!(
-        r#"
-[simulation]
-dimension = 3
-duration = 2e-7
-[grid]
-min = [0.0, 0.0, 0.0]
-max = [0.032, 0.032, 0.032]
-cell = [0.001, 0.001, 0.001]
-[[material]]
-name = "m"
-E = 1e9
-nu = 0.3
-rho = 1000.0
-[[body]]
-material = "m"
-box = {{ min = [0.002, 0.002, 0.002], max = [0.03, 0.03, 0.03] }}
-{cracks}[fracture]
-domain = 3
-"#
+    cube(
+        0.032,
+        0.001,
+        0.002,
+        2e-7,
+        &format!("{cracks}[fracture]\ndomain = 3\n"),
     )
 }
 
