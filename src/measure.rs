@@ -465,7 +465,7 @@ pub fn path_tips(h: &History, crack: u32) -> Vec<u32> {
 
 /// A crack's rows of the last fracture measurement (one per tip or front vertex); None
 /// without any.
-fn last_rows(h: &History, crack: u32) -> Option<Vec<&TipResult>> {
+pub fn last_rows(h: &History, crack: u32) -> Option<Vec<&TipResult>> {
     let rows = h.fracture.iter().filter(|r| r.crack == crack);
     let last = rows.clone().map(|r| r.step).max()?;
     Some(rows.filter(|r| r.step == last).collect())

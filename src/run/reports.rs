@@ -2,8 +2,8 @@
 //! front that did not fit inside the body.
 
 use crate::dim::Dim;
-use crate::fracture::{FracturePlan, TipResult};
-use crate::measure::{History, path_difference, path_tips};
+use crate::fracture::FracturePlan;
+use crate::measure::{History, last_rows, path_difference, path_tips};
 use crate::output::summary::{PathReport, TubeReport};
 use crate::world::World;
 
@@ -72,13 +72,11 @@ pub(super) fn tubes<D: Dim>(
     };
     let h = (0..D::D).map(|a| world.grid.geom.h[a]).fold(0.0, f64::max);
     let asked = plan.domain * h;
-    let last = history.fracture.last().map(|t| t.step);
-    let rows: Vec<&TipResult> = (history.fracture.iter().rev())
-        .take_while(|t| Some(t.step) == last)
-        .collect();
     let mut out = Vec::new();
     for (c, crack) in cracks.topology.cracks().iter().enumerate() {
-        let mut mine: Vec<&&TipResult> = rows.iter().filter(|t| t.crack == c as u32).collect();
+        let Some(mut mine) = last_rows(history, c as u32) else {
+            continue;
+        };
         mine.sort_by_key(|t| t.tip);
         let unfitted: Vec<u32> = (mine.iter())
             .filter(|t| t.domain == 0.0)
