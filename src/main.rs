@@ -4,6 +4,7 @@ use clap::{Parser, Subcommand};
 use fissure::dim::{D2, D3};
 use fissure::error::{ScenarioError, UsageError};
 use fissure::run::checkpoint::resolve;
+use fissure::run::stop::StopRequests;
 use fissure::run::{Outcome, RunOptions, resume, run};
 use fissure::scenario::{Source, build};
 use fissure::schedule::Schedule;
@@ -11,7 +12,7 @@ use fissure::snapshot::{Reader, SnapshotError};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 /// Dynamic fracture with the material point method.
@@ -143,16 +144,10 @@ fn report(e: anyhow::Error) -> ExitCode {
 /// before the first, during set-up) and writes a snapshot; a second signal exits at once,
 /// leaving a summary.json in `out` that says so.
 fn stop_flag(out: &Path) -> Arc<AtomicBool> {
-    let flag = Arc::new(AtomicBool::new(false));
-    let f = flag.clone();
-    let summary = out.join("summary.json");
+    let requests = StopRequests::new(out);
+    let flag = requests.flag();
     let installed = ctrlc::set_handler(move || {
-        if f.swap(true, Ordering::SeqCst) {
-            let text = "{\n  \"status\": \"interrupted\",\n  \"message\": \"aborted by a second \
-                        signal, without a clean stop: no snapshot of this invocation\"\n}\n";
-            if summary.parent().is_some_and(Path::is_dir) {
-                std::fs::write(&summary, text).ok();
-            }
+        if requests.request() {
             std::process::exit(i32::from(INTERRUPTED));
         }
         eprintln!("\nstopping after this step (signal again to abort at once)");

@@ -4,6 +4,7 @@
 pub mod checkpoint;
 mod reports;
 pub mod state;
+pub mod stop;
 pub mod writers;
 
 use crate::dim::{D2, D3, Dim};
