@@ -6,6 +6,7 @@
 //! written once.
 
 use crate::crack::{Element, Segment, Triangle};
+use crate::error::Unstable;
 use crate::fracture::FracturePlan;
 use crate::geometry::{point_segment, point_segment_sq, point_triangle, segment_segment};
 use crate::snapshot::Columnar;
@@ -52,6 +53,8 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     /// The fracture system of this dimension (J and K at crack tips in 2D, at every front
     /// vertex in 3D, stored in the crack scratch).
     const FRACTURE: FractureSystem<Self>;
+    /// The growth system of this dimension; None where cracks do not grow yet (3D).
+    const GROWTH: Option<GrowthSystem<Self>>;
 
     /// The zero vector.
     fn zero() -> Self::Vec;
@@ -126,6 +129,15 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
 /// A fracture system: measures at every crack front of the world as the plan says.
 pub type FractureSystem<D> = fn(&mut World<D>, &FracturePlan);
 
+/// A growth system: `run` advances the growing crack tips after a step; `needs_k` says
+/// whether it reads K at the end of a given step (which must then keep its stencils).
+pub struct GrowthSystem<D: Dim> {
+    /// Advances the tips.
+    pub run: fn(&mut World<D>, Option<&FracturePlan>) -> Result<(), Unstable>,
+    /// Whether the tips read K or J at the end of this step.
+    pub needs_k: fn(&World<D>, u64) -> bool,
+}
+
 /// +1 for a non-negative orientation, -1 otherwise (the tie rule of [`Dim::crossing`]).
 #[inline(always)]
 fn side(o: f64) -> i8 {
@@ -149,6 +161,10 @@ impl Dim for D2 {
     type Sym = Sym2;
     type Elem = Segment;
     const FRACTURE: FractureSystem<Self> = crate::systems::fracture::run;
+    const GROWTH: Option<GrowthSystem<Self>> = Some(GrowthSystem {
+        run: crate::systems::grow::run,
+        needs_k: crate::systems::grow::needs_k,
+    });
 
     #[inline(always)]
     fn zero() -> DVec2 {
@@ -262,6 +278,7 @@ impl Dim for D3 {
     type Sym = Sym3;
     type Elem = Triangle;
     const FRACTURE: FractureSystem<Self> = crate::systems::fracture_front::run;
+    const GROWTH: Option<GrowthSystem<Self>> = None;
 
     #[inline(always)]
     fn zero() -> DVec3 {

@@ -3,17 +3,16 @@
 
 use thiserror::Error;
 
-/// A run that went unstable: the step, time and particle where it was detected.
+/// A run that went unstable: the step and time where it was detected, and what happened
+/// (naming the particle or crack tip).
 #[derive(Debug, Error, Clone)]
-#[error("run went unstable at step {step} (t = {time:.6e} s): particle {particle} {what}")]
+#[error("run went unstable at step {step} (t = {time:.6e} s): {what}")]
 pub struct Unstable {
     /// Step at which the problem was detected.
     pub step: u64,
     /// Simulated time (s).
     pub time: f64,
-    /// Offending particle index.
-    pub particle: usize,
-    /// What happened.
+    /// What happened, to what.
     pub what: String,
 }
 

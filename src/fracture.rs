@@ -49,6 +49,8 @@ pub struct Measured {
     pub tips: Vec<TipResult>,
     /// One result per tip and compared contour.
     pub paths: Vec<PathResult>,
+    /// The growth system's records of new segments.
+    pub growth: Vec<crate::growth::GrowthRow>,
 }
 
 /// J on one contour at one tip and time, its line and area parts apart (J/m^2): the

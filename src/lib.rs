@@ -15,6 +15,7 @@ pub mod front;
 pub mod front_integral;
 pub mod geometry;
 pub mod grid;
+pub mod growth;
 pub mod interaction;
 pub mod loads;
 pub mod material;

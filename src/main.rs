@@ -203,6 +203,15 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
             parts.join("; ")
         );
     }
+    for g in &s.growth {
+        if let Some(why) = &g.stopped {
+            println!(
+                "  note: the {} tip of crack `{}` {why} at ({:.4e}, {:.4e}) m after growing \
+                 {:.4e} m, and stopped there",
+                g.tip, g.crack, g.x[0], g.x[1], g.grown
+            );
+        }
+    }
     for e in &s.expects {
         println!(
             "  {} {:<22} value {:>12} reference {:>12.5e} error {:>10} tol {:.2e}",

@@ -2,6 +2,7 @@
 
 use crate::dim::Dim;
 use crate::fracture::{PathResult, TipResult};
+use crate::growth::GrowthRow;
 use crate::material::Elastic;
 use crate::particles::Particles;
 use crate::sym::SymTensor;
@@ -89,6 +90,8 @@ pub struct History {
     pub fracture: Vec<TipResult>,
     /// J on the compared contours, at the energy cadence.
     pub paths: Vec<PathResult>,
+    /// The growing tips' new segments.
+    pub growth: Vec<GrowthRow>,
 }
 
 /// How a reference varies along a front with the angle theta about its centre.
@@ -205,6 +208,15 @@ pub enum Measure {
         /// Start of the window (s).
         from: f64,
     },
+    /// A growing tip's path or fatigue life, from its growth rows.
+    Growth {
+        /// Crack index.
+        crack: u32,
+        /// 0 start, 1 end.
+        tip: u32,
+        /// What is read.
+        qty: GrowthQty,
+    },
     /// Path dependence of J with the area (3D: volume) term at a crack tip: the largest
     /// [`path_difference`] of the compared contours against the main one; along a 3D front
     /// the largest over its vertices, or at the one `near` a point.
@@ -222,6 +234,22 @@ pub enum Measure {
         /// Start of the window (s).
         from: f64,
     },
+}
+
+/// What a growth expect reads from a tip's growth rows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GrowthQty {
+    /// The first new segment's turn from the crack's last segment (degrees).
+    Kink,
+    /// The path's line over the last quarter of the length grown (the chord between the
+    /// tip positions there, smoother than one segment), as an angle to x in (-90, 90]
+    /// degrees.
+    PathAngle,
+    /// The chord from where the tip started to its last new vertex, as a turn from the
+    /// crack's direction there (degrees, counterclockwise, in (-180, 180]).
+    Turn,
+    /// Fatigue: load cycles to grow by this length (m), interpolated linearly between rows.
+    Cycles(f64),
 }
 
 /// A checked expectation.
@@ -375,6 +403,38 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
                 })
                 .flatten()
                 .and_then(finite)
+        }
+        Measure::Growth { crack, tip, qty } => {
+            let rows: Vec<&GrowthRow> = (h.growth.iter())
+                .filter(|g| g.crack == crack && g.tip == tip)
+                .collect();
+            match qty {
+                GrowthQty::Kink => finite(rows.first()?.kink.to_degrees()),
+                GrowthQty::PathAngle => {
+                    let last = rows.last()?;
+                    let from = rows.iter().find(|g| g.grown >= 0.75 * last.grown)?;
+                    let (dx, dy) = (last.x[0] - from.x[0], last.x[1] - from.x[1]);
+                    let a = if from.step == last.step {
+                        last.heading.to_degrees()
+                    } else {
+                        dy.atan2(dx).to_degrees()
+                    };
+                    finite(a - 180.0 * ((a + 90.0) / 180.0).ceil() + 180.0)
+                }
+                GrowthQty::Turn => {
+                    let (first, last) = (rows.first()?, rows.last()?);
+                    let chord = (last.x[1] - first.x[1]).atan2(last.x[0] - first.x[0]);
+                    let turn = (chord - (first.heading - first.kink)).to_degrees();
+                    finite(turn - 360.0 * ((turn + 180.0) / 360.0).ceil() + 360.0)
+                }
+                GrowthQty::Cycles(length) => {
+                    // The lengths are sums of extensions: allow for their rounding.
+                    let k = rows.iter().position(|g| g.grown >= length * (1.0 - 1e-9))?;
+                    let (a, b) = (rows[k.checked_sub(1)?], rows[k]);
+                    let w = (length - a.grown) / (b.grown - a.grown);
+                    finite(a.fatigue[1] + w * (b.fatigue[1] - a.fatigue[1]))
+                }
+            }
         }
         Measure::Max(p) => h.probes[p].iter().copied().reduce(f64::max),
         Measure::Min(p) => h.probes[p].iter().copied().reduce(f64::min),

@@ -53,6 +53,8 @@ pub enum System {
     G2pRemap,
     /// J and K at the crack fronts, on the steps that end at an output row.
     Fracture,
+    /// Advance the growing crack tips, after the step and its measurement.
+    Grow,
 }
 
 impl System {
@@ -71,6 +73,7 @@ impl System {
             System::G2p => "g2p",
             System::G2pRemap => "g2p_remap",
             System::Fracture => "fracture",
+            System::Grow => "grow",
         }
     }
 }
@@ -84,6 +87,8 @@ pub struct Schedule {
     pub seconds: Vec<f64>,
     /// What the fracture system measures (None: the scene measures nothing at its cracks).
     fracture: Option<FracturePlan>,
+    /// Whether some crack grows.
+    grows: bool,
 }
 
 impl Schedule {
@@ -142,11 +147,20 @@ impl Schedule {
         if fracture.is_some() {
             s.push(Fracture);
         }
+        let grows = D::GROWTH.is_some()
+            && world
+                .cracks
+                .as_ref()
+                .is_some_and(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()));
+        if grows {
+            s.push(Grow);
+        }
         let seconds = vec![0.0; s.len()];
         Schedule {
             systems: s,
             seconds,
             fracture,
+            grows,
         }
     }
 
@@ -194,13 +208,25 @@ impl Schedule {
         keep_stencils: bool,
         measure: bool,
     ) -> Result<(), Unstable> {
-        with_warm_workers(|| self.run_systems(world, keep_stencils))?;
+        let growth = D::GROWTH.filter(|_| self.grows);
+        // A step whose end a growing tip reads K at keeps its stencils, as a measured one.
+        let reads = growth
+            .as_ref()
+            .is_some_and(|g| (g.needs_k)(world, world.step + 1));
+        with_warm_workers(|| self.run_systems(world, keep_stencils || reads))?;
         world.step += 1;
         world.time = world.step as f64 * world.settings.dt;
-        // The fracture system, last in the schedule, measures the state at the step's end,
-        // so it runs once the clock has moved to it.
+        // The fracture system measures the state at the step's end, so it runs once the
+        // clock has moved to it; then the tips grow from what it saw.
         if measure {
             self.fracture_system(world);
+        }
+        if let Some(g) = growth {
+            let t0 = Instant::now();
+            (g.run)(world, self.fracture.as_ref())?;
+            if let Some(k) = self.systems.iter().position(|s| *s == System::Grow) {
+                self.seconds[k] += t0.elapsed().as_secs_f64();
+            }
         }
         Ok(())
     }
@@ -250,7 +276,7 @@ impl Schedule {
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),
-                System::Fracture => continue,
+                System::Fracture | System::Grow => continue,
             }
             self.seconds[k] += t0.elapsed().as_secs_f64();
         }

@@ -117,16 +117,12 @@ pub(crate) fn outside<D: Dim>(world: &World<D>, i: usize, step: u64, time: f64) 
     let x = D::to_xyz(world.particles.x[i]);
     let what = if x.iter().all(|c| c.is_finite()) {
         format!(
-            "left the grid at ({:.6e}, {:.6e}, {:.6e}) m (its stencil must stay inside the grid)",
+            "particle {i} left the grid at ({:.6e}, {:.6e}, {:.6e}) m (its stencil must stay \
+             inside the grid)",
             x[0], x[1], x[2]
         )
     } else {
-        "has a non-finite position (NaN or infinity)".to_string()
+        format!("particle {i} has a non-finite position (NaN or infinity)")
     };
-    Unstable {
-        step,
-        time,
-        particle: i,
-        what,
-    }
+    Unstable { step, time, what }
 }

@@ -540,6 +540,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 links,
                 ..
             },
+        ..
     }) = world.cracks.as_mut()
     else {
         return;

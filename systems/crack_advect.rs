@@ -46,6 +46,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         topology,
         geometry: Geometry { x: xs, top, bottom },
         scratch: Scratch { fields, .. },
+        ..
     }) = world.cracks.as_mut()
     else {
         return;

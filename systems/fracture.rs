@@ -64,8 +64,9 @@ pub fn measure(world: &World<D2>, plan: &FracturePlan) -> Measured {
     let Some(cracks) = &world.cracks else {
         return m;
     };
-    for front in cracks.topology.fronts() {
-        let (t, p) = tip(world, cracks, front, plan);
+    for (f, front) in cracks.topology.fronts().iter().enumerate() {
+        let speed = cracks.tips.get(f).map_or(0.0, |t| t.speed);
+        let (t, p) = tip(world, cracks, front, plan, speed);
         m.tips.push(t);
         m.paths.extend(p);
     }
@@ -107,11 +108,13 @@ fn intersect(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> Option<f64> 
     ((0.0..1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
 }
 
-fn tip(
+/// J and K at the tip of `front`, running at `speed` (m/s), and J on the compared contours.
+pub(crate) fn tip(
     world: &World<D2>,
     cracks: &Cracks<D2>,
     front: &Front,
     plan: &FracturePlan,
+    speed: f64,
 ) -> (TipResult, Vec<PathResult>) {
     let geom = &world.grid.geom;
     let topo = &cracks.topology;
@@ -195,7 +198,7 @@ fn tip(
     }
     let [d_i, d_ii] = opening_amplitudes(cracks, &walk, end, xt, dir, h, window);
     let mat = &world.materials[world.particles.material[main.nearest] as usize];
-    let [o1, o2] = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, 0.0);
+    let [o1, o2] = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, speed);
     res.k_opening = [o1, o2, 0.0];
     let at = Tip {
         crack: c,

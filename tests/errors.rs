@@ -706,3 +706,51 @@ fn too_many_materials_are_refused_by_count() {
     let e = refused(&text);
     assert_error(&e, "material", None, "65537 materials: at most 65535");
 }
+
+#[test]
+fn bad_growth_tables_name_the_key() {
+    let crack = "[[crack]]\npoints = [[0.003, 0.01], [0.009, 0.01]]\n[crack.growth]\n";
+    let fracture = "[fracture]\ncontour = 2\n";
+    let with = |growth: &str| error_with_text(&format!("{crack}{growth}{fracture}"));
+    let e = with("initiation = \"hoop\"\nKIc = -2e6\n");
+    assert_error(&e, "crack[0].growth.KIc", Some(22), "must be positive");
+    let e = with("initiation = \"energy\"\n");
+    assert_error(&e, "crack[0].growth.initiation", Some(21), "needs `Gc`");
+    let e = with("initiation = \"hoop\"\nKIc = 2e6\nGc = 20.0\n");
+    assert_error(&e, "crack[0].growth.Gc", Some(23), "does not apply");
+    let e = with("initiation = \"time\"\nat = 0.0\nextension = 1e-6\n");
+    assert_error(&e, "crack[0].growth.extension", Some(23), "0.01 to 2 cells");
+    let e = with("initiation = \"time\"\nat = 0.0\nextension = 0.005\n");
+    assert_error(&e, "crack[0].growth.extension", Some(23), "0.01 to 2 cells");
+    let e = with("initiation = \"time\"\nat = 0.0\ninterval = 1e-12\n");
+    assert_error(&e, "crack[0].growth.interval", Some(23), "one time step");
+    let e = with("initiation = \"time\"\nat = 0.0\nspeed = 1e5\n");
+    assert_error(&e, "crack[0].growth.speed", Some(23), "Rayleigh");
+    let e = with("initiation = \"time\"\nat = 0.0\nparis = { C = 1e-29, m = 0.0 }\n");
+    assert_error(
+        &e,
+        "crack[0].growth.paris.m",
+        Some(23),
+        "exponent must be positive",
+    );
+    let e = with("initiation = \"time\"\nat = 0.0\nparis = { C = -1.0, m = 3.0 }\n");
+    assert_error(&e, "crack[0].growth.paris.C", Some(23), "must be positive");
+    let e = with("initiation = \"time\"\nat = 0.0\nparis = { C = 1e-29, m = 3.0, R = 1.0 }\n");
+    assert_error(&e, "crack[0].growth.paris.R", Some(23), "[0, 1)");
+    let e = with("initiation = \"hoop\"\nKIc = 2e6\nparis = { C = 1e-29, m = 3.0 }\n");
+    assert_error(&e, "crack[0].growth.initiation", Some(21), "set time");
+    let e = with("initiation = \"time\"\nat = 0.0\ntoughness = 2e6\n");
+    assert_error(&e, "crack[0].growth.toughness", Some(23), "unknown field");
+    let e = error_with_text(&format!("{crack}initiation = \"hoop\"\nKIc = 2e6\n"));
+    assert_error(&e, "crack[0].growth", None, "add a [fracture] table");
+    let e = error_with_text(&format!(
+        "{crack}initiation = \"time\"\nat = 0.0\n{fracture}[[expect]]\nquantity = \"cycles\"\n\
+         crack = \"crack0\"\nlength = 1e-3\nreference = 1.0\nsource = \"x\"\ntolerance = 0.1\n"
+    ));
+    assert_error(&e, "expect[0].quantity", None, "no `paris`");
+    let e = error_3d(
+        "[[crack]]\npenny = { center = [0.01, 0.01, 0.01], normal = [0.0, 0.0, 1.0], radius = \
+         0.003 }\n[crack.growth]\ninitiation = \"time\"\nat = 0.0\n",
+    );
+    assert_error(&e, "crack[0].growth", None, "2D for now");
+}

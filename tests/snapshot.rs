@@ -92,7 +92,7 @@ fn restart_is_bit_exact(text: &str, k: u64, threads: usize, name: &str) {
 
     let last_frame = newest_frame(&dir.join("full"));
     let final_snap = format!("snapshots/step_{steps:012}.fsnap");
-    let measured = ["fracture.csv", "paths.csv"]
+    let measured = ["fracture.csv", "paths.csv", "growth.csv"]
         .into_iter()
         .filter(|f| dir.join("full").join(f).exists());
     for f in ["energy.csv", "probes.csv", &last_frame, &final_snap]
@@ -123,6 +123,15 @@ fn restart_is_bit_exact(text: &str, k: u64, threads: usize, name: &str) {
     };
     assert_eq!(values(&full), values(&resumed));
     std::fs::remove_dir_all(dir).ok();
+}
+
+/// A run whose crack grows under fatigue resumes bit for bit: the tip's state (cycles,
+/// last rate) and the new vertices travel in the snapshot.
+#[test]
+fn restart_is_bit_exact_with_a_growing_crack() {
+    let text = common::edge_plate(common::PARIS_GROWTH, 2.2e-5)
+        + "interval = 5.0e-6\n[checkpoint]\nevery_steps = 100\n";
+    restart_is_bit_exact(&text, 330, 2, "growing");
 }
 
 #[test]

@@ -18,6 +18,7 @@ pub use law::{Contact, Law};
 pub use topology::{Crack, Front, Topology, TopologyError};
 
 use crate::dim::Dim;
+use crate::growth::TipState;
 
 /// Most cracks a scene may hold (each takes two bits of a node field's side mask).
 pub const MAX_CRACKS: usize = 32;
@@ -50,6 +51,8 @@ pub struct Cracks<D: Dim> {
     pub topology: Topology<D>,
     /// Where the vertices are.
     pub geometry: Geometry<D>,
+    /// What each front's tip has grown (one per front, in the topology's order).
+    pub tips: Vec<TipState>,
     /// Rebuilt or kept by the systems; not part of a snapshot.
     pub scratch: Scratch<D>,
 }

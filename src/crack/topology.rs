@@ -5,6 +5,7 @@
 use super::element::Element;
 use super::law::Contact;
 use crate::dim::Dim;
+use crate::growth::Growth;
 
 /// One crack of the store.
 #[derive(Clone, Debug, PartialEq)]
@@ -13,6 +14,8 @@ pub struct Crack {
     pub name: String,
     /// How the crack faces interact where they touch.
     pub contact: Contact,
+    /// How its tips grow (None: they do not).
+    pub growth: Option<Growth>,
     /// Its vertices; in 2D the polyline in order from start to end.
     pub vertices: Vec<u32>,
 }
@@ -97,6 +100,7 @@ impl<D: Dim> Topology<D> {
         &mut self,
         name: String,
         contact: Contact,
+        growth: Option<Growth>,
         vertices: usize,
         elems: &[D::Elem],
         fronts: &[(u32, Vec<u32>)],
@@ -117,6 +121,7 @@ impl<D: Dim> Topology<D> {
         self.cracks.push(Crack {
             name,
             contact,
+            growth,
             vertices: (first..first + vertices as u32).collect(),
         });
         self.vertex_count += vertices;

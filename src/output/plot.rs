@@ -31,6 +31,29 @@ pub fn lines(
     y_label: &str,
     series: &[Series],
 ) -> Result<(), String> {
+    draw(path, title, x_label, y_label, series, false)
+}
+
+/// Draws curves in the plane (x, y in m) into a PNG at `path`, one metre on x as long as
+/// one on y, so that angles read true (crack paths).
+pub fn plane(path: &Path, title: &str, series: &[Series]) -> Result<(), String> {
+    draw(path, title, "x (m)", "y (m)", series, true)
+}
+
+/// A tick label; a rounding residue of zero (a billionth of the axis's scale) reads 0.
+fn tick(v: f64, scale: f64) -> String {
+    let v = if v.abs() < 1e-9 * scale { 0.0 } else { v };
+    format!("{v:.2e}")
+}
+
+fn draw(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    equal: bool,
+) -> Result<(), String> {
     register();
     let pts = || series.iter().flat_map(|s| s.points.iter());
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
@@ -46,8 +69,15 @@ pub fn lines(
     if x1 <= x0 {
         x1 = x0 + 1.0;
     }
-    let pad = 0.05 * (y1 - y0).abs().max(1e-300);
-    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+    let mut pad = 0.05 * (y1 - y0).abs().max(1e-300);
+    let size = if equal { (760, 760) } else { (900, 560) };
+    if equal {
+        // A square plot area over the larger of the two ranges, each centred.
+        let half = 0.55 * (x1 - x0).max(y1 - y0);
+        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        (x0, x1, y0, y1, pad) = (cx - half, cx + half, cy - half, cy + half, 0.0);
+    }
+    let root = BitMapBackend::new(path, size).into_drawing_area();
     let e = |e: &dyn std::fmt::Display| e.to_string();
     root.fill(&WHITE).map_err(|x| e(&x))?;
     let mut chart = ChartBuilder::on(&root)
@@ -62,8 +92,8 @@ pub fn lines(
         .configure_mesh()
         .x_desc(x_label)
         .y_desc(y_label)
-        .x_label_formatter(&|v| format!("{v:.2e}"))
-        .y_label_formatter(&|v| format!("{v:.2e}"))
+        .x_label_formatter(&|v| tick(*v, x0.abs().max(x1.abs())))
+        .y_label_formatter(&|v| tick(*v, y0.abs().max(y1.abs())))
         .draw()
         .map_err(|x| e(&x))?;
     for (i, s) in series.iter().enumerate() {

@@ -53,6 +53,8 @@ pub struct Summary {
     /// Along 3D fronts: where the tube around a vertex was shrunk to stay inside the body,
     /// or none fitted (last measurement).
     pub tubes: Vec<TubeReport>,
+    /// Every growing crack tip: how far it grew and whether it stopped for good.
+    pub growth: Vec<GrowthReport>,
     /// Snapshot this run continued from.
     pub resumed_from: Option<String>,
     /// Newest snapshot written (or resumed from).
@@ -97,4 +99,23 @@ pub struct TubeReport {
     pub shrunk: String,
     /// Vertices where no tube of 2 cells or more fits.
     pub unfitted: String,
+}
+
+/// A growing crack tip at the end of the run.
+#[derive(Clone, Debug, Serialize)]
+pub struct GrowthReport {
+    /// Crack name.
+    pub crack: String,
+    /// "start" or "end".
+    pub tip: String,
+    /// Where the tip is (m).
+    pub x: [f64; 2],
+    /// Length grown (m).
+    pub grown: f64,
+    /// Time it started to grow (s); null if it did not.
+    pub started: Option<f64>,
+    /// Fatigue: load cycles to the last check; null without a fatigue law.
+    pub cycles: Option<f64>,
+    /// Why it stopped growing for good, if it did.
+    pub stopped: Option<String>,
 }

@@ -7,6 +7,7 @@ pub mod state;
 pub mod stop;
 pub mod writers;
 
+use crate::crack::Cracks;
 use crate::dim::{D2, D3, Dim};
 use crate::error::{Unstable, UsageError};
 use crate::fracture::TipResult;
@@ -133,8 +134,7 @@ fn check_finite<D: Dim>(world: &World<D>, e: &Energies) -> Result<(), Unstable> 
     Err(Unstable {
         step: world.step,
         time: world.time,
-        particle: bad,
-        what: "has a non-finite velocity or stress (NaN)".into(),
+        what: format!("particle {bad} has a non-finite velocity or stress (NaN)"),
     })
 }
 
@@ -207,6 +207,11 @@ fn drive<D: Dim>(
         .as_ref()
         .and(world.cracks.as_ref())
         .map(|c| c.topology.cracks().iter().map(|c| c.name.clone()).collect());
+    let growing: Option<Vec<String>> = world
+        .cracks
+        .as_ref()
+        .filter(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()))
+        .map(|c| c.topology.cracks().iter().map(|c| c.name.clone()).collect());
     let mut writers = match &opts.out {
         Some(dir) => Some(Writers::open(
             dir,
@@ -214,6 +219,7 @@ fn drive<D: Dim>(
             crack_names.as_deref(),
             fracture.as_ref().is_some_and(|f| !f.compare.is_empty()),
             D::D == 3,
+            growing.as_deref(),
             &state.history,
         )?),
         None => None,
@@ -224,7 +230,7 @@ fn drive<D: Dim>(
     {
         w.frames_in(run_dir, state.frames.len());
     }
-    // Takes what the fracture system measured to fracture.csv and the history.
+    // Takes what the fracture and growth systems recorded to their files and the history.
     let take = |world: &mut World<D>, state: &mut RunState, w: &mut Option<Writers>| {
         let Some(c) = world.cracks.as_mut() else {
             return Ok::<(), anyhow::Error>(());
@@ -232,9 +238,11 @@ fn drive<D: Dim>(
         let m = std::mem::take(&mut c.scratch.measured);
         if let Some(w) = w {
             w.fracture(&m.tips, &m.paths)?;
+            w.growth(&m.growth)?;
         }
         state.history.fracture.extend(m.tips);
         state.history.paths.extend(m.paths);
+        state.history.growth.extend(m.growth);
         Ok(())
     };
     let mut checkpoints = match &opts.out {
@@ -295,6 +303,7 @@ fn drive<D: Dim>(
             break;
         }
         state.sample(&world, &probes);
+        take(&mut world, &mut state, &mut writers)?;
         let last = world.step == steps;
         if row_due(world.time, state.next_history, last) {
             state.next_history += output.history_interval;
@@ -304,7 +313,6 @@ fn drive<D: Dim>(
                 break;
             }
             let row = *state.record(&world, energies);
-            take(&mut world, &mut state, &mut writers)?;
             if let Some(w) = &mut writers {
                 w.row(&row, &state.history)?;
             }
@@ -414,6 +422,7 @@ fn drive<D: Dim>(
         expects: results,
         paths: reports::paths(&world, fracture.as_ref(), &state.history),
         tubes: reports::tubes(&world, fracture.as_ref(), &state.history),
+        growth: reports::growth(&world),
         resumed_from: resumed_from.map(|p| p.display().to_string()),
         snapshot: snapshot.as_ref().map(|s| s.0.display().to_string()),
         snapshot_seconds: checkpoints.as_ref().map_or(0.0, |c| c.seconds),
@@ -435,6 +444,12 @@ fn drive<D: Dim>(
                     plot_fracture(&path, &name, &state.history, &expects, cracks, k0)
                 };
                 drawn.map_err(|e| anyhow::anyhow!("cannot draw fracture.png: {e}"))?;
+            }
+            if growing.is_some()
+                && let Some(cracks) = &world.cracks
+            {
+                plot_paths(&w.dir.join("growth.png"), &name, cracks)
+                    .map_err(|e| anyhow::anyhow!("cannot draw growth.png: {e}"))?;
             }
         }
     }
@@ -588,6 +603,23 @@ fn plot_front(
         points,
         k0,
     )
+}
+
+/// growth.png: every growing crack's path (its whole polyline) at the end of the run.
+fn plot_paths<D: Dim>(path: &Path, name: &str, cracks: &Cracks<D>) -> Result<(), String> {
+    let series: Vec<Series> = (cracks.topology.cracks().iter())
+        .filter(|c| c.growth.is_some())
+        .map(|c| Series {
+            label: &c.name,
+            points: (c.vertices.iter())
+                .map(|&v| {
+                    let x = D::to_xyz(cracks.geometry.x[v as usize]);
+                    (x[0], x[1])
+                })
+                .collect(),
+        })
+        .collect();
+    plot::plane(path, &format!("{name}: crack paths"), &series)
 }
 
 fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {

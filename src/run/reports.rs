@@ -1,10 +1,11 @@
-//! The fracture reports of summary.json: path dependence of J, and the tubes around a 3D
-//! front that did not fit inside the body.
+//! The fracture reports of summary.json: path dependence of J, the tubes around a 3D front
+//! that did not fit inside the body, and how far the growing tips got.
 
 use crate::dim::Dim;
 use crate::fracture::FracturePlan;
+use crate::growth::Stopped;
 use crate::measure::{History, last_rows, path_difference, path_tips};
-use crate::output::summary::{PathReport, TubeReport};
+use crate::output::summary::{GrowthReport, PathReport, TubeReport};
 use crate::world::World;
 
 /// The path-dependence report of summary.json: every crack tip against every compared
@@ -116,6 +117,30 @@ fn ranges(v: &[u32]) -> String {
         k = e + 1;
     }
     out.join(", ")
+}
+
+/// Every growing 2D tip: where it is, how far it grew, and why it stopped, if it did.
+pub(super) fn growth<D: Dim>(world: &World<D>) -> Vec<GrowthReport> {
+    let Some(cracks) = &world.cracks else {
+        return Vec::new();
+    };
+    let topo = &cracks.topology;
+    (topo.fronts().iter().zip(&cracks.tips))
+        .filter_map(|(f, st)| {
+            let crack = &topo.cracks()[f.crack as usize];
+            let g = crack.growth?;
+            let x = D::to_xyz(cracks.geometry.x[f.vertices[0] as usize]);
+            Some(GrowthReport {
+                crack: crack.name.clone(),
+                tip: ["start", "end"][f.end as usize].into(),
+                x: [x[0], x[1]],
+                grown: st.grown,
+                started: (!st.started.is_nan()).then_some(st.started),
+                cycles: g.paris.map(|_| st.cycles),
+                stopped: Stopped::from_code(st.stopped).map(|s| s.describe().into()),
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]

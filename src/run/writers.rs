@@ -5,6 +5,7 @@
 use super::state::RunState;
 use crate::dim::Dim;
 use crate::fracture::{PathResult, TipResult};
+use crate::growth::GrowthRow;
 use crate::measure::{History, Row};
 use crate::output::vtk;
 use crate::world::World;
@@ -21,6 +22,7 @@ pub struct Writers {
     probes: BufWriter<File>,
     fracture: Option<(BufWriter<File>, Vec<String>)>,
     paths: Option<BufWriter<File>>,
+    growth: Option<(BufWriter<File>, Vec<String>)>,
     /// Whether a tip is a 3D front vertex (named by its ordinal along the crack's front)
     /// rather than a 2D crack end (named start or end).
     front_vertices: bool,
@@ -34,13 +36,15 @@ impl Writers {
     /// already recorded in `history` (none for a fresh run).
     /// `cracks` names the cracks when J and K are measured (then fracture.csv is written);
     /// `paths` asks for paths.csv (J on compared contours); `front_vertices` says the tips
-    /// are 3D front vertices.
+    /// are 3D front vertices; `growing` names the cracks when some crack grows (then
+    /// growth.csv is written).
     pub fn open(
         dir: &Path,
         probe_names: &[String],
         cracks: Option<&[String]>,
         paths: bool,
         front_vertices: bool,
+        growing: Option<&[String]>,
         history: &History,
     ) -> anyhow::Result<Self> {
         std::fs::create_dir_all(dir)
@@ -81,12 +85,24 @@ impl Writers {
             }
             _ => None,
         };
+        let growth = match growing {
+            Some(names) => {
+                let mut f = create("growth.csv")?;
+                writeln!(
+                    f,
+                    "step,time,crack,tip,grown,x,y,KI,KII,kink_deg,heading_deg,dKeq,cycles"
+                )?;
+                Some((f, names.to_vec()))
+            }
+            None => None,
+        };
         let mut w = Writers {
             dir: dir.to_path_buf(),
             energy,
             probes,
             fracture,
             paths,
+            growth,
             front_vertices,
             earlier: None,
         };
@@ -94,6 +110,7 @@ impl Writers {
             w.row(row, history)?;
         }
         w.fracture(&history.fracture, &history.paths)?;
+        w.growth(&history.growth)?;
         Ok(w)
     }
 
@@ -159,6 +176,35 @@ impl Writers {
                 write!(f, ",{v:.9e}")?;
             }
             writeln!(f)?;
+        }
+        Ok(())
+    }
+
+    /// Appends the growing tips' new segments to growth.csv: the length grown and tip
+    /// before the segment (m), K read there (Pa sqrt(m)), the segment's turn and direction
+    /// (degrees), and under fatigue Delta K_eq (Pa sqrt(m)) and the cycles to that length.
+    pub fn growth(&mut self, rows: &[GrowthRow]) -> anyhow::Result<()> {
+        let Some((f, names)) = &mut self.growth else {
+            return Ok(());
+        };
+        for g in rows {
+            writeln!(
+                f,
+                "{},{:.9e},{},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.6},{:.6},{:.9e},{:.9e}",
+                g.step,
+                g.time,
+                names[g.crack as usize],
+                ["start", "end"][g.tip as usize],
+                g.grown,
+                g.x[0],
+                g.x[1],
+                g.k[0],
+                g.k[1],
+                g.kink.to_degrees(),
+                g.heading.to_degrees(),
+                g.fatigue[0],
+                g.fatigue[1]
+            )?;
         }
         Ok(())
     }

@@ -593,6 +593,15 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             (_, Some(qty)) => Some(super::cracks::front_measure(src, i, e, qty)?),
             _ if e.quantity == "J_path" => Some(super::cracks::path_measure::<D>(src, i, e)?),
             _ if e.quantity == "K_drift" => Some(super::cracks::drift_measure(src, i, e)?),
+            _ if ["kink", "path_angle", "turn", "cycles"].contains(&e.quantity.as_str()) => {
+                if D::D == 3 {
+                    return Err(src.error(
+                        &key("quantity"),
+                        format!("`{}` follows a growing 2D tip", e.quantity),
+                    ));
+                }
+                Some(super::growth::growth_measure(src, i, e)?)
+            }
             _ => None,
         };
         if let Some(measure) = crack_measure {
@@ -620,6 +629,9 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         if e.at.is_some() {
             return Err(src.error(&key("at"), "`at` applies to KI, KII, J1 and J2"));
         }
+        if e.length.is_some() {
+            return Err(src.error(&key("length"), "`length` applies to cycles"));
+        }
         let need = match e.quantity.as_str() {
             "wave_speed" => 2,
             "final" | "max" | "min" | "frequency" => 1,
@@ -631,7 +643,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                         "unknown quantity `{other}` (final, max, min, frequency, wave_speed, \
                          momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2, \
                          J_path, K_drift, kinetic_fraction, KI_front, KII_front, KIII_front, \
-                         J1_front)"
+                         J1_front, kink, path_angle, turn, cycles)"
                     ),
                 ));
             }
@@ -700,7 +712,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         None => duration / 400.0,
     };
     let checkpoint = checkpoint_plan(src)?;
-    let cracks = super::cracks::build::<D>(src, &particles, &geom)?;
+    let cracks = super::cracks::build::<D>(src, &particles, &materials, &geom, dt)?;
     let fracture = super::cracks::fracture_plan(src, cracks.as_ref(), &geom)?;
     super::cracks::check_front_expects(src, &expects, cracks.as_ref(), geom.min_cell())?;
     if fracture.is_some() {

@@ -9,6 +9,8 @@ use crate::dim::{D3, Dim};
 use crate::error::ScenarioError;
 use crate::fracture::{FracturePlan, KMethod};
 use crate::grid::GridGeom;
+use crate::growth::TipState;
+use crate::material::Elastic;
 use crate::measure::{Along, Expect, Measure, Shape};
 use crate::particles::Particles;
 use glam::DVec3;
@@ -27,7 +29,9 @@ const REACH_CELLS: f64 = 2.0;
 pub(super) fn build<D: Dim>(
     src: &Source,
     particles: &Particles<D>,
+    materials: &[Elastic],
     geom: &GridGeom<D>,
+    dt: f64,
 ) -> R<Option<Cracks<D>>> {
     let specs = &src.scenario.cracks;
     if specs.is_empty() {
@@ -109,9 +113,20 @@ pub(super) fn build<D: Dim>(
                 format!("two cracks are named `{name}`: expects and outputs name cracks"),
             ));
         }
+        let growth = super::growth::growth::<D>(
+            src,
+            c,
+            spec,
+            materials,
+            geom.min_cell(),
+            dt,
+            src.scenario.fracture.is_some(),
+            !piece.fronts.is_empty(),
+        )?;
         store.topology.add_crack(
             name,
             contact,
+            growth,
             piece.points.len(),
             &piece.elems,
             &piece.fronts,
@@ -121,6 +136,7 @@ pub(super) fn build<D: Dim>(
     let g = &mut store.geometry;
     g.top = g.x.clone();
     g.bottom = g.x.clone();
+    store.tips = vec![TipState::default(); store.topology.fronts().len()];
     Ok(Some(store))
 }
 

@@ -4,6 +4,7 @@
 pub mod build;
 mod crack_meet;
 mod cracks;
+mod growth;
 mod memory;
 mod region;
 pub mod schema;

@@ -241,6 +241,52 @@ pub struct CrackSpec {
     pub tips: Option<Vec<String>>,
     /// Contact between the crack faces (default: none, an open crack).
     pub contact: Option<ContactSpec>,
+    /// 2D: how the crack's tips grow (default: they do not).
+    pub growth: Option<GrowthSpec>,
+}
+
+/// `[crack.growth]`: when a tip starts to grow, which way, and how far or how fast.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GrowthSpec {
+    /// "hoop" (maximum hoop stress reaches `KIc`), "energy" (J reaches `Gc`) or "time"
+    /// (at time `at`).
+    pub initiation: String,
+    /// Fracture toughness K_Ic (Pa sqrt(m)), for "hoop".
+    #[serde(rename = "KIc")]
+    pub k_ic: Option<f64>,
+    /// Critical energy release rate G_c (J/m^2), for "energy".
+    #[serde(rename = "Gc")]
+    pub g_c: Option<f64>,
+    /// Start time (s), for "time".
+    pub at: Option<f64>,
+    /// "hoop" (the direction of the largest hoop stress; default) or "straight".
+    pub direction: Option<String>,
+    /// Once started, run at this speed (m/s) whatever K does (default: extend by
+    /// `extension` at every check at which the criterion holds).
+    pub speed: Option<f64>,
+    /// Length of a new crack segment (m; default half the smallest cell).
+    pub extension: Option<f64>,
+    /// Time between evaluations of the criterion and direction (s; default every tenth
+    /// step).
+    /// Under fatigue, long enough for the damped run to settle after each extension.
+    pub interval: Option<f64>,
+    /// Fatigue: the Paris-Erdogan law; each extension then costs load cycles.
+    pub paris: Option<ParisSpec>,
+}
+
+/// `paris = { C, m, R }`: da/dN = C (Delta K_eq)^m, Delta K in Pa sqrt(m), a in m.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParisSpec {
+    /// C (m per cycle per (Pa sqrt(m))^m).
+    #[serde(rename = "C")]
+    pub c: f64,
+    /// Exponent m (> 0).
+    pub m: f64,
+    /// Load ratio R = K_min / K_max in [0, 1) (default 0); the run holds the largest load.
+    #[serde(rename = "R")]
+    pub r: Option<f64>,
 }
 
 /// A 3D crack surface as lists: `vertices = [[x, y, z], ...]` (m), `triangles = [[i, j,
@@ -508,7 +554,10 @@ pub struct ExpectSpec {
     /// one `near` a point); K_drift (largest |K(t) - K(end)| from
     /// `from` on, relative to |K(end)|); in 3D KI_front, KII_front, KIII_front, J1_front
     /// (the value farthest from the reference over a crack's front vertices, or at the
-    /// vertex `near` a point, last row).
+    /// vertex `near` a point, last row); for a growing 2D tip kink (its first turn,
+    /// degrees), path_angle (its line over the last quarter of the length grown, to x, degrees in
+    /// (-90, 90]), turn (the chord from the tip's start to its last new vertex, as a turn
+    /// from the crack, degrees) and cycles (fatigue: load cycles to grow by `length`).
     pub quantity: String,
     /// Probe(s) the quantity is measured on (wave_speed takes two).
     #[serde(default)]
@@ -521,6 +570,8 @@ pub struct ExpectSpec {
     pub at: Option<f64>,
     /// For K_drift: the start of the window (s).
     pub from: Option<f64>,
+    /// For cycles: the length grown (m) whose cycles are compared.
+    pub length: Option<f64>,
     /// For the front quantities: how the reference varies along the front (default: it
     /// does not).
     pub along: Option<AlongSpec>,

@@ -8,6 +8,7 @@ use super::format::{ColumnSet, Header, Reader, SnapshotError};
 use super::topology::{self, Encoded};
 use crate::dim::Dim;
 use crate::fracture::{PathResult, TipResult};
+use crate::growth::{GrowthRow, TipState};
 use crate::material::Elastic;
 use crate::measure::{History, Row};
 use crate::run::state::RunState;
@@ -98,11 +99,17 @@ pub fn write<D: Dim>(
     let path_ids: Vec<u64> = h.paths.iter().map(|p| tip_id(p.crack, p.tip)).collect();
     let path_contours: Vec<u64> = h.paths.iter().map(|p| u64::from(p.contour)).collect();
     let path_data: Vec<f64> = h.paths.iter().flat_map(path_data).collect();
+    let growth_steps: Vec<u64> = h.growth.iter().map(|g| g.step).collect();
+    let growth_ids: Vec<u64> = h.growth.iter().map(|g| tip_id(g.crack, g.tip)).collect();
+    let growth_data: Vec<f64> = h.growth.iter().flat_map(|g| g.values()).collect();
     let probe_names: Vec<String> = (0..h.probes.len())
         .map(|k| format!("history.probe.{k}"))
         .collect();
 
     let topology = world.cracks.as_ref().map(|cr| Encoded::new(&cr.topology));
+    let tips: Vec<f64> = (world.cracks.iter())
+        .flat_map(|cr| cr.tips.iter().flat_map(|t| t.values()))
+        .collect();
     let mut c = ColumnSet::default();
     c.add("scenario.toml", src.text.as_bytes());
     c.add("scenario.file", src.file.as_bytes());
@@ -132,6 +139,7 @@ pub fn write<D: Dim>(
         c.add("cracks.x", &cr.geometry.x);
         c.add("cracks.top", &cr.geometry.top);
         c.add("cracks.bottom", &cr.geometry.bottom);
+        c.add("cracks.tips", &tips);
     }
     c.add("history.fracture.step", &tip_steps);
     c.add("history.fracture.tip", &tip_ids);
@@ -140,6 +148,9 @@ pub fn write<D: Dim>(
     c.add("history.paths.id", &path_ids);
     c.add("history.paths.contour", &path_contours);
     c.add("history.paths.data", &path_data);
+    c.add("history.growth.step", &growth_steps);
+    c.add("history.growth.id", &growth_ids);
+    c.add("history.growth.data", &growth_data);
     c.add("history.rows.step", &row_steps);
     c.add("history.rows.data", &rows);
     let header = Header {
@@ -250,6 +261,17 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
         cr.geometry.x = r.column("cracks.x", nv)?;
         cr.geometry.top = r.column("cracks.top", nv)?;
         cr.geometry.bottom = r.column("cracks.bottom", nv)?;
+        // A snapshot from a build without crack growth has no tip states: none grew.
+        let fronts = cr.topology.fronts().len();
+        cr.tips = if r.offset_of("cracks.tips").is_some() {
+            let tips: Vec<f64> = r.column("cracks.tips", fronts * TipState::VALUES)?;
+            (tips.chunks_exact(TipState::VALUES))
+                .map(TipState::from_values)
+                .collect::<Option<_>>()
+                .ok_or_else(|| r.invalid("cracks.tips: a tip's growth state is not one"))?
+        } else {
+            vec![TipState::default(); fronts]
+        };
     }
     w.time = h.time;
     w.step = h.step;
@@ -307,6 +329,16 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
             area: [d[3], d[4]],
         })
         .collect();
+    // A snapshot from a build without crack growth has no growth rows.
+    if r.offset_of("history.growth.step").is_some() {
+        let steps: Vec<u64> = r.column_any("history.growth.step")?;
+        let ids: Vec<u64> = r.column("history.growth.id", steps.len())?;
+        let data: Vec<f64> = r.column("history.growth.data", steps.len() * GrowthRow::VALUES)?;
+        history.growth = (steps.iter().zip(&ids))
+            .zip(data.chunks_exact(GrowthRow::VALUES))
+            .map(|((&step, &id), d)| GrowthRow::from_values(step, (id >> 32) as u32, id as u32, d))
+            .collect();
+    }
     let state = RunState {
         history,
         next_history: cadence[0],

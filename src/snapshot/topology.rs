@@ -86,6 +86,7 @@ pub fn read<D: Dim>(r: &mut Reader, built: &Topology<D>) -> Result<Topology<D>, 
         cracks.push(Crack {
             name: c.name.clone(),
             contact: c.contact,
+            growth: c.growth,
             vertices,
         });
     }

@@ -305,3 +305,53 @@ rho = 2700.0
 {rest}"#
     )
 }
+
+/// An 8 x 16 mm plate with a 2 mm edge crack under a ramped tension; `growth` is the body
+/// of its `[crack.growth]` table and `duration` the run's length (s).
+pub fn edge_plate(growth: &str, duration: f64) -> String {
+    format!(
+        r#"name = "edge_growth"
+[simulation]
+dimension = 2
+duration = {duration:e}
+cfl = 0.5
+damping = 4.0e5
+[grid]
+min = [-0.0015, -0.00875]
+max = [0.0095, 0.00875]
+cell = [0.0005, 0.0005]
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 7800.0
+[[body]]
+material = "steel"
+box = {{ min = [0.0, -0.008], max = [0.008, 0.008] }}
+[[crack]]
+name = "edge"
+line = {{ start = [-0.0005, 0.0], end = [0.002, 0.0] }}
+[crack.growth]
+{growth}
+[[load]]
+region = {{ min = [0.0, 0.0077], max = [0.008, 0.008] }}
+force = [0.0, 8.0e5]
+time = {{ kind = "ramp", rise = 4.0e-6 }}
+[[load]]
+region = {{ min = [0.0, -0.008], max = [0.008, -0.0077] }}
+force = [0.0, -8.0e5]
+time = {{ kind = "ramp", rise = 4.0e-6 }}
+[fracture]
+contour = 2
+[output]
+history_interval = 1.0e-6
+"#
+    )
+}
+
+/// A fatigue law for [`edge_plate`]: Paris growth by a cell every 4 us from 10 us on.
+pub const PARIS_GROWTH: &str = r#"initiation = "time"
+at = 1.0e-5
+extension = 5.0e-4
+interval = 4.0e-6
+paris = { C = 1.0e-29, m = 3.0, R = 0.25 }"#;

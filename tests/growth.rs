@@ -1,0 +1,141 @@
+//! Crack growth: the fatigue bookkeeping against the Paris law recomputed from the K the
+//! run read, tips that reach a surface or leave the grid, and bitwise determinism over
+//! thread counts.
+
+mod common;
+
+use common::{PARIS_GROWTH, edge_plate, source};
+use fissure::growth::GrowthRow;
+use fissure::run::{Outcome, RunOptions, run};
+
+fn run_with(text: &str, threads: usize) -> Outcome {
+    let opts = RunOptions {
+        threads,
+        ..RunOptions::default()
+    };
+    run(&source(text), &opts).unwrap_or_else(|e| panic!("{e:#}"))
+}
+
+/// Each fatigue row's cycles are the last row's plus the trapezoidal rule on the Paris
+/// rate C ((1 - R) K_I)^m at the two lengths, recomputed here from the K_I the rows
+/// record (mode I: no kink, Delta K_eq = (1 - R) K_I, Belytschko et al. 1995, Eq. 40).
+#[test]
+fn fatigue_cycles_follow_the_paris_law() {
+    let out = run_with(&edge_plate(PARIS_GROWTH, 2.8e-5), 2);
+    let rows: Vec<&GrowthRow> = out.history.growth.iter().collect();
+    assert!(rows.len() >= 4, "{} rows", rows.len());
+    let rate = |g: &GrowthRow| 1.0e-29 * (0.75 * g.k[0]).powi(3);
+    assert_eq!(rows[0].fatigue[1], 0.0);
+    for w in rows.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        assert!((b.fatigue[0] - 0.75 * b.k[0]).abs() <= 1e-9 * b.fatigue[0]);
+        assert!(
+            b.kink.abs() < 1e-3,
+            "a mode I crack grows straight: {}",
+            b.kink
+        );
+        let da = b.grown - a.grown;
+        assert!((da - 5.0e-4).abs() < 1e-12, "one extension per check: {da}");
+        let expected = a.fatigue[1] + 0.5 * da * (1.0 / rate(a) + 1.0 / rate(b));
+        assert!(
+            (b.fatigue[1] - expected).abs() <= 1e-9 * expected,
+            "{} against {expected}",
+            b.fatigue[1]
+        );
+        assert!(b.k[0] > a.k[0], "K_I grows with the crack");
+    }
+    let g = &out.summary.growth[0];
+    assert_eq!((g.crack.as_str(), g.tip.as_str()), ("edge", "end"));
+    assert!(g.stopped.is_none());
+    assert!((g.grown - 5.0e-4 * rows.len() as f64).abs() < 1e-12);
+}
+
+/// A tip running straight across the plate stops at the far surface, says so, and grows
+/// no more; the crack then cuts the body through.
+#[test]
+fn a_tip_stops_at_the_free_surface() {
+    let text = edge_plate(
+        "initiation = \"time\"\nat = 2.0e-6\ndirection = \"straight\"\nspeed = 2000.0",
+        8.0e-6,
+    );
+    let out = run_with(&text, 2);
+    assert_eq!(out.summary.status, "completed");
+    let g = &out.summary.growth[0];
+    assert_eq!(g.stopped.as_deref(), Some("reached the free surface"));
+    assert!(
+        g.x[0] > 0.008 && g.x[0] < 0.0095,
+        "a cell past the surface: {}",
+        g.x[0]
+    );
+    assert!(g.x[1].abs() < 1e-12, "straight on: {}", g.x[1]);
+}
+
+/// A tip carried past the surface beyond the grid's edge makes the run unstable, with a
+/// message that names the crack and where its tip went, and the last good snapshot.
+#[test]
+fn growth_out_of_the_grid_stops_the_run() {
+    let text = edge_plate(
+        "initiation = \"time\"\nat = 2.0e-6\ndirection = \"straight\"\nspeed = 2000.0",
+        8.0e-6,
+    )
+    .replace("max = [0.0095, 0.00875]", "max = [0.0085, 0.00875]")
+        + "[checkpoint]\nevery_steps = 20\n";
+    let dir = std::env::temp_dir().join(format!("fissure-grow-{}-grid", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    let opts = RunOptions {
+        out: Some(dir.clone()),
+        ..RunOptions::default()
+    };
+    let err = run(&source(&text), &opts)
+        .expect_err("must stop")
+        .to_string();
+    assert!(err.contains("crack `edge` grew out of the grid"), "{err}");
+    assert!(err.contains("last good snapshot"), "{err}");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// Growth, with the K it reads and the cycles it counts, is bitwise the same on 1, 2 and
+/// 3 threads.
+#[test]
+fn growth_is_identical_on_one_two_and_three_threads() {
+    let text = edge_plate(PARIS_GROWTH, 2.0e-5);
+    let bits = |o: &Outcome| -> Vec<u64> {
+        (o.history.growth.iter())
+            .flat_map(|g| g.values())
+            .chain(o.history.fracture.iter().flat_map(|t| t.values()))
+            .map(f64::to_bits)
+            .collect()
+    };
+    let one = run_with(&text, 1);
+    assert!(!one.history.growth.is_empty());
+    for threads in [2, 3] {
+        assert!(
+            bits(&one) == bits(&run_with(&text, threads)),
+            "{threads} threads"
+        );
+    }
+}
+
+/// growth.csv holds one row per new segment, as the history does, with the cycles in its
+/// last column; growth.png draws the path.
+#[test]
+fn growth_outputs_are_written() {
+    let dir = std::env::temp_dir().join(format!("fissure-grow-{}-out", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    let opts = RunOptions {
+        out: Some(dir.clone()),
+        ..RunOptions::default()
+    };
+    let out = run(&source(&edge_plate(PARIS_GROWTH, 2.0e-5)), &opts).unwrap();
+    let csv = std::fs::read_to_string(dir.join("growth.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert!(lines[0].ends_with("dKeq,cycles"), "{}", lines[0]);
+    assert_eq!(lines.len() - 1, out.history.growth.len());
+    for (line, row) in lines[1..].iter().zip(&out.history.growth) {
+        let cycles: f64 = line.rsplit(',').next().unwrap().parse().unwrap();
+        assert!((cycles - row.fatigue[1]).abs() <= 1e-8 * row.fatigue[1].max(1.0));
+    }
+    let png = std::fs::read(dir.join("growth.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"), "growth.png is a PNG");
+    std::fs::remove_dir_all(dir).ok();
+}
