@@ -1,5 +1,10 @@
 //! PNG plots drawn with plotters' bitmap backend and an embedded font (no system fonts).
+//! Plots a user can trust: the legend sits in headroom above the data, never over it;
+//! curves after the first are dashed, so one lying on another (a zero K_II on its zero
+//! reference) still shows; a series breaks at NaN rows instead of jumping to them, and a
+//! lone point is marked.
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::Once;
@@ -23,6 +28,16 @@ pub struct Series<'a> {
     pub points: Vec<(f64, f64)>,
 }
 
+/// One panel of a figure: its y-axis label and its series.
+pub struct Panel<'a> {
+    /// Y-axis label.
+    pub y_label: &'a str,
+    /// Series drawn in it.
+    pub series: Vec<Series<'a>>,
+}
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+
 /// Draws line series into a PNG at `path`.
 pub fn lines(
     path: &Path,
@@ -31,33 +46,99 @@ pub fn lines(
     y_label: &str,
     series: &[Series],
 ) -> Result<(), String> {
-    draw(path, title, x_label, y_label, series, false)
+    register();
+    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let area = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    draw(&area, x_label, y_label, series, false)?;
+    root.present().map_err(err)
+}
+
+/// Draws panels stacked top to bottom on one time axis into a PNG at `path`; the first
+/// panel gets `share` of the height, the others split the rest.
+pub fn panels(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    panels: &[Panel],
+    share: f64,
+) -> Result<(), String> {
+    register();
+    let root = BitMapBackend::new(path, (900, 780)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let mut rest = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    let height = rest.dim_in_pixel().1 as f64;
+    for (k, p) in panels.iter().enumerate() {
+        let left = panels.len() - k;
+        let area = if left == 1 {
+            rest.clone()
+        } else {
+            let h = if k == 0 {
+                share * height
+            } else {
+                rest.dim_in_pixel().1 as f64 / left as f64
+            };
+            let (top, bottom) = rest.split_vertically(h as u32);
+            rest = bottom;
+            top
+        };
+        draw(&area, x_label, p.y_label, &p.series, false)?;
+    }
+    root.present().map_err(err)
 }
 
 /// Draws curves in the plane (x, y in m) into a PNG at `path`, one metre on x as long as
 /// one on y, so that angles read true (crack paths).
 pub fn plane(path: &Path, title: &str, series: &[Series]) -> Result<(), String> {
-    draw(path, title, "x (m)", "y (m)", series, true)
+    register();
+    let root = BitMapBackend::new(path, (760, 800)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let area = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    draw(&area, "x (m)", "y (m)", series, true)?;
+    root.present().map_err(err)
 }
 
-/// A tick label; a rounding residue of zero (a billionth of the axis's scale) reads 0.
+fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+/// A tick label on an axis reaching `scale` in magnitude: 0 as "0" (and a rounding
+/// residue of it, a billionth of the scale), plain notation on an axis of moderate scale,
+/// scientific otherwise, so that one axis reads in one notation.
 fn tick(v: f64, scale: f64) -> String {
-    let v = if v.abs() < 1e-9 * scale { 0.0 } else { v };
-    format!("{v:.2e}")
+    if v.abs() <= 1e-9 * scale {
+        return "0".into();
+    }
+    if (0.1..1e4).contains(&scale) {
+        let s = format!("{v:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+/// The finite runs of a series: NaN or infinite points break the line.
+fn runs(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+    points
+        .split(|(x, y)| !(x.is_finite() && y.is_finite()))
+        .filter(|r| !r.is_empty())
+        .map(<[(f64, f64)]>::to_vec)
+        .collect()
 }
 
 fn draw(
-    path: &Path,
-    title: &str,
+    area: &Area,
     x_label: &str,
     y_label: &str,
     series: &[Series],
     equal: bool,
 ) -> Result<(), String> {
-    register();
-    let pts = || series.iter().flat_map(|s| s.points.iter());
+    let finite = || {
+        (series.iter().flat_map(|s| s.points.iter()))
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+    };
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in pts().filter(|(x, y)| x.is_finite() && y.is_finite()) {
+    for &(x, y) in finite() {
         x0 = x0.min(x);
         x1 = x1.max(x);
         y0 = y0.min(y);
@@ -69,51 +150,91 @@ fn draw(
     if x1 <= x0 {
         x1 = x0 + 1.0;
     }
-    let mut pad = 0.05 * (y1 - y0).abs().max(1e-300);
-    let size = if equal { (760, 760) } else { (900, 560) };
-    if equal {
-        // A square plot area over the larger of the two ranges, each centred.
-        let half = 0.55 * (x1 - x0).max(y1 - y0);
-        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-        (x0, x1, y0, y1, pad) = (cx - half, cx + half, cy - half, cy + half, 0.0);
+    if y1 <= y0 {
+        let half = 0.5 * y0.abs().max(1e-300);
+        (y0, y1) = (y0 - half, y1 + half);
     }
-    let root = BitMapBackend::new(path, size).into_drawing_area();
-    let e = |e: &dyn std::fmt::Display| e.to_string();
-    root.fill(&WHITE).map_err(|x| e(&x))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
+    // The plotting area in pixels (the margins and label areas set below taken off).
+    let (w, h) = area.dim_in_pixel();
+    let (plot_w, plot_h) = ((w as f64 - 150.0).max(100.0), (h as f64 - 69.0).max(100.0));
+    // Headroom for the legend above the data: each label takes about 20 pixels.
+    let legend = (series.len() as f64 * 20.0 + 16.0).min(0.6 * plot_h);
+    let span = y1 - y0;
+    let mut bottom = y0 - 0.04 * span;
+    let mut top = y1 + 0.04 * span;
+    top += (top - bottom) * legend / (plot_h - legend);
+    if equal {
+        // As many metres per pixel on x as on y: widen whichever range is short.
+        let sx = 1.08 * (x1 - x0);
+        let unit = (sx / plot_w).max((top - bottom) / plot_h);
+        let (cx, grow) = (0.5 * (x0 + x1), 0.5 * (unit * plot_h - (top - bottom)));
+        (x0, x1) = (cx - 0.5 * unit * plot_w, cx + 0.5 * unit * plot_w);
+        (bottom, top) = (bottom - grow, top + grow);
+    }
+    let mut chart = ChartBuilder::on(area)
         .margin(12)
         .margin_right(48)
         .x_label_area_size(45)
         .y_label_area_size(90)
-        .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
-        .map_err(|x| e(&x))?;
+        .build_cartesian_2d(x0..x1, bottom..top)
+        .map_err(err)?;
+    let (xs, ys) = (x0.abs().max(x1.abs()), bottom.abs().max(top.abs()));
     chart
         .configure_mesh()
         .x_desc(x_label)
         .y_desc(y_label)
-        .x_label_formatter(&|v| tick(*v, x0.abs().max(x1.abs())))
-        .y_label_formatter(&|v| tick(*v, y0.abs().max(y1.abs())))
+        .x_label_formatter(&|v| tick(*v, xs))
+        .y_label_formatter(&|v| tick(*v, ys))
         .draw()
-        .map_err(|x| e(&x))?;
+        .map_err(err)?;
     for (i, s) in series.iter().enumerate() {
         let colour = Palette99::pick(i).to_rgba();
-        chart
-            .draw_series(LineSeries::new(
-                s.points.iter().copied(),
-                colour.stroke_width(2),
-            ))
-            .map_err(|x| e(&x))?
-            .label(s.label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
-            });
+        let style = colour.stroke_width(if i == 0 { 3 } else { 2 });
+        let mut labelled = false;
+        for run in runs(&s.points) {
+            let drawn = if run.len() == 1 {
+                // A lone point (a reference at one time) would draw no line: mark it.
+                chart.draw_series(run.into_iter().map(|p| Circle::new(p, 5, style)))
+            } else if i == 0 {
+                chart.draw_series(LineSeries::new(run, style))
+            } else {
+                let dash = 6 + 2 * (i as u32 % 4);
+                chart.draw_series(DashedLineSeries::new(run, dash, 4, style))
+            }
+            .map_err(err)?;
+            if !labelled {
+                drawn
+                    .label(s.label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+                labelled = true;
+            }
+        }
     }
     chart
         .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.9))
         .border_style(BLACK)
         .draw()
-        .map_err(|x| e(&x))?;
-    root.present().map_err(|x| e(&x))
+        .map_err(err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ticks read as numbers a user would write; NaN rows split a line into its runs.
+    #[test]
+    fn ticks_and_runs() {
+        assert_eq!(tick(0.0, 1.0), "0");
+        assert_eq!(tick(1.7e-18, 1e-2), "0");
+        assert_eq!(tick(0.25, 1.0), "0.25");
+        assert_eq!(tick(1500.0, 2e3), "1500");
+        assert_eq!(tick(5e-3, 1.2e-2), "5.00e-3");
+        assert_eq!(tick(2.5e7, 1e8), "2.50e7");
+        assert_eq!(tick(-3.0e-5, 1e-4), "-3.00e-5");
+        let nan = f64::NAN;
+        let r = runs(&[(0.0, nan), (1.0, 2.0), (2.0, 3.0), (3.0, nan), (4.0, 1.0)]);
+        assert_eq!(r, vec![vec![(1.0, 2.0), (2.0, 3.0)], vec![(4.0, 1.0)]]);
+    }
 }

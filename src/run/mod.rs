@@ -12,7 +12,7 @@ use crate::dim::{D2, D3, Dim};
 use crate::error::{Unstable, UsageError};
 use crate::fracture::TipResult;
 use crate::measure::{Expect, History, Measure, Row};
-use crate::output::plot::{self, Series};
+use crate::output::plot::{self, Panel, Series};
 use crate::output::summary::Summary;
 use crate::scenario::build::MAX_STEPS;
 use crate::scenario::{Scene, Source, build};
@@ -622,39 +622,56 @@ fn plot_paths<D: Dim>(path: &Path, name: &str, cracks: &Cracks<D>) -> Result<(),
     plot::plane(path, &format!("{name}: crack paths"), &series)
 }
 
+/// energy.png: the energies and works on top; below, the energy balance's drift
+/// (E(t) - E(0)) over the largest energy or work of the run, the scale `energy_drift`
+/// uses, so a drift too small to see on the energies' scale still shows.
 fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
     let pick = |f: &dyn Fn(&Row) -> f64| h.rows.iter().map(|r| (r.time, f(r))).collect();
-    let series = [
-        Series {
-            label: "kinetic",
-            points: pick(&|r| r.energies.kinetic),
-        },
-        Series {
-            label: "strain",
-            points: pick(&|r| r.energies.strain),
-        },
-        Series {
-            label: "external work",
-            points: pick(&|r| r.energies.external_work),
-        },
-        Series {
-            label: "damping work",
-            points: pick(&|r| r.energies.damping_work),
-        },
-        Series {
-            label: "K + W - W_ext + W_damp",
-            points: pick(&|r| {
-                let e = &r.energies;
-                e.kinetic + e.strain - e.external_work + e.damping_work
-            }),
-        },
-    ];
-    plot::lines(
+    let total = |e: &Energies| e.kinetic + e.strain - e.external_work + e.damping_work;
+    let e0 = h.rows.first().map_or(0.0, |r| total(&r.energies));
+    let scale = (h.rows.iter())
+        .map(|r| {
+            let e = &r.energies;
+            (e.kinetic + e.strain)
+                .max(e.external_work.abs())
+                .max(e.damping_work)
+        })
+        .fold(0.0, f64::max);
+    let scale = if scale > 0.0 { scale } else { 1.0 };
+    let energies = Panel {
+        y_label: "energy (J)",
+        series: vec![
+            Series {
+                label: "kinetic K",
+                points: pick(&|r| r.energies.kinetic),
+            },
+            Series {
+                label: "strain W",
+                points: pick(&|r| r.energies.strain),
+            },
+            Series {
+                label: "external work W_ext",
+                points: pick(&|r| r.energies.external_work),
+            },
+            Series {
+                label: "damping work W_damp",
+                points: pick(&|r| r.energies.damping_work),
+            },
+        ],
+    };
+    let balance = Panel {
+        y_label: "balance drift (relative)",
+        series: vec![Series {
+            label: "(K + W - W_ext + W_damp - E(0)) / largest energy or work",
+            points: pick(&|r| (total(&r.energies) - e0) / scale),
+        }],
+    };
+    plot::panels(
         path,
         &format!("{name}: energies"),
         "time (s)",
-        "energy (J)",
-        &series,
+        &[energies, balance],
+        0.62,
     )
 }
 
