@@ -616,6 +616,36 @@ fn a_stop_during_set_up_ends_the_run_before_its_first_step() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// A full disk (here a frame that lands on /dev/full) ends the run as failed: the error and
+/// summary.json name the file, the step and the last snapshot, and the partial frame is
+/// removed while the frames before it stay.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_names_the_file_and_keeps_a_summary() {
+    if !Path::new("/dev/full").exists() {
+        eprintln!("no /dev/full on this machine: the full-disk case is not tried");
+        return;
+    }
+    let dir = scratch("full");
+    std::os::unix::fs::symlink("/dev/full", dir.join("particles_00002.vtu")).unwrap();
+    let err = run(&source(&scene(2, "linear", "usf")), &opts(&dir, 1))
+        .expect_err("a full disk must stop the run")
+        .to_string();
+    assert!(
+        err.contains("particles_00002.vtu") && err.contains("No space left"),
+        "{err}"
+    );
+    assert!(err.contains("output failed at step") && err.contains("the last snapshot is"));
+    let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    assert!(
+        summary.contains("\"failed\"") && summary.contains("particles_00002.vtu"),
+        "{summary}"
+    );
+    assert!(!dir.join("particles_00002.vtu").exists());
+    assert!(dir.join("particles_00001.vtu").exists());
+    std::fs::remove_dir_all(dir).ok();
+}
+
 /// The first stop request only sets the run's flag; the second writes the abort summary
 /// and tells the caller to exit.
 #[test]

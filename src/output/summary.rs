@@ -12,7 +12,8 @@ pub struct Summary {
     pub scenario: String,
     /// 2 or 3.
     pub dimension: usize,
-    /// "completed", "interrupted" (stopped on request) or "unstable".
+    /// "completed", "interrupted" (stopped on request), "unstable" or "failed" (an output
+    /// file could not be written).
     pub status: String,
     /// Why the run stopped early, if it did.
     pub message: Option<String>,

@@ -154,6 +154,8 @@ enum Stop {
     Interrupted,
     /// Went unstable.
     Unstable(Unstable),
+    /// An output file could not be written (a full disk, a folder gone).
+    Output(anyhow::Error),
 }
 
 fn drive<D: Dim>(
@@ -290,6 +292,15 @@ fn drive<D: Dim>(
         Stop::Completed
     };
     let t0 = Instant::now();
+    // An output error ends the run as failed, keeping the history for summary.json.
+    macro_rules! or_stop {
+        ($e:expr) => {
+            if let Err(e) = $e {
+                stop = Stop::Output(e);
+                break;
+            }
+        };
+    }
     while !early && world.step < steps {
         // A step that ends at a history row with J to measure keeps its own stencils.
         let next = world.step + 1;
@@ -303,7 +314,7 @@ fn drive<D: Dim>(
             break;
         }
         state.sample(&world, &probes);
-        take(&mut world, &mut state, &mut writers)?;
+        or_stop!(take(&mut world, &mut state, &mut writers));
         let last = world.step == steps;
         if row_due(world.time, state.next_history, last) {
             state.next_history += output.history_interval;
@@ -314,13 +325,13 @@ fn drive<D: Dim>(
             }
             let row = *state.record(&world, energies);
             if let Some(w) = &mut writers {
-                w.row(&row, &state.history)?;
+                or_stop!(w.row(&row, &state.history));
             }
         }
         if vtk && (world.time >= state.next_frame * (1.0 - 1e-9) || last) {
             state.next_frame += output.interval;
             if let Some(w) = &mut writers {
-                w.frame(&world, &mut state)?;
+                or_stop!(w.frame(&world, &mut state));
             }
         }
         let requested = opts
@@ -336,9 +347,9 @@ fn drive<D: Dim>(
                 break;
             }
             if let Some(w) = &mut writers {
-                w.flush()?;
+                or_stop!(w.flush());
             }
-            c.write(src, &world, &state)?;
+            or_stop!(c.write(src, &world, &state));
         }
         if requested && !last {
             stop = Stop::Interrupted;
@@ -348,6 +359,13 @@ fn drive<D: Dim>(
             bar.set_message(format!("{:.4e} s", world.time));
             bar.set_position(world.step);
         }
+    }
+    // The files must take the last rows before the summary says how the run ended.
+    if !matches!(stop, Stop::Output(_))
+        && let Some(w) = &mut writers
+        && let Err(e) = w.flush()
+    {
+        stop = Stop::Output(e);
     }
     let wall = t0.elapsed().as_secs_f64();
     bar.finish_and_clear();
@@ -389,6 +407,22 @@ fn drive<D: Dim>(
                 None => e.to_string(),
             }),
         ),
+        Stop::Output(e) => (
+            "failed",
+            Some(format!(
+                "output failed at step {} (t = {:.6e} s): {e:#}; {}",
+                world.step,
+                world.time,
+                match &snapshot {
+                    Some((p, s)) => format!(
+                        "the last snapshot is {} (step {s}): `fissure resume` it into a folder \
+                         with room, which rewrites the history files",
+                        p.display()
+                    ),
+                    None => "no snapshot was written".into(),
+                }
+            )),
+        ),
     };
     let summary = Summary {
         scenario: name.clone(),
@@ -428,11 +462,19 @@ fn drive<D: Dim>(
         snapshot_seconds: checkpoints.as_ref().map_or(0.0, |c| c.seconds),
         snapshot_bytes: checkpoints.as_ref().map_or(0, |c| c.bytes),
     };
+    let failed = matches!(stop, Stop::Output(_));
     if let Some(w) = &mut writers {
-        w.flush()?;
         let json = serde_json::to_string_pretty(&summary)?;
-        std::fs::write(w.dir.join("summary.json"), json)?;
-        if output.plot {
+        let summary_path = w.dir.join("summary.json");
+        if failed {
+            // Best effort: the disk that failed may yet take a small file.
+            w.flush().ok();
+            std::fs::write(&summary_path, json).ok();
+        } else {
+            std::fs::write(&summary_path, json)
+                .with_context(|| format!("cannot write {}", summary_path.display()))?;
+        }
+        if output.plot && !failed {
             plot_energies(&w.dir.join("energy.png"), &name, &state.history)
                 .map_err(|e| anyhow::anyhow!("cannot draw energy.png: {e}"))?;
             if let Some(cracks) = &crack_names {
@@ -452,6 +494,12 @@ fn drive<D: Dim>(
                     .map_err(|e| anyhow::anyhow!("cannot draw growth.png: {e}"))?;
             }
         }
+    }
+    if failed {
+        return Err(anyhow::anyhow!(
+            "{}",
+            message.expect("failed runs have a message")
+        ));
     }
     if let Stop::Unstable(_) = stop {
         let kept = opts

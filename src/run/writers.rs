@@ -14,15 +14,40 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+/// A buffered output file whose write errors name it (a full disk says which file).
+struct Named {
+    path: PathBuf,
+    w: BufWriter<File>,
+}
+
+impl Named {
+    fn named(&self, e: std::io::Error) -> std::io::Error {
+        std::io::Error::new(
+            e.kind(),
+            format!("cannot write {}: {e}", self.path.display()),
+        )
+    }
+}
+
+impl Write for Named {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.w.write(buf).map_err(|e| self.named(e))
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.w.flush().map_err(|e| self.named(e))
+    }
+}
+
 /// Open output files of a run.
 pub struct Writers {
     /// Output folder.
     pub dir: PathBuf,
-    energy: BufWriter<File>,
-    probes: BufWriter<File>,
-    fracture: Option<(BufWriter<File>, Vec<String>)>,
-    paths: Option<BufWriter<File>>,
-    growth: Option<(BufWriter<File>, Vec<String>)>,
+    energy: Named,
+    probes: Named,
+    fracture: Option<(Named, Vec<String>)>,
+    paths: Option<Named>,
+    growth: Option<(Named, Vec<String>)>,
     /// Whether a tip is a 3D front vertex (named by its ordinal along the crack's front)
     /// rather than a 2D crack end (named start or end).
     front_vertices: bool,
@@ -51,9 +76,12 @@ impl Writers {
             .with_context(|| format!("cannot create output folder {}", dir.display()))?;
         let create = |name: &str| -> anyhow::Result<_> {
             let path = dir.join(name);
-            Ok(BufWriter::new(File::create(&path).with_context(|| {
-                format!("cannot create {}", path.display())
-            })?))
+            let file =
+                File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+            Ok(Named {
+                w: BufWriter::new(file),
+                path,
+            })
         };
         let mut energy = create("energy.csv")?;
         writeln!(
@@ -233,12 +261,16 @@ impl Writers {
     /// Writes a VTK frame of `world` and the collection file listing every frame so far.
     pub fn frame<D: Dim>(&mut self, world: &World<D>, state: &mut RunState) -> anyhow::Result<()> {
         let name = frame_name(state.frames.len());
-        vtk::write_particles(&self.dir.join(&name), &world.particles)?;
+        whole(&self.dir.join(&name), |p| {
+            vtk::write_particles(p, &world.particles)
+        })?;
         state.frames.push(world.time);
         let list: Vec<(f64, String)> = (state.frames.iter().enumerate())
             .map(|(k, &t)| (t, self.listed("particles", k)))
             .collect();
-        vtk::write_collection(&self.dir.join("particles.pvd"), &list)?;
+        whole(&self.dir.join("particles.pvd"), |p| {
+            vtk::write_collection(p, &list)
+        })?;
         if let Some(c) = &world.cracks {
             let crack_name = |k: usize| format!("cracks_{k:05}.vtu");
             let last = state.history.fracture.last().map(|t| t.step);
@@ -246,11 +278,15 @@ impl Writers {
                 .take_while(|t| Some(t.step) == last)
                 .copied()
                 .collect();
-            vtk::write_cracks(&self.dir.join(crack_name(state.frames.len() - 1)), c, &tips)?;
+            whole(&self.dir.join(crack_name(state.frames.len() - 1)), |p| {
+                vtk::write_cracks(p, c, &tips)
+            })?;
             let list: Vec<(f64, String)> = (state.frames.iter().enumerate())
                 .map(|(k, &t)| (t, self.listed("cracks", k)))
                 .collect();
-            vtk::write_collection(&self.dir.join("cracks.pvd"), &list)?;
+            whole(&self.dir.join("cracks.pvd"), |p| {
+                vtk::write_collection(p, &list)
+            })?;
         }
         Ok(())
     }
@@ -265,8 +301,20 @@ impl Writers {
         if let Some(f) = &mut self.paths {
             f.flush()?;
         }
+        if let Some((f, _)) = &mut self.growth {
+            f.flush()?;
+        }
         Ok(())
     }
+}
+
+/// Writes the file at `path` with `write`; on failure removes what was written of it (a
+/// truncated frame would mislead a reader) and names it in the error.
+fn whole(path: &Path, write: impl FnOnce(&Path) -> std::io::Result<()>) -> anyhow::Result<()> {
+    write(path).map_err(|e| {
+        std::fs::remove_file(path).ok();
+        anyhow::anyhow!("cannot write {}: {e}", path.display())
+    })
 }
 
 fn frame_name(k: usize) -> String {
