@@ -28,6 +28,7 @@ pub mod scenario;
 pub mod schedule;
 pub mod shape;
 pub mod snapshot;
+pub mod sweep;
 pub mod sym;
 pub mod tiles;
 pub mod timefn;

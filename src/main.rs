@@ -9,6 +9,7 @@ use fissure::run::{Outcome, RunOptions, resume, run};
 use fissure::scenario::{Source, build};
 use fissure::schedule::Schedule;
 use fissure::snapshot::{Reader, SnapshotError};
+use fissure::sweep::{Vary, sweep};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -69,6 +70,25 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         overrides: Vec<String>,
     },
+    /// Run a scenario over every combination of values of some keys (sweep.csv: size, cost
+    /// and every expect's error per run); a stopped sweep resumes where it stopped.
+    Sweep {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+        /// A key and its values, as --set takes them: --vary grid.cell=[2e-3,2e-3],[1e-3,1e-3]
+        /// (repeatable: every combination runs).
+        #[arg(long, value_name = "KEY=V1,V2,...", required = true)]
+        vary: Vec<String>,
+        /// Worker threads (default: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Output folder (default: out/<scenario name>-sweep).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Run more than 1,000 combinations.
+        #[arg(long)]
+        yes: bool,
+    },
     /// Run scenarios and check every [[expect]]; exits non-zero if any fails.
     Validate {
         /// Scenario files or folders of them.
@@ -113,6 +133,62 @@ fn main() -> ExitCode {
             out,
             overrides,
         } => cmd_validate(&paths, threads, out, &overrides),
+        Command::Sweep {
+            scenario,
+            vary,
+            threads,
+            out,
+            yes,
+        } => cmd_sweep(&scenario, &vary, threads, out, yes),
+    }
+}
+
+/// `sweep`: the runs one line each as they finish; sweep.csv holds the figures.
+fn cmd_sweep(
+    scenario: &Path,
+    vary: &[String],
+    threads: usize,
+    out: Option<PathBuf>,
+    yes: bool,
+) -> ExitCode {
+    let vary = match vary
+        .iter()
+        .map(|v| Vary::parse(v))
+        .collect::<Result<Vec<_>, _>>()
+    {
+        Ok(v) => v,
+        Err(e) => return report(e.into()),
+    };
+    let out = out.unwrap_or_else(|| {
+        let stem = scenario
+            .file_stem()
+            .map_or("scenario".into(), |s| s.to_string_lossy());
+        PathBuf::from("out").join(format!("{stem}-sweep"))
+    });
+    let done = sweep(scenario, &vary, threads, &out, yes, |r| {
+        let (k, n) = r.index;
+        let what = r.set.join(" ");
+        match (r.summary, &r.error) {
+            (Some(s), _) => {
+                let worst = (s.expects.iter())
+                    .filter_map(|e| e.error.map(|x| x / e.tolerance))
+                    .fold(0.0, f64::max);
+                println!(
+                    "[{k}/{n}] {what}: {}, {} particles, {:.2} s, worst error {worst:.2} of its \
+                     tolerance",
+                    s.status, s.particles, s.wall_seconds
+                );
+            }
+            (None, Some(e)) => println!("[{k}/{n}] {what}: {e}"),
+            (None, None) => {}
+        }
+    });
+    match done {
+        Ok(()) => {
+            println!("sweep.csv in {}", out.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => report(e),
     }
 }
 

@@ -1,0 +1,342 @@
+//! Parameter sweeps: a scenario run over the grid of values of one or more keys, each run
+//! a row of sweep.csv (its values, size, cost and every expect's value and error), so
+//! error can be read against cost. A sweep stopped part-way resumes: the rows already in
+//! sweep.csv are not run again.
+
+use crate::error::UsageError;
+use crate::output::summary::Summary;
+use crate::run::{RunOptions, run};
+use crate::scenario::Source;
+use anyhow::Context;
+use std::io::Write;
+use std::path::Path;
+
+/// Most runs a sweep makes without being told `--yes`.
+pub const MAX_RUNS: usize = 1000;
+
+/// One swept key and its values, as `--set` takes them (TOML values).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Vary {
+    /// Dotted key, e.g. `grid.cell`.
+    pub key: String,
+    /// Its values, in order.
+    pub values: Vec<String>,
+}
+
+impl Vary {
+    /// Parses `KEY=V1,V2,...`; commas inside brackets, braces or quotes belong to a value
+    /// (`grid.cell=[2e-3, 2e-3],[1e-3, 1e-3]`).
+    pub fn parse(arg: &str) -> Result<Vary, UsageError> {
+        let bad = |why: &str| UsageError(format!("--vary {arg}: {why}"));
+        let (key, list) = arg
+            .split_once('=')
+            .ok_or_else(|| bad("give KEY=V1,V2,..."))?;
+        let key = key.trim();
+        if key.is_empty() {
+            return Err(bad("the key is empty"));
+        }
+        let values = split_values(list).map_err(|why| bad(&why))?;
+        if values.iter().any(String::is_empty) {
+            return Err(bad(
+                "a value is empty (give at least one, separated by commas)",
+            ));
+        }
+        Ok(Vary {
+            key: key.to_string(),
+            values,
+        })
+    }
+}
+
+/// Splits a value list at the commas outside brackets, braces and quotes.
+fn split_values(list: &str) -> Result<Vec<String>, String> {
+    let (mut out, mut cur, mut depth, mut quote) = (Vec::new(), String::new(), 0i32, None);
+    for ch in list.chars() {
+        match (quote, ch) {
+            (Some(q), c) if c == q => quote = None,
+            (Some(_), _) => {}
+            (None, '"' | '\'') => quote = Some(ch),
+            (None, '[' | '{') => depth += 1,
+            (None, ']' | '}') => depth -= 1,
+            (None, ',') if depth == 0 => {
+                out.push(cur.trim().to_string());
+                cur.clear();
+                continue;
+            }
+            _ => {}
+        }
+        if depth < 0 {
+            return Err("a closing bracket has no opening one".into());
+        }
+        cur.push(ch);
+    }
+    if depth != 0 || quote.is_some() {
+        return Err("a bracket or quote is not closed".into());
+    }
+    out.push(cur.trim().to_string());
+    Ok(out)
+}
+
+/// Every combination of the values, the first key varying slowest, as `--set` arguments.
+pub fn combinations(vary: &[Vary]) -> Vec<Vec<String>> {
+    vary.iter().fold(vec![Vec::new()], |acc, v| {
+        acc.iter()
+            .flat_map(|prefix| {
+                v.values.iter().map(move |value| {
+                    let mut c = prefix.clone();
+                    c.push(format!("{}={value}", v.key));
+                    c
+                })
+            })
+            .collect()
+    })
+}
+
+/// The header of sweep.csv: the varied keys, the run's figures, then value, error and
+/// pass of each expect (named by quantity and crack or probes).
+pub fn header(vary: &[Vary], expects: &[String]) -> String {
+    let mut cols: Vec<String> = vary.iter().map(|v| v.key.clone()).collect();
+    cols.extend(
+        [
+            "status",
+            "particles",
+            "nodes",
+            "steps",
+            "wall_seconds",
+            "particle_steps_per_second",
+            "bytes_per_particle",
+        ]
+        .map(String::from),
+    );
+    for e in expects {
+        cols.extend([
+            format!("{e} value"),
+            format!("{e} error"),
+            format!("{e} pass"),
+        ]);
+    }
+    cols.iter().map(|c| quote(c)).collect::<Vec<_>>().join(",")
+}
+
+/// One run's row of sweep.csv: `values` are the varied keys' values in order.
+pub fn row(values: &[String], summary: &Summary) -> String {
+    let mut cols: Vec<String> = values.iter().map(|v| quote(v)).collect();
+    cols.extend([
+        summary.status.clone(),
+        summary.particles.to_string(),
+        summary.nodes.to_string(),
+        summary.steps.to_string(),
+        format!("{:.6e}", summary.wall_seconds),
+        format!("{:.6e}", summary.particle_steps_per_second),
+        summary.bytes_per_particle.to_string(),
+    ]);
+    for e in &summary.expects {
+        let num = |v: Option<f64>| v.map_or("NaN".into(), |v| format!("{v:.9e}"));
+        cols.extend([num(e.value), num(e.error), e.pass.to_string()]);
+    }
+    cols.join(",")
+}
+
+/// The row of a run that did not finish (unstable, or refused at set-up): its status,
+/// and empty figures and expects.
+pub fn failed_row(values: &[String], status: &str, expects: usize) -> String {
+    let mut cols: Vec<String> = values.iter().map(|v| quote(v)).collect();
+    cols.push(status.to_string());
+    cols.extend(std::iter::repeat_n(String::new(), 6 + 3 * expects));
+    cols.join(",")
+}
+
+/// A CSV field: quoted when it holds a comma or a quote.
+fn quote(s: &str) -> String {
+    if s.contains([',', '"']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// The varied values of the rows already in `csv` (a sweep resuming), after checking that
+/// its header is `header`; an empty list when there is no such file.
+pub fn done(csv: &Path, header: &str, keys: usize) -> Result<Vec<Vec<String>>, UsageError> {
+    let Ok(text) = std::fs::read_to_string(csv) else {
+        return Ok(Vec::new());
+    };
+    let mut lines = text.lines();
+    if lines.next() != Some(header) {
+        return Err(UsageError(format!(
+            "{} belongs to another sweep (other keys or expects): give another --out",
+            csv.display()
+        )));
+    }
+    Ok(lines
+        .filter(|l| !l.is_empty())
+        .map(|l| fields(l).into_iter().take(keys).collect())
+        .collect())
+}
+
+/// The fields of a CSV line written by [`row`] (quotes undone).
+fn fields(line: &str) -> Vec<String> {
+    let (mut out, mut cur, mut quoted, mut chars) =
+        (Vec::new(), String::new(), false, line.chars());
+    while let Some(c) = chars.next() {
+        match (quoted, c) {
+            (true, '"') if chars.clone().next() == Some('"') => {
+                chars.next();
+                cur.push('"');
+            }
+            (true, '"') => quoted = false,
+            (false, '"') => quoted = true,
+            (false, ',') => out.push(std::mem::take(&mut cur)),
+            _ => cur.push(c),
+        }
+    }
+    out.push(cur);
+    out
+}
+
+/// How one run of a sweep went, for the launcher's progress line.
+pub struct Ran<'a> {
+    /// 1-based index of the run and the number of runs.
+    pub index: (usize, usize),
+    /// The `--set` arguments of the run.
+    pub set: &'a [String],
+    /// Its summary, when it finished (completed or not).
+    pub summary: Option<&'a Summary>,
+    /// Why it did not finish, if it did not; "already in sweep.csv" for a skipped run.
+    pub error: Option<String>,
+}
+
+/// Runs `file` over every combination of `vary` on `threads` threads, appending a row per
+/// run to `<out>/sweep.csv` and telling `progress` about each. Every combination is loaded
+/// (so a bad key or value is refused) before the first run; more than [`MAX_RUNS`] runs
+/// need `yes`.
+pub fn sweep(
+    file: &Path,
+    vary: &[Vary],
+    threads: usize,
+    out: &Path,
+    yes: bool,
+    mut progress: impl FnMut(&Ran),
+) -> anyhow::Result<()> {
+    if vary.is_empty() {
+        return Err(UsageError("give at least one --vary KEY=V1,V2,...".into()).into());
+    }
+    for (k, v) in vary.iter().enumerate() {
+        if vary[..k].iter().any(|w| w.key == v.key) {
+            return Err(UsageError(format!("--vary {} is given twice", v.key)).into());
+        }
+    }
+    let combos = combinations(vary);
+    if combos.len() > MAX_RUNS && !yes {
+        return Err(UsageError(format!(
+            "the sweep has {} runs, more than {MAX_RUNS}: add --yes to run them all",
+            combos.len()
+        ))
+        .into());
+    }
+    let sources = (combos.iter())
+        .map(|set| Source::load(file, set))
+        .collect::<Result<Vec<_>, _>>()?;
+    let expects: Vec<String> = (sources[0].scenario.expects.iter())
+        .map(|e| {
+            let names: Vec<&str> = (e.crack.iter().chain(&e.tip).chain(&e.probes))
+                .map(String::as_str)
+                .collect();
+            format!("{} {}", e.quantity, names.join("/"))
+                .trim()
+                .to_string()
+        })
+        .collect();
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create output folder {}", out.display()))?;
+    let csv = out.join("sweep.csv");
+    let head = header(vary, &expects);
+    let done = done(&csv, &head, vary.len())?;
+    let mut file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&csv)
+        .with_context(|| format!("cannot open {}", csv.display()))?;
+    let named = |e: std::io::Error| anyhow::anyhow!("cannot write {}: {e}", csv.display());
+    if done.is_empty() && file.metadata().map_err(named)?.len() == 0 {
+        writeln!(file, "{head}").map_err(named)?;
+    }
+    let n = combos.len();
+    for (k, (set, src)) in combos.iter().zip(sources).enumerate() {
+        let values: Vec<String> = (set.iter())
+            .map(|a| a.split_once('=').map_or("", |(_, v)| v).to_string())
+            .collect();
+        let index = (k + 1, n);
+        if done.contains(&values) {
+            progress(&Ran {
+                index,
+                set,
+                summary: None,
+                error: Some("already in sweep.csv".into()),
+            });
+            continue;
+        }
+        let opts = RunOptions {
+            threads,
+            ..RunOptions::default()
+        };
+        match run(&src, &opts) {
+            Ok(o) => {
+                writeln!(file, "{}", row(&values, &o.summary)).map_err(named)?;
+                progress(&Ran {
+                    index,
+                    set,
+                    summary: Some(&o.summary),
+                    error: None,
+                });
+            }
+            Err(e) => {
+                let status = if e.to_string().contains("unstable") {
+                    "unstable"
+                } else {
+                    "error"
+                };
+                writeln!(file, "{}", failed_row(&values, status, expects.len())).map_err(named)?;
+                progress(&Ran {
+                    index,
+                    set,
+                    summary: None,
+                    error: Some(format!("{e:#}")),
+                });
+            }
+        }
+        file.flush().map_err(named)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Lists keep their commas; combinations run the first key slowest; a row's quoted
+    /// values read back as they were.
+    #[test]
+    fn values_combinations_and_rows() {
+        let v = Vary::parse("grid.cell=[2e-3, 2e-3],[1e-3, 1e-3]").unwrap();
+        assert_eq!(v.values, vec!["[2e-3, 2e-3]", "[1e-3, 1e-3]"]);
+        let s = Vary::parse("simulation.shape=\"linear\",\"ugimp\"").unwrap();
+        let c = combinations(&[v, s]);
+        assert_eq!(c.len(), 4);
+        assert_eq!(
+            c[1],
+            vec!["grid.cell=[2e-3, 2e-3]", "simulation.shape=\"ugimp\""]
+        );
+        assert!(Vary::parse("grid.cell").is_err());
+        assert!(Vary::parse("grid.cell=").is_err());
+        assert!(Vary::parse("grid.cell=[1e-3,1e-3").is_err());
+        assert!(Vary::parse("a=1,,2").is_err());
+        let values = vec!["[2e-3, 2e-3]".to_string(), "\"ugimp\"".to_string()];
+        let line = failed_row(&values, "unstable", 1);
+        assert_eq!(
+            fields(&line)[..3],
+            ["[2e-3, 2e-3]", "\"ugimp\"", "unstable"]
+        );
+        assert_eq!(fields(&line).len(), 3 + 6 + 3);
+    }
+}

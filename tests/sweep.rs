@@ -1,0 +1,125 @@
+//! `sweep`: every combination runs once and lands in sweep.csv; a sweep stopped part-way
+//! runs only what is missing; bad keys, values and oversized sweeps are refused before
+//! the first run.
+
+mod common;
+
+use fissure::sweep::{Vary, sweep};
+use std::path::{Path, PathBuf};
+
+/// A fresh folder under the system temp folder, and a scenario file in it: the block of
+/// `common::block_2d` moving at 1 m/s with an energy-balance expect, so each row carries
+/// an error.
+fn setup(name: &str) -> (PathBuf, PathBuf) {
+    let dir = std::env::temp_dir().join(format!("fissure-sweep-{}-{name}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = common::block_2d(
+        2e-5,
+        0.006,
+        0.014,
+        "velocity = [1.0, 0.0]\n[[expect]]\nquantity = \"energy_drift\"\nreference = 0.0\nsource = \"balance\"\n\
+         tolerance = 0.01\n",
+    );
+    let file = dir.join("block.toml");
+    std::fs::write(&file, format!("name = \"block\"\n{text}")).unwrap();
+    (dir, file)
+}
+
+fn vary(args: &[&str]) -> Vec<Vary> {
+    args.iter().map(|a| Vary::parse(a).unwrap()).collect()
+}
+
+/// Runs the sweep, returning the progress lines (index and whether it ran).
+fn go(file: &Path, v: &[Vary], out: &Path) -> Vec<(usize, bool)> {
+    let mut seen = Vec::new();
+    sweep(file, v, 1, out, false, |r| {
+        seen.push((r.index.0, r.summary.is_some()))
+    })
+    .unwrap_or_else(|e| panic!("{e:#}"));
+    seen
+}
+
+/// Two cell sizes by two shape functions: four rows; the finer cells hold four times the
+/// particles; dropping the last row and sweeping again runs that one only.
+#[test]
+fn every_combination_runs_once_and_a_stopped_sweep_resumes() {
+    let (dir, file) = setup("grid");
+    let out = dir.join("out");
+    let v = vary(&[
+        "grid.cell=[2e-3, 2e-3],[1e-3, 1e-3]",
+        "simulation.shape=linear,ugimp",
+    ]);
+    let seen = go(&file, &v, &out);
+    assert_eq!(seen, vec![(1, true), (2, true), (3, true), (4, true)]);
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 5, "{csv}");
+    assert!(lines[0].starts_with("grid.cell,simulation.shape,status,particles"));
+    assert!(lines[0].ends_with("energy_drift value,energy_drift error,energy_drift pass"));
+    let particles = |l: &str| -> usize {
+        let after = l.rsplit_once("\",").unwrap().1;
+        after.split(',').nth(2).unwrap().parse().unwrap()
+    };
+    assert_eq!(particles(lines[3]), 4 * particles(lines[1]));
+    assert!(lines[4].starts_with("\"[1e-3, 1e-3]\",ugimp,completed,"));
+    std::fs::write(out.join("sweep.csv"), lines[..4].join("\n") + "\n").unwrap();
+    let seen = go(&file, &v, &out);
+    assert_eq!(seen, vec![(1, false), (2, false), (3, false), (4, true)]);
+    let again = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    assert_eq!(again.lines().count(), 5);
+    // The same run again: the same figures but for its timing.
+    let untimed = |l: &str| -> Vec<String> {
+        // After the quoted cell size: shape, status, particles, nodes, steps, two timings.
+        let f: Vec<String> = l
+            .rsplit_once("\",")
+            .unwrap()
+            .1
+            .split(',')
+            .map(String::from)
+            .collect();
+        [&f[..5], &f[7..]].concat()
+    };
+    assert_eq!(untimed(again.lines().last().unwrap()), untimed(lines[4]));
+    assert!(!lines[4].contains("NaN"), "{}", lines[4]);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// A bad key or value is named before any run (no sweep.csv), as are a repeated key and
+/// a sweep of more than 1,000 runs without `yes`; a malformed --vary is refused.
+#[test]
+fn bad_sweeps_are_refused_before_the_first_run() {
+    let (dir, file) = setup("bad");
+    let out = dir.join("out");
+    let refused = |v: &[Vary], yes: bool| -> String {
+        let e = sweep(&file, v, 1, &out, yes, |_| panic!("no run may start"))
+            .expect_err("must be refused");
+        assert!(!out.join("sweep.csv").exists());
+        format!("{e:#}")
+    };
+    let e = refused(&vary(&["simulation.duration=1e-5", "grid.size=1,2"]), false);
+    assert!(
+        e.contains("grid.size") && e.contains("unknown field"),
+        "{e}"
+    );
+    let e = refused(&vary(&["simulation.duration=1e-5,abc"]), false);
+    assert!(
+        e.contains("simulation.duration") && e.contains("invalid type"),
+        "{e}"
+    );
+    let e = refused(
+        &vary(&["simulation.cfl=0.1,0.2", "simulation.cfl=0.3"]),
+        false,
+    );
+    assert!(e.contains("given twice"), "{e}");
+    let many: Vec<String> = (0..1001)
+        .map(|k| format!("{}", 1e-6 * (k + 1) as f64))
+        .collect();
+    let big = vary(&[&format!("simulation.duration={}", many.join(","))]);
+    let e = refused(&big, false);
+    assert!(e.contains("1001 runs") && e.contains("--yes"), "{e}");
+    for bad in ["grid.cell", "grid.cell=", "grid.cell=[1e-3, 1e-3", "a=1,,2"] {
+        assert!(Vary::parse(bad).is_err(), "{bad}");
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
