@@ -4,6 +4,7 @@
 //! sweep.csv are not run again.
 
 use crate::error::UsageError;
+use crate::output::plot::{self, Series};
 use crate::output::summary::Summary;
 use crate::run::{RunOptions, run};
 use crate::scenario::Source;
@@ -306,6 +307,42 @@ pub fn sweep(
             }
         }
         file.flush().map_err(named)?;
+    }
+    plots(&csv, vary, &expects, out)
+}
+
+/// sweep_<k>.png for expect k: its error against wall time on log-log axes, every row of
+/// sweep.csv (this invocation's and earlier ones'), one curve per value of the first
+/// varied key when more than one key varies.
+fn plots(csv: &Path, vary: &[Vary], expects: &[String], out: &Path) -> anyhow::Result<()> {
+    let text =
+        std::fs::read_to_string(csv).with_context(|| format!("cannot read {}", csv.display()))?;
+    let rows: Vec<Vec<String>> = text.lines().skip(1).map(fields).collect();
+    let keys = vary.len();
+    let number = |r: &[String], k: usize| r.get(k).and_then(|v| v.parse::<f64>().ok());
+    let groups: Vec<String> = if keys > 1 {
+        vary[0].values.clone()
+    } else {
+        vec![String::new()]
+    };
+    for (k, e) in expects.iter().enumerate() {
+        let series: Vec<Series> = (groups.iter())
+            .map(|g| Series {
+                label: if keys > 1 { g } else { "runs" },
+                points: (rows.iter())
+                    .filter(|r| keys == 1 || r.first() == Some(g))
+                    .filter_map(|r| Some((number(r, keys + 4)?, number(r, keys + 8 + 3 * k)?)))
+                    .collect(),
+            })
+            .collect();
+        let title = if keys > 1 {
+            format!("{e}: error against cost, by {}", vary[0].key)
+        } else {
+            format!("{e}: error against cost over {}", vary[0].key)
+        };
+        let path = out.join(format!("sweep_{k}.png"));
+        plot::log_log(&path, &title, "wall time (s)", "error", &series)
+            .map_err(|why| anyhow::anyhow!("cannot draw {}: {why}", path.display()))?;
     }
     Ok(())
 }

@@ -63,6 +63,11 @@ fn every_combination_runs_once_and_a_stopped_sweep_resumes() {
     };
     assert_eq!(particles(lines[3]), 4 * particles(lines[1]));
     assert!(lines[4].starts_with("\"[1e-3, 1e-3]\",ugimp,completed,"));
+    let png = std::fs::read(out.join("sweep_0.png")).unwrap();
+    assert!(
+        png.starts_with(b"\x89PNG"),
+        "sweep_0.png is the error-against-cost plot"
+    );
     std::fs::write(out.join("sweep.csv"), lines[..4].join("\n") + "\n").unwrap();
     let seen = go(&file, &v, &out);
     assert_eq!(seen, vec![(1, false), (2, false), (3, false), (4, true)]);
