@@ -646,6 +646,46 @@ fn a_full_disk_names_the_file_and_keeps_a_summary() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// A snapshot write that meets a full disk (its temporary file lands on /dev/full) fails,
+/// and leaves neither the partial temporary file nor a snapshot behind.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_during_a_snapshot_leaves_no_partial_file() {
+    if !Path::new("/dev/full").exists() {
+        eprintln!("no /dev/full on this machine: the full-disk case is not tried");
+        return;
+    }
+    let dir = scratch("full-snap");
+    let (path, tmp) = (dir.join("s.fsnap"), dir.join("s.fsnap.tmp"));
+    std::os::unix::fs::symlink("/dev/full", &tmp).unwrap();
+    let data = vec![1.0f64; 1 << 18];
+    let mut columns = fissure::snapshot::format::ColumnSet::default();
+    columns.add("x", &data);
+    let header = Header {
+        dimension: 2,
+        particles: 0,
+        nodes: 0,
+        step: 0,
+        time: 0.0,
+        dt: 1.0,
+        scenario: "full".into(),
+        scenario_hash: 0,
+        build: "test".into(),
+        data_len: 0,
+        columns: Vec::new(),
+    };
+    let err = columns
+        .write(&path, header)
+        .expect_err("a full disk must fail");
+    assert_eq!(err.raw_os_error(), Some(28), "{err}");
+    assert!(
+        std::fs::symlink_metadata(&tmp).is_err(),
+        "the partial file is gone"
+    );
+    assert!(!path.exists());
+    std::fs::remove_dir_all(dir).ok();
+}
+
 /// The first stop request only sets the run's flag; the second writes the abort summary
 /// and tells the caller to exit.
 #[test]

@@ -189,19 +189,26 @@ impl<'a> ColumnSet<'a> {
         let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
         tmp_name.push(".tmp");
         let tmp = path.with_file_name(tmp_name);
-        let mut f = std::io::BufWriter::with_capacity(1 << 20, File::create(&tmp)?);
-        f.write_all(&pre)?;
-        f.write_all(&pad(pre.len() as u64))?;
-        for (col, blob) in header.columns.iter().zip(&self.blobs) {
-            debug_assert_eq!(col.len * col.elem.size(), blob.len() as u64);
-            f.write_all(blob)?;
-            f.write_all(&pad(blob.len() as u64))?;
+        let written = (|| {
+            let mut f = std::io::BufWriter::with_capacity(1 << 20, File::create(&tmp)?);
+            f.write_all(&pre)?;
+            f.write_all(&pad(pre.len() as u64))?;
+            for (col, blob) in header.columns.iter().zip(&self.blobs) {
+                debug_assert_eq!(col.len * col.elem.size(), blob.len() as u64);
+                f.write_all(blob)?;
+                f.write_all(&pad(blob.len() as u64))?;
+            }
+            f.write_all(&checksum.to_le_bytes())?;
+            let f = f.into_inner().map_err(|e| e.into_error())?;
+            f.sync_all()?;
+            drop(f);
+            std::fs::rename(&tmp, path)
+        })();
+        if written.is_err() {
+            // A write cut short (a full disk) leaves no partial file to fill the disk.
+            std::fs::remove_file(&tmp).ok();
         }
-        f.write_all(&checksum.to_le_bytes())?;
-        let f = f.into_inner().map_err(|e| e.into_error())?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)?;
+        written?;
         if let Some(d) = dir {
             // Persist the rename itself; opening a folder for sync is Unix-only.
             #[cfg(unix)]
