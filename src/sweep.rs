@@ -344,7 +344,84 @@ fn plots(csv: &Path, vary: &[Vary], expects: &[String], out: &Path) -> anyhow::R
         plot::log_log(&path, &title, "wall time (s)", "error", &series)
             .map_err(|why| anyhow::anyhow!("cannot draw {}: {why}", path.display()))?;
     }
+    if let Some(c) = vary.iter().position(|v| v.key == "grid.cell") {
+        convergence(&rows, vary, c, expects, out)?;
+    }
     Ok(())
+}
+
+/// sweep_<k>_cell.png when `grid.cell` (key `c`) is swept: expect k's error against the
+/// cell size on log-log axes, one curve per setting of the other keys, with the fitted
+/// order of convergence in its label.
+fn convergence(
+    rows: &[Vec<String>],
+    vary: &[Vary],
+    c: usize,
+    expects: &[String],
+    out: &Path,
+) -> anyhow::Result<()> {
+    let keys = vary.len();
+    let others = |r: &[String]| -> String {
+        (0..keys)
+            .filter(|&j| j != c)
+            .map(|j| format!("{}={}", vary[j].key, r.get(j).map_or("", String::as_str)))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let mut groups: Vec<String> = Vec::new();
+    for r in rows {
+        let g = others(r);
+        if !groups.contains(&g) {
+            groups.push(g);
+        }
+    }
+    for (k, e) in expects.iter().enumerate() {
+        let mut labels = Vec::new();
+        let mut points = Vec::new();
+        for g in &groups {
+            let pts: Vec<(f64, f64)> = (rows.iter())
+                .filter(|r| &others(r) == g)
+                .filter_map(|r| {
+                    let h = cell_size(r.get(c)?)?;
+                    Some((h, r.get(keys + 8 + 3 * k)?.parse().ok()?))
+                })
+                .collect();
+            let fit = order(&pts).map_or("no order".into(), |p| format!("order {p:.2}"));
+            let name = if g.is_empty() { "runs" } else { g };
+            labels.push(format!("{name} ({fit})"));
+            points.push(pts);
+        }
+        let series: Vec<Series> = (labels.iter().zip(points))
+            .map(|(label, points)| Series { label, points })
+            .collect();
+        let path = out.join(format!("sweep_{k}_cell.png"));
+        let title = format!("{e}: error against cell size");
+        plot::log_log(&path, &title, "cell size (m)", "error", &series)
+            .map_err(|why| anyhow::anyhow!("cannot draw {}: {why}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// The first cell size of a `grid.cell` value (`[2e-3, 2e-3]` gives 2e-3).
+fn cell_size(value: &str) -> Option<f64> {
+    let inner = value.trim().trim_start_matches('[');
+    inner.split([',', ']']).next()?.trim().parse().ok()
+}
+
+/// The order of convergence p of error ~ h^p: the least-squares slope of ln(error)
+/// against ln(h) over the points with both positive; None with fewer than two sizes.
+pub fn order(points: &[(f64, f64)]) -> Option<f64> {
+    let logs: Vec<(f64, f64)> = (points.iter())
+        .filter(|(h, e)| *h > 0.0 && *e > 0.0 && h.is_finite() && e.is_finite())
+        .map(|(h, e)| (h.ln(), e.ln()))
+        .collect();
+    let n = logs.len() as f64;
+    let (mx, my) = logs
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let sxx: f64 = logs.iter().map(|(x, _)| (x - mx).powi(2)).sum();
+    let sxy: f64 = logs.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    (logs.len() >= 2 && sxx > 0.0).then(|| sxy / sxx)
 }
 
 #[cfg(test)]
@@ -375,5 +452,18 @@ mod tests {
             ["[2e-3, 2e-3]", "\"ugimp\"", "unstable"]
         );
         assert_eq!(fields(&line).len(), 3 + 6 + 3);
+    }
+
+    /// The fitted order of a power law is its exponent; one size gives none.
+    #[test]
+    fn order_of_convergence() {
+        let pts: Vec<(f64, f64)> = [4e-3, 2e-3, 1e-3]
+            .iter()
+            .map(|&h| (h, 3.0 * h * h))
+            .collect();
+        assert!((order(&pts).unwrap() - 2.0).abs() < 1e-12);
+        assert_eq!(order(&pts[..1]), None);
+        assert_eq!(cell_size("[2e-3, 2e-3]"), Some(2e-3));
+        assert_eq!(cell_size("5e-4"), Some(5e-4));
     }
 }
