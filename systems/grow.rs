@@ -2,10 +2,11 @@
 //! (the maximum hoop stress reaching K_Ic, Erdogan & Sih 1963; J reaching G_c; or a set
 //! time), turns to the direction of the largest hoop stress or runs straight on, and then
 //! either runs at a set speed or extends by one segment at every check at which the
-//! criterion still holds. A tip that reaches the body's free surface is carried a cell
-//! past it and stops; one that reaches another crack stops just short of it. Runs after
-//! the step and its fracture measurement; the moved tip is classified, in contact and
-//! measured from the next step on.
+//! criterion still holds; under a Paris law each extension adds the load cycles it costs
+//! (Belytschko et al. 1995, Eqs. 38-41). A tip that reaches the body's free surface is
+//! carried a cell past it and stops; one that reaches another crack stops just short of
+//! it. Runs after the step and its fracture measurement; the moved tip is classified, in
+//! contact and measured from the next step on.
 
 use crate::crack::{Cracks, Element};
 use crate::dim::D2;

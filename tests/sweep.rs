@@ -68,6 +68,11 @@ fn every_combination_runs_once_and_a_stopped_sweep_resumes() {
         png.starts_with(b"\x89PNG"),
         "sweep_0.png is the error-against-cost plot"
     );
+    let png = std::fs::read(out.join("sweep_0_cell.png")).unwrap();
+    assert!(
+        png.starts_with(b"\x89PNG"),
+        "sweep_0_cell.png: error against cell size"
+    );
     std::fs::write(out.join("sweep.csv"), lines[..4].join("\n") + "\n").unwrap();
     let seen = go(&file, &v, &out);
     assert_eq!(seen, vec![(1, false), (2, false), (3, false), (4, true)]);
