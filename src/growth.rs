@@ -63,10 +63,11 @@ pub struct Paris {
 }
 
 impl Paris {
-    /// Crack growth per cycle (m) at a tip where the largest load gives K_I and K_II, and
-    /// the kink angle of the growth there (maximum hoop stress, Eq. 41 of Belytschko et al.
-    /// 1995, on the ranges); zero growth where Delta K_eq is not positive.
-    pub fn rate(&self, k1: f64, k2: f64) -> (f64, f64) {
+    /// Crack growth per cycle (m) at a tip where the largest load gives K_I and K_II, the
+    /// kink angle of the growth there (maximum hoop stress, Eq. 41 of Belytschko et al.
+    /// 1995, on the ranges) and Delta K_eq (Pa sqrt(m)); zero growth where Delta K_eq is
+    /// not positive.
+    pub fn rate(&self, k1: f64, k2: f64) -> (f64, f64, f64) {
         let (dk1, dk2) = ((1.0 - self.r) * k1, (1.0 - self.r) * k2);
         let theta = hoop_angle(dk1, dk2);
         let dk = delta_k_eq(dk1, dk2, theta);
@@ -75,7 +76,7 @@ impl Paris {
         } else {
             0.0
         };
-        (rate, theta)
+        (rate, theta, dk)
     }
 }
 
@@ -313,14 +314,14 @@ mod tests {
             m: 3.0,
             r: 0.2,
         };
-        let (rate, theta) = p.rate(10e6, 0.0);
+        let (rate, theta, _) = p.rate(10e6, 0.0);
         assert_eq!(theta, 0.0);
         assert!(
             (rate - 1e-29 * 8e6f64.powi(3)).abs() < 1e-12 * rate,
             "{rate}"
         );
         let (k1, k2) = (8e6, 3e6);
-        let (rate, theta) = p.rate(k1, k2);
+        let (rate, theta, _) = p.rate(k1, k2);
         assert!((theta - hoop_angle(k1, k2)).abs() < 1e-12);
         let (c, s) = ((0.5 * theta).cos(), (0.5 * theta).sin());
         let eq = 0.8 * k1 * c.powi(3) - 3.0 * 0.8 * k2 * c * c * s;

@@ -474,18 +474,35 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
 /// How far the energy balance E = K + W - W_ext + W_damp strays from its start: the
 /// largest |E(t) - E(0)| over the largest of K + W, |W_ext| and W_damp in the run.
 pub fn energy_balance(h: &History) -> Option<f64> {
+    let drift = balance_drift(h)?;
+    // NaN (a run with no energy at all) stays NaN, as a failed measurement.
+    Some(drift.iter().map(|(_, d)| d.abs()).fold(0.0, |m: f64, d| {
+        if m.is_nan() || d.is_nan() {
+            f64::NAN
+        } else {
+            m.max(d)
+        }
+    }))
+}
+
+/// The energy balance's drift over time: (t, (E(t) - E(0)) / scale), with the scale of
+/// [`energy_balance`]; None without rows.
+pub fn balance_drift(h: &History) -> Option<Vec<(f64, f64)>> {
     let total = |e: &Energies| e.kinetic + e.strain - e.external_work + e.damping_work;
     let e0 = total(&h.rows.first()?.energies);
-    let (mut worst, mut scale) = (0.0f64, 0.0f64);
-    for r in &h.rows {
-        let e = &r.energies;
-        worst = worst.max((total(e) - e0).abs());
-        scale = scale
-            .max(e.kinetic + e.strain)
-            .max(e.external_work.abs())
-            .max(e.damping_work);
-    }
-    Some(worst / scale)
+    let scale = (h.rows.iter())
+        .map(|r| {
+            let e = &r.energies;
+            (e.kinetic + e.strain)
+                .max(e.external_work.abs())
+                .max(e.damping_work)
+        })
+        .fold(0.0, f64::max);
+    Some(
+        (h.rows.iter())
+            .map(|r| (r.time, (total(&r.energies) - e0) / scale))
+            .collect(),
+    )
 }
 
 fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

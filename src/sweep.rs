@@ -15,6 +15,28 @@ use std::path::Path;
 /// Most runs a sweep makes without being told `--yes`.
 pub const MAX_RUNS: usize = 1000;
 
+/// The run's columns of sweep.csv, after the varied keys and before the expects' value,
+/// error and pass.
+const RUN_COLUMNS: [&str; 7] = [
+    "status",
+    "particles",
+    "nodes",
+    "steps",
+    "wall_seconds",
+    "particle_steps_per_second",
+    "bytes_per_particle",
+];
+
+/// The column of the wall time in a row of `keys` varied keys.
+fn wall_column(keys: usize) -> usize {
+    keys + 4
+}
+
+/// The column of expect `k`'s error in a row of `keys` varied keys.
+fn error_column(keys: usize, k: usize) -> usize {
+    keys + RUN_COLUMNS.len() + 3 * k + 1
+}
+
 /// One swept key and its values, as `--set` takes them (TOML values).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Vary {
@@ -97,18 +119,7 @@ pub fn combinations(vary: &[Vary]) -> Vec<Vec<String>> {
 /// pass of each expect (named by quantity and crack or probes).
 pub fn header(vary: &[Vary], expects: &[String]) -> String {
     let mut cols: Vec<String> = vary.iter().map(|v| v.key.clone()).collect();
-    cols.extend(
-        [
-            "status",
-            "particles",
-            "nodes",
-            "steps",
-            "wall_seconds",
-            "particle_steps_per_second",
-            "bytes_per_particle",
-        ]
-        .map(String::from),
-    );
+    cols.extend(RUN_COLUMNS.map(String::from));
     for e in expects {
         cols.extend([
             format!("{e} value"),
@@ -143,7 +154,10 @@ pub fn row(values: &[String], summary: &Summary) -> String {
 pub fn failed_row(values: &[String], status: &str, expects: usize) -> String {
     let mut cols: Vec<String> = values.iter().map(|v| quote(v)).collect();
     cols.push(status.to_string());
-    cols.extend(std::iter::repeat_n(String::new(), 6 + 3 * expects));
+    cols.extend(std::iter::repeat_n(
+        String::new(),
+        RUN_COLUMNS.len() - 1 + 3 * expects,
+    ));
     cols.join(",")
 }
 
@@ -331,7 +345,12 @@ fn plots(csv: &Path, vary: &[Vary], expects: &[String], out: &Path) -> anyhow::R
                 label: if keys > 1 { g } else { "runs" },
                 points: (rows.iter())
                     .filter(|r| keys == 1 || r.first() == Some(g))
-                    .filter_map(|r| Some((number(r, keys + 4)?, number(r, keys + 8 + 3 * k)?)))
+                    .filter_map(|r| {
+                        Some((
+                            number(r, wall_column(keys))?,
+                            number(r, error_column(keys, k))?,
+                        ))
+                    })
                     .collect(),
             })
             .collect();
@@ -383,7 +402,7 @@ fn convergence(
                 .filter(|r| &others(r) == g)
                 .filter_map(|r| {
                     let h = cell_size(r.get(c)?)?;
-                    Some((h, r.get(keys + 8 + 3 * k)?.parse().ok()?))
+                    Some((h, r.get(error_column(keys, k))?.parse().ok()?))
                 })
                 .collect();
             let fit = order(&pts).map_or("no order".into(), |p| format!("order {p:.2}"));

@@ -162,8 +162,7 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
 /// cycles from the last check's length to this one by the trapezoidal rule in a (second
 /// order in the extension, where the forward rule would be first). Returns Delta K_eq.
 fn fatigue(p: &Paris, st: &mut TipState, k1: f64, k2: f64) -> f64 {
-    let (rate, theta) = p.rate(k1, k2);
-    let dk = crate::growth::delta_k_eq((1.0 - p.r) * k1, (1.0 - p.r) * k2, theta);
+    let (rate, _, dk) = p.rate(k1, k2);
     if !st.rate.is_nan() && rate > 0.0 {
         st.cycles += (st.grown - st.checked) * 0.5 * (1.0 / st.rate + 1.0 / rate);
     }

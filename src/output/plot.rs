@@ -46,11 +46,22 @@ pub fn lines(
     y_label: &str,
     series: &[Series],
 ) -> Result<(), String> {
+    figure(path, (900, 560), title, |area| {
+        draw(area, x_label, y_label, series, false)
+    })
+}
+
+/// A white PNG of `size` pixels at `path` with `title` on top; `body` draws below it.
+fn figure(
+    path: &Path,
+    size: (u32, u32),
+    title: &str,
+    body: impl FnOnce(&Area) -> Result<(), String>,
+) -> Result<(), String> {
     register();
-    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+    let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
-    let area = root.titled(title, ("sans-serif", 22)).map_err(err)?;
-    draw(&area, x_label, y_label, series, false)?;
+    body(&root.titled(title, ("sans-serif", 22)).map_err(err)?)?;
     root.present().map_err(err)
 }
 
@@ -63,39 +74,35 @@ pub fn panels(
     panels: &[Panel],
     share: f64,
 ) -> Result<(), String> {
-    register();
-    let root = BitMapBackend::new(path, (900, 780)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    let mut rest = root.titled(title, ("sans-serif", 22)).map_err(err)?;
-    let height = rest.dim_in_pixel().1 as f64;
-    for (k, p) in panels.iter().enumerate() {
-        let left = panels.len() - k;
-        let area = if left == 1 {
-            rest.clone()
-        } else {
-            let h = if k == 0 {
-                share * height
+    figure(path, (900, 780), title, |area| {
+        let mut rest = area.clone();
+        let height = rest.dim_in_pixel().1 as f64;
+        for (k, p) in panels.iter().enumerate() {
+            let left = panels.len() - k;
+            let panel = if left == 1 {
+                rest.clone()
             } else {
-                rest.dim_in_pixel().1 as f64 / left as f64
+                let h = if k == 0 {
+                    share * height
+                } else {
+                    rest.dim_in_pixel().1 as f64 / left as f64
+                };
+                let (top, bottom) = rest.split_vertically(h as u32);
+                rest = bottom;
+                top
             };
-            let (top, bottom) = rest.split_vertically(h as u32);
-            rest = bottom;
-            top
-        };
-        draw(&area, x_label, p.y_label, &p.series, false)?;
-    }
-    root.present().map_err(err)
+            draw(&panel, x_label, p.y_label, &p.series, false)?;
+        }
+        Ok(())
+    })
 }
 
 /// Draws curves in the plane (x, y in m) into a PNG at `path`, one metre on x as long as
 /// one on y, so that angles read true (crack paths).
 pub fn plane(path: &Path, title: &str, series: &[Series]) -> Result<(), String> {
-    register();
-    let root = BitMapBackend::new(path, (760, 800)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    let area = root.titled(title, ("sans-serif", 22)).map_err(err)?;
-    draw(&area, "x (m)", "y (m)", series, true)?;
-    root.present().map_err(err)
+    figure(path, (760, 800), title, |area| {
+        draw(area, "x (m)", "y (m)", series, true)
+    })
 }
 
 /// Draws series on log-log axes (positive values only; others are left out) into a PNG
@@ -107,64 +114,61 @@ pub fn log_log(
     y_label: &str,
     series: &[Series],
 ) -> Result<(), String> {
-    register();
     let positive = |s: &Series| -> Vec<(f64, f64)> {
         (s.points.iter().copied())
             .filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite())
             .collect()
     };
     let all: Vec<(f64, f64)> = series.iter().flat_map(positive).collect();
-    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    if all.is_empty() {
-        // Nothing a log axis can show (every error 0, or no finished run): say so.
-        let note = format!("{title}: no positive values to draw");
-        root.draw_text(&note, &("sans-serif", 20).into_text_style(&root), (20, 20))
+    figure(path, (900, 560), title, |area| {
+        if all.is_empty() {
+            // Nothing a log axis can show (every error 0, or no finished run): say so.
+            let style = ("sans-serif", 20).into_text_style(area);
+            return (area.draw_text("no positive values to draw", &style, (20, 20))).map_err(err);
+        }
+        let (x0, x1) =
+            (all.iter()).fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+        let (y0, y1) =
+            (all.iter()).fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+        // Half a decade around the data, more above for the legend.
+        let (x0, x1) = (x0 / 1.5, x1 * 1.5);
+        let (y0, y1) = (y0 / 2.0, y1 * 2.0 * 10f64.powf(0.25 * series.len() as f64));
+        let mut chart = ChartBuilder::on(area)
+            .margin(12)
+            .margin_right(48)
+            .x_label_area_size(45)
+            .y_label_area_size(90)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(err)?;
-        return root.present().map_err(err);
-    }
-    let (x0, x1) = (all.iter()).fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
-    let (y0, y1) = (all.iter()).fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
-    // Half a decade around the data, more above for the legend.
-    let (x0, x1) = (x0 / 1.5, x1 * 1.5);
-    let (y0, y1) = (y0 / 2.0, y1 * 2.0 * 10f64.powf(0.25 * series.len() as f64));
-    let area = root.titled(title, ("sans-serif", 22)).map_err(err)?;
-    let mut chart = ChartBuilder::on(&area)
-        .margin(12)
-        .margin_right(48)
-        .x_label_area_size(45)
-        .y_label_area_size(90)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
-        .y_desc(y_label)
-        .x_label_formatter(&|v| format!("{v:.1e}"))
-        .y_label_formatter(&|v| format!("{v:.1e}"))
-        .draw()
-        .map_err(err)?;
-    for (i, s) in series.iter().enumerate() {
-        let mut pts = positive(s);
-        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let style = Palette99::pick(i).to_rgba().stroke_width(2);
         chart
-            .draw_series(LineSeries::new(pts.clone(), style))
-            .map_err(err)?
-            .label(s.label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
-        chart
-            .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, style.filled())))
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .x_label_formatter(&|v| format!("{v:.1e}"))
+            .y_label_formatter(&|v| format!("{v:.1e}"))
+            .draw()
             .map_err(err)?;
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
-    root.present().map_err(err)
+        for (i, s) in series.iter().enumerate() {
+            let mut pts = positive(s);
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let style = Palette99::pick(i).to_rgba().stroke_width(2);
+            chart
+                .draw_series(LineSeries::new(pts.clone(), style))
+                .map_err(err)?
+                .label(s.label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+            chart
+                .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, style.filled())))
+                .map_err(err)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .draw()
+            .map_err(err)
+    })
 }
 
 fn err(e: impl std::fmt::Display) -> String {

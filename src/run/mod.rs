@@ -11,7 +11,7 @@ use crate::crack::Cracks;
 use crate::dim::{D2, D3, Dim};
 use crate::error::{Unstable, UsageError};
 use crate::fracture::TipResult;
-use crate::measure::{Expect, History, Measure, Row};
+use crate::measure::{Expect, History, Measure, Row, balance_drift};
 use crate::output::plot::{self, Panel, Series};
 use crate::output::summary::Summary;
 use crate::scenario::build::MAX_STEPS;
@@ -675,17 +675,6 @@ fn plot_paths<D: Dim>(path: &Path, name: &str, cracks: &Cracks<D>) -> Result<(),
 /// uses, so a drift too small to see on the energies' scale still shows.
 fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
     let pick = |f: &dyn Fn(&Row) -> f64| h.rows.iter().map(|r| (r.time, f(r))).collect();
-    let total = |e: &Energies| e.kinetic + e.strain - e.external_work + e.damping_work;
-    let e0 = h.rows.first().map_or(0.0, |r| total(&r.energies));
-    let scale = (h.rows.iter())
-        .map(|r| {
-            let e = &r.energies;
-            (e.kinetic + e.strain)
-                .max(e.external_work.abs())
-                .max(e.damping_work)
-        })
-        .fold(0.0, f64::max);
-    let scale = if scale > 0.0 { scale } else { 1.0 };
     let energies = Panel {
         y_label: "energy (J)",
         series: vec![
@@ -711,7 +700,7 @@ fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
         y_label: "balance drift (relative)",
         series: vec![Series {
             label: "(K + W - W_ext + W_damp - E(0)) / largest energy or work",
-            points: pick(&|r| (total(&r.energies) - e0) / scale),
+            points: balance_drift(h).unwrap_or_default(),
         }],
     };
     plot::panels(
