@@ -1,7 +1,7 @@
 //! Fracture measurement results and the conversion of the energy release rate into stress
 //! intensity factors from the crack opening (Guo & Nairn 2D (2004) Eqs. 10, 14-22).
 
-use crate::material::{Elastic, Plane};
+use crate::material::{Material, Plane};
 
 /// What to measure at crack tips, from the scenario's `[fracture]` table.
 #[derive(Clone, Debug)]
@@ -165,7 +165,7 @@ pub fn speed_factors(c: f64, cs: f64, cd: f64, kappa: f64) -> (f64, f64, f64, f6
 }
 
 /// kappa: 3 - 4 nu in plane strain (and 3D), (3 - nu)/(1 + nu) in plane stress.
-pub fn kappa(m: &Elastic, plane: Plane) -> f64 {
+pub fn kappa(m: &Material, plane: Plane) -> f64 {
     match plane {
         Plane::Stress => (3.0 - m.poisson) / (1.0 + m.poisson),
         Plane::Strain | Plane::None => 3.0 - 4.0 * m.poisson,
@@ -173,7 +173,7 @@ pub fn kappa(m: &Elastic, plane: Plane) -> f64 {
 }
 
 /// E' = E in plane stress, E / (1 - nu^2) in plane strain: G = (K_I^2 + K_II^2) / E'.
-pub fn e_prime(m: &Elastic, plane: Plane) -> f64 {
+pub fn e_prime(m: &Material, plane: Plane) -> f64 {
     match plane {
         Plane::Stress => m.youngs,
         Plane::Strain | Plane::None => m.youngs / (1.0 - m.poisson * m.poisson),
@@ -184,7 +184,7 @@ pub fn e_prime(m: &Elastic, plane: Plane) -> f64 {
 /// K_II^2) / E', Irwin 1957). The energy release rate `g` comes from the path-independent J
 /// and the mode mixity from the interaction integral, which is the more sensitive of the
 /// two to where the discrete crack's tip lies. NaN when `k` is NaN or zero.
-pub fn k_from_mixity(m: &Elastic, plane: Plane, g: f64, k: [f64; 2]) -> [f64; 2] {
+pub fn k_from_mixity(m: &Material, plane: Plane, g: f64, k: [f64; 2]) -> [f64; 2] {
     let norm = k[0].hypot(k[1]);
     if norm.is_nan() || norm == 0.0 {
         return [f64::NAN; 2];
@@ -196,7 +196,7 @@ pub fn k_from_mixity(m: &Elastic, plane: Plane, g: f64, k: [f64; 2]) -> [f64; 2]
 /// K_I and K_II from the energy release rate `g` and the opening `d_i` and sliding `d_ii`
 /// displacements behind a tip running at speed `c` (Guo & Nairn 2D (2004) Eqs. 14-15; at
 /// c = 0 these reduce to Eqs. 21-22). NaN when the crack is closed (no opening to split by).
-pub fn k_from_g(m: &Elastic, plane: Plane, g: f64, d_i: f64, d_ii: f64, c: f64) -> [f64; 2] {
+pub fn k_from_g(m: &Material, plane: Plane, g: f64, d_i: f64, d_ii: f64, c: f64) -> [f64; 2] {
     let kap = kappa(m, plane);
     let cs = (m.mu / m.density).sqrt();
     let cd = cs * ((kap + 1.0) / (kap - 1.0)).sqrt();
@@ -219,7 +219,7 @@ mod tests {
     /// At c = 0, Eqs. 14-15 are K = (delta/|delta|) sqrt(G E') (Eqs. 21-22).
     #[test]
     fn stationary_limit_is_sqrt_g_e() {
-        let m = Elastic::new("m", 2.3e9, 0.33, 1500.0);
+        let m = Material::new("m", 2.3e9, 0.33, 1500.0);
         let g = 10.0;
         for (plane, e) in [
             (Plane::Stress, 2.3e9),

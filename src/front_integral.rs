@@ -193,6 +193,9 @@ struct Fields {
     /// Volume (m^3) and mass (kg).
     vol: f64,
     mass: f64,
+    /// Stress-work density of a plastic particle, elastic energy plus plastic work
+    /// (J/m^3); None for an elastic one, whose density is sigma : grad u / 2.
+    work: Option<f64>,
 }
 
 fn mv(m: &M3, v: [f64; 3]) -> [f64; 3] {
@@ -226,7 +229,8 @@ impl Sample {
                 f.vol * p(g1, s1, g2, s2, w, de1, e3) + inertia,
             ]
         };
-        let w = 0.5 * contract(&f.s, &f.gu) + 0.5 * f.mass / f.vol * dot(f.v, f.v);
+        let stored = f.work.unwrap_or_else(|| 0.5 * contract(&f.s, &f.gu));
+        let w = stored + 0.5 * f.mass / f.vol * dot(f.v, f.v);
         let col1 = |g: &M3| [g[0][0], g[1][0], g[2][0]];
         let mut c = [[0.0; 3]; 4];
         c[0] = coeffs(
@@ -474,6 +478,9 @@ fn gather(
             a: to_local(&at.e, accel(world, cracks, i)),
             vol: p.volume[i],
             mass: p.mass[i],
+            work: (!p.hardened.is_empty()).then(|| {
+                world.materials[p.material[i] as usize].energy_density(&st) + p.plastic_work(i)
+            }),
         };
         out.push(Sample::new(&at, &fields, &elastic(p.material[i])));
     }
@@ -575,6 +582,7 @@ mod tests {
                         a: [0.0; 3],
                         vol: h * h * h,
                         mass: 0.0,
+                        work: None,
                     };
                     out.push(Sample::new(&place, &fields, &el));
                 }

@@ -21,7 +21,7 @@ use crate::crack::Cracks;
 use crate::dim::{D2, Dim};
 use crate::fracture::{e_prime, kappa};
 use crate::geometry::point_segment;
-use crate::material::Elastic;
+use crate::material::Material;
 use crate::near_tip;
 use crate::shape::Stencil;
 use crate::sym::SymTensor;
@@ -114,7 +114,7 @@ pub fn interaction_k(
     radius: f64,
     step: f64,
     min_radius: f64,
-    mat: &Elastic,
+    mat: &Material,
 ) -> InteractionK {
     let plane = world.settings.plane;
     let kap = kappa(mat, plane);

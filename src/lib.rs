@@ -23,6 +23,7 @@ pub mod measure;
 pub mod near_tip;
 pub mod output;
 pub mod particles;
+pub mod plastic;
 pub mod run;
 pub mod scenario;
 pub mod schedule;

@@ -1,5 +1,7 @@
-//! Constitutive models: small-strain isotropic linear elasticity.
+//! Constitutive models: small-strain isotropic linear elasticity, and J2 plasticity
+//! ([`crate::plastic`]) on top of it for the materials that ask for it.
 
+use crate::plastic::{Hardened, Hardening, J2};
 use crate::sym::Sym3;
 use serde::Serialize;
 
@@ -14,9 +16,10 @@ pub enum Plane {
     Stress,
 }
 
-/// Isotropic linear elastic material (SI: Pa, kg/m^3).
+/// An isotropic material (SI: Pa, kg/m^3): linear elastic, and von Mises plastic when `j2`
+/// is set.
 #[derive(Clone, Debug, Serialize)]
-pub struct Elastic {
+pub struct Material {
     /// Name from the scenario.
     pub name: String,
     /// Young's modulus (Pa).
@@ -29,20 +32,43 @@ pub struct Elastic {
     pub lambda: f64,
     /// Shear modulus (Pa).
     pub mu: f64,
+    /// J2 plasticity; None for a linear elastic material.
+    pub j2: Option<J2>,
 }
 
-impl Elastic {
+impl Material {
     /// Builds the material; the caller has checked E > 0, rho > 0, -1 < nu < 0.5.
     pub fn new(name: &str, youngs: f64, poisson: f64, density: f64) -> Self {
         let mu = youngs / (2.0 * (1.0 + poisson));
         let lambda = youngs * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
-        Elastic {
+        Material {
             name: name.to_string(),
             youngs,
             poisson,
             density,
             lambda,
             mu,
+            j2: None,
+        }
+    }
+
+    /// The material made von Mises plastic with initial yield stress `yield_stress` (Pa).
+    pub fn with_j2(mut self, yield_stress: f64, hardening: Hardening) -> Self {
+        self.j2 = Some(J2 {
+            yield_stress,
+            hardening,
+            youngs: self.youngs,
+            mu: self.mu,
+        });
+        self
+    }
+
+    /// The same material with new elastic constants (a plastic one keeps its yield law).
+    pub fn with_elastic(&self, youngs: f64, poisson: f64, density: f64) -> Self {
+        let m = Material::new(&self.name, youngs, poisson, density);
+        match self.j2 {
+            Some(j) => m.with_j2(j.yield_stress, j.hardening),
+            None => m,
         }
     }
 
@@ -61,8 +87,20 @@ impl Elastic {
     #[inline(always)]
     pub fn update(&self, plane: Plane, mut de: Sym3, stress: &mut Sym3) {
         if plane == Plane::Stress {
-            de.zz = -self.lambda / (self.lambda + 2.0 * self.mu) * (de.xx + de.yy);
+            de.zz = self.plane_stress_zz(&de);
         }
+        self.add_elastic(&de, stress);
+    }
+
+    /// The zz strain that keeps an elastic increment at sigma_zz = 0.
+    #[inline(always)]
+    fn plane_stress_zz(&self, de: &Sym3) -> f64 {
+        -self.lambda / (self.lambda + 2.0 * self.mu) * (de.xx + de.yy)
+    }
+
+    /// Adds the elastic stress increment C : `de` to `stress`.
+    #[inline(always)]
+    fn add_elastic(&self, de: &Sym3, stress: &mut Sym3) {
         let lt = self.lambda * de.trace();
         let m2 = 2.0 * self.mu;
         stress.xx += lt + m2 * de.xx;
@@ -73,8 +111,65 @@ impl Elastic {
         stress.xy += m2 * de.xy;
     }
 
-    /// Strain from stress through the 3D compliance, eps = ((1 + nu) sigma - nu tr(sigma) I)/E.
-    /// Linear elasticity starting unstressed keeps sigma = C : eps, so strain is not stored.
+    /// The stress update of a plastic material (`j2` set) by the strain increment `de`, with
+    /// the particle's plastic strain and hardening state: an elastic predictor and a radial
+    /// return. In plane stress the zz strain is found by the secant method so that the
+    /// returned sigma_zz vanishes (it is monotone in that strain).
+    pub fn update_plastic(
+        &self,
+        plane: Plane,
+        mut de: Sym3,
+        stress: &mut Sym3,
+        plastic: &mut Sym3,
+        h: &mut Hardened,
+    ) {
+        let Some(j2) = &self.j2 else {
+            return self.update(plane, de, stress);
+        };
+        let trial = |de: &Sym3| {
+            let (mut s, mut p, mut hh) = (*stress, *plastic, *h);
+            self.add_elastic(de, &mut s);
+            j2.radial_return(&mut s, &mut p, &mut hh);
+            (s, p, hh)
+        };
+        if plane != Plane::Stress {
+            (*stress, *plastic, *h) = trial(&de);
+            return;
+        }
+        de.zz = self.plane_stress_zz(&de);
+        let mut now = trial(&de);
+        let tol = 1e-12 * j2.flow_stress(&now.2);
+        if now.0.zz.abs() > tol {
+            // The first correction follows the continuum elastic-plastic tangent's zz entry,
+            // (lambda + 2 mu) - 6 mu^2/(3 mu + H) N_zz^2 with N = sqrt(3/2) S / sigma_y
+            // (Mashayekhi et al. 2011, Eq. 60); the secant method takes it from there.
+            let (mut z0, mut f0) = (de.zz, now.0.zz);
+            let y = j2.flow_stress(&now.2);
+            let n_zz = now.0.deviator().zz / y;
+            let slope = self.lambda + 2.0 * self.mu
+                - 6.0 * self.mu * self.mu / (3.0 * self.mu + j2.hardening_slope(y))
+                    * 1.5
+                    * n_zz
+                    * n_zz;
+            de.zz -= f0 / slope;
+            now = trial(&de);
+            for _ in 0..60 {
+                let f1 = now.0.zz;
+                if f1.abs() <= tol || f1 == f0 {
+                    break;
+                }
+                let z1 = de.zz;
+                de.zz = z1 - f1 * (z1 - z0) / (f1 - f0);
+                (z0, f0) = (z1, f1);
+                now = trial(&de);
+            }
+        }
+        (*stress, *plastic, *h) = now;
+    }
+
+    /// Elastic strain from stress through the 3D compliance, eps = ((1 + nu) sigma - nu
+    /// tr(sigma) I)/E. Linear elasticity starting unstressed keeps sigma = C : eps, so strain
+    /// is not stored; a plastic particle adds its plastic strain column.
     #[inline(always)]
     pub fn strain(&self, s: &Sym3) -> Sym3 {
         let (e, nu) = (self.youngs, self.poisson);
@@ -89,7 +184,7 @@ impl Elastic {
         }
     }
 
-    /// Strain energy density W = sigma : eps / 2 (J/m^3).
+    /// Elastic strain energy density W = sigma : eps_e / 2 (J/m^3).
     #[inline(always)]
     pub fn energy_density(&self, stress: &Sym3) -> f64 {
         0.5 * stress.ddot(&self.strain(stress))
@@ -103,7 +198,7 @@ mod tests {
     /// Uniaxial stress in plane stress gives sigma_xx = E eps_xx and sigma_zz = 0.
     #[test]
     fn plane_stress_uniaxial_recovers_youngs_modulus() {
-        let m = Elastic::new("m", 100e9, 0.3, 1000.0);
+        let m = Material::new("m", 100e9, 0.3, 1000.0);
         let mut s = Sym3::default();
         let nu_eff = m.poisson; // lateral contraction of a free plate: eps_yy = -nu eps_xx
         let de = Sym3 {

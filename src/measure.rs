@@ -3,7 +3,7 @@
 use crate::dim::Dim;
 use crate::fracture::{PathResult, TipResult};
 use crate::growth::GrowthRow;
-use crate::material::Elastic;
+use crate::material::Material;
 use crate::particles::Particles;
 use crate::sym::SymTensor;
 use crate::world::Energies;
@@ -42,7 +42,7 @@ pub struct Probe {
 
 impl Probe {
     /// Current average.
-    pub fn sample<D: Dim>(&self, p: &Particles<D>, materials: &[Elastic]) -> f64 {
+    pub fn sample<D: Dim>(&self, p: &Particles<D>, materials: &[Material]) -> f64 {
         let mut sum = 0.0;
         for &i in &self.particles {
             let i = i as usize;
@@ -51,9 +51,14 @@ impl Probe {
                 ProbeQty::Velocity => p.v[i][self.comp],
                 ProbeQty::Position => p.x[i][self.comp],
                 ProbeQty::Stress => p.stress[i].to_sym3().to_array()[self.comp],
-                ProbeQty::Strain => materials[p.material[i] as usize]
-                    .strain(&p.stress[i].to_sym3())
-                    .to_array()[self.comp],
+                ProbeQty::Strain => {
+                    let elastic = materials[p.material[i] as usize].strain(&p.stress[i].to_sym3());
+                    let strain = match p.plastic_strain.get(i) {
+                        Some(ep) => elastic + ep.to_sym3(),
+                        None => elastic,
+                    };
+                    strain.to_array()[self.comp]
+                }
             };
         }
         sum / self.particles.len() as f64
@@ -157,6 +162,16 @@ pub enum Measure {
     /// probe's arrival is when its change first reaches half its plateau (the mean change
     /// over the last tenth of the run), which is insensitive to the overshoot at a front.
     WaveSpeed(usize, usize),
+    /// The change of one probe over the change of another, from time `from` to the end
+    /// (e.g. an unloading modulus: the change of stress over that of strain).
+    Slope {
+        /// The probe in the numerator.
+        rise: usize,
+        /// The probe in the denominator.
+        run: usize,
+        /// Start of the window (s).
+        from: f64,
+    },
     /// Largest |P(t) - P(0)| over the largest sum |m v| (relative).
     MomentumDrift,
     /// The energy balance: [`energy_balance`].
@@ -446,6 +461,11 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             let d = (0..3).map(|k| (cb[k] - ca[k]).powi(2)).sum::<f64>().sqrt();
             finite(d / (tb - ta))
         }
+        Measure::Slope { rise, run, from } => {
+            let k = h.time.iter().position(|&t| t >= from)?;
+            let change = |p: usize| Some(h.probes[p].last()? - h.probes[p][k]);
+            finite(change(rise)? / change(run)?)
+        }
         Measure::MomentumDrift => {
             let first = h.rows.first()?;
             let scale = h.rows.iter().map(|r| r.momentum_scale).fold(0.0, f64::max);
@@ -471,8 +491,8 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
     }
 }
 
-/// How far the energy balance E = K + W - W_ext + W_damp strays from its start: the
-/// largest |E(t) - E(0)| over the largest of K + W, |W_ext| and W_damp in the run.
+/// How far the energy balance E = K + W + W_p - W_ext + W_damp strays from its start: the
+/// largest |E(t) - E(0)| over the largest of K + W + W_p, |W_ext| and W_damp in the run.
 pub fn energy_balance(h: &History) -> Option<f64> {
     let drift = balance_drift(h)?;
     // NaN (a run with no energy at all) stays NaN, as a failed measurement.
@@ -488,19 +508,18 @@ pub fn energy_balance(h: &History) -> Option<f64> {
 /// The energy balance's drift over time: (t, (E(t) - E(0)) / scale), with the scale of
 /// [`energy_balance`]; None without rows.
 pub fn balance_drift(h: &History) -> Option<Vec<(f64, f64)>> {
-    let total = |e: &Energies| e.kinetic + e.strain - e.external_work + e.damping_work;
-    let e0 = total(&h.rows.first()?.energies);
+    let e0 = h.rows.first()?.energies.balance();
     let scale = (h.rows.iter())
         .map(|r| {
             let e = &r.energies;
-            (e.kinetic + e.strain)
+            (e.internal())
                 .max(e.external_work.abs())
                 .max(e.damping_work)
         })
         .fold(0.0, f64::max);
     Some(
         (h.rows.iter())
-            .map(|r| (r.time, (total(&r.energies) - e0) / scale))
+            .map(|r| (r.time, (r.energies.balance() - e0) / scale))
             .collect(),
     )
 }

@@ -1,6 +1,7 @@
 //! Particle component store: one column per component (struct of arrays).
 
 use crate::dim::Dim;
+use crate::plastic::Hardened;
 
 /// Material points. Columns a scene does not need stay empty (e.g. `half` unless uGIMP).
 #[derive(Clone, Debug)]
@@ -28,6 +29,11 @@ pub struct Particles<D: Dim> {
     /// Displacement gradient du_i/dx_j, accumulated from grad v; only allocated when
     /// J-integrals are measured (Guo & Nairn 2D (2004) section 3 tracks it on particles).
     pub grad_u: Vec<D::Mat>,
+    /// Plastic strain; only allocated when a material is plastic.
+    pub plastic_strain: Vec<D::Sym>,
+    /// Hardening state (equivalent plastic strain, yield stress, plastic work); only
+    /// allocated when a material is plastic.
+    pub hardened: Vec<Hardened>,
 }
 
 impl<D: Dim> Default for Particles<D> {
@@ -43,6 +49,8 @@ impl<D: Dim> Default for Particles<D> {
             material: Vec::new(),
             half: Vec::new(),
             grad_u: Vec::new(),
+            plastic_strain: Vec::new(),
+            hardened: Vec::new(),
         }
     }
 }
@@ -79,6 +87,23 @@ impl<D: Dim> Particles<D> {
         let mat = std::mem::size_of::<D::Mat>();
         base + if self.half.is_empty() { 0 } else { vec }
             + if self.grad_u.is_empty() { 0 } else { 2 * mat }
+            + if self.hardened.is_empty() {
+                0
+            } else {
+                std::mem::size_of::<D::Sym>() + std::mem::size_of::<Hardened>()
+            }
+    }
+
+    /// Allocates the plastic columns (zero plastic strain, no hardening yet).
+    pub fn make_plastic(&mut self) {
+        self.plastic_strain = vec![D::Sym::default(); self.len()];
+        self.hardened = vec![Hardened::default(); self.len()];
+    }
+
+    /// Plastic work per unit volume of particle `p` (J/m^3; zero when no material is plastic).
+    #[inline(always)]
+    pub fn plastic_work(&self, p: usize) -> f64 {
+        self.hardened.get(p).map_or(0.0, |h| h.work)
     }
 
     /// Reorders every column so that new particle `k` is old particle `order[k]`.
@@ -98,6 +123,8 @@ impl<D: Dim> Particles<D> {
         apply(&mut self.material, order);
         apply(&mut self.half, order);
         apply(&mut self.grad_u, order);
+        apply(&mut self.plastic_strain, order);
+        apply(&mut self.hardened, order);
     }
 
     /// Displacement of particle `p` from its initial position (m).

@@ -105,6 +105,29 @@ impl Sym3 {
             + 2.0 * (self.yz * b.yz + self.xz * b.xz + self.xy * b.xy)
     }
 
+    /// The isotropic tensor I.
+    #[inline(always)]
+    pub fn identity() -> Sym3 {
+        Sym3 {
+            xx: 1.0,
+            yy: 1.0,
+            zz: 1.0,
+            ..Sym3::default()
+        }
+    }
+
+    /// The deviatoric part `a - tr(a)/3 I`.
+    #[inline(always)]
+    pub fn deviator(&self) -> Sym3 {
+        let p = self.trace() / 3.0;
+        Sym3 {
+            xx: self.xx - p,
+            yy: self.yy - p,
+            zz: self.zz - p,
+            ..*self
+        }
+    }
+
     /// Components in the order xx, yy, zz, yz, xz, xy.
     pub fn to_array(&self) -> [f64; 6] {
         [self.xx, self.yy, self.zz, self.yz, self.xz, self.xy]

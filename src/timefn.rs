@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 /// A dimensionless multiplier f(t) applied to a load or a prescribed velocity.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
 pub enum TimeFn {
     /// f = 1 at all times.
@@ -31,6 +31,13 @@ pub enum TimeFn {
         /// Duration (s), > 0.
         width: f64,
     },
+    /// Piecewise linear through `points` = [[t, f], ...] (s, -), times increasing; f is
+    /// held at the first value before the first time and at the last after the last.
+    /// Loading and unloading cycles are tables.
+    Table {
+        /// The (time, value) corners.
+        points: Vec<[f64; 2]>,
+    },
 }
 
 impl TimeFn {
@@ -41,6 +48,15 @@ impl TimeFn {
             TimeFn::Step { start } => (t >= start) as u8 as f64,
             TimeFn::Ramp { start, rise } => ((t - start) / rise).clamp(0.0, 1.0),
             TimeFn::Pulse { start, width } => (t >= start && t < start + width) as u8 as f64,
+            TimeFn::Table { ref points } => {
+                let k = points.partition_point(|p| p[0] <= t);
+                match (k.checked_sub(1).map(|j| points[j]), points.get(k)) {
+                    (Some(a), Some(b)) => a[1] + (b[1] - a[1]) * (t - a[0]) / (b[0] - a[0]),
+                    (Some(a), None) => a[1],
+                    (None, Some(b)) => b[1],
+                    (None, None) => 0.0,
+                }
+            }
         }
     }
 
@@ -53,7 +69,45 @@ impl TimeFn {
             TimeFn::Pulse { width, .. } if !width.is_finite() || width <= 0.0 => {
                 Some("pulse width must be > 0 s")
             }
+            TimeFn::Table { ref points } if points.is_empty() => {
+                Some("a table needs at least one [time, value] point")
+            }
+            TimeFn::Table { ref points }
+                if points.iter().flatten().any(|v| !v.is_finite())
+                    || points.windows(2).any(|w| w[1][0] <= w[0][0]) =>
+            {
+                Some("table points must be finite with strictly increasing times")
+            }
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TimeFn;
+
+    /// A table interpolates linearly between its corners and holds its end values.
+    #[test]
+    fn table_interpolates_and_holds() {
+        let f = TimeFn::Table {
+            points: vec![[1.0, 0.0], [3.0, 2.0], [4.0, -1.0]],
+        };
+        assert_eq!(f.check(), None);
+        for (t, v) in [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (2.0, 1.0),
+            (3.0, 2.0),
+            (3.5, 0.5),
+            (9.0, -1.0),
+        ] {
+            assert!((f.at(t) - v).abs() < 1e-15, "f({t}) = {} not {v}", f.at(t));
+        }
+        let back = TimeFn::Table {
+            points: vec![[1.0, 0.0], [1.0, 2.0]],
+        };
+        assert!(back.check().is_some());
+        assert!(TimeFn::Table { points: vec![] }.check().is_some());
     }
 }

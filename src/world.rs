@@ -4,7 +4,7 @@ use crate::crack::Cracks;
 use crate::dim::Dim;
 use crate::grid::Grid;
 use crate::loads::{Load, VelocityBc};
-use crate::material::{Elastic, Plane};
+use crate::material::{Material, Plane};
 use crate::particles::Particles;
 use crate::shape::{ShapeKind, StencilCache};
 use crate::sym::SymTensor;
@@ -64,12 +64,26 @@ pub struct Work {
 pub struct Energies {
     /// Kinetic energy.
     pub kinetic: f64,
-    /// Elastic strain energy.
+    /// Material strain energy.
     pub strain: f64,
     /// External work done on the body.
     pub external_work: f64,
     /// Energy removed by damping.
     pub damping_work: f64,
+    /// Energy dissipated by plastic flow (zero in an elastic scene).
+    pub plastic_work: f64,
+}
+
+impl Energies {
+    /// The stored and dissipated energy, K + W + W_p.
+    pub fn internal(&self) -> f64 {
+        self.kinetic + self.strain + self.plastic_work
+    }
+
+    /// The balance E = K + W + W_p - W_ext + W_damp, constant when energy is conserved.
+    pub fn balance(&self) -> f64 {
+        self.internal() - self.external_work + self.damping_work
+    }
 }
 
 /// All simulation state.
@@ -82,7 +96,7 @@ pub struct World<D: Dim> {
     /// Particle bins.
     pub tiles: Tiles,
     /// Material table, indexed by the particles' material column.
-    pub materials: Vec<Elastic>,
+    pub materials: Vec<Material>,
     /// Scene settings.
     pub settings: Settings<D>,
     /// External particle forces.
@@ -108,22 +122,24 @@ impl<D: Dim> World<D> {
     pub fn energies(&self) -> Energies {
         let p = &self.particles;
         let mats = &self.materials;
-        let parts: Vec<(f64, f64)> = (0..p.len().div_ceil(CHUNK))
+        let parts: Vec<[f64; 3]> = (0..p.len().div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
-                let (mut k, mut w) = (0.0, 0.0);
+                let (mut k, mut w, mut wp) = (0.0, 0.0, 0.0);
                 for i in c * CHUNK..((c + 1) * CHUNK).min(p.len()) {
                     k += 0.5 * p.mass[i] * D::dot(p.v[i], p.v[i]);
                     w += p.volume[i]
                         * mats[p.material[i] as usize].energy_density(&p.stress[i].to_sym3());
+                    wp += p.volume[i] * p.plastic_work(i);
                 }
-                (k, w)
+                [k, w, wp]
             })
             .collect();
-        let (kinetic, strain) = parts.iter().fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+        let sum = |k: usize| parts.iter().map(|p| p[k]).sum();
         Energies {
-            kinetic,
-            strain,
+            kinetic: sum(0),
+            strain: sum(1),
+            plastic_work: sum(2),
             external_work: self.work.external,
             damping_work: self.work.damping,
         }

@@ -335,7 +335,7 @@ fn contour_j(
             m * gu[1],
             m * gu[2],
             m * gu[3],
-            m * mat.energy_density(&st),
+            m * (mat.energy_density(&st) + p.plastic_work(i)),
             m * 0.5 * (m / p.volume[i]) * (v[0] * v[0] + v[1] * v[1]),
         ];
         let targets = fields.targets_of(i);

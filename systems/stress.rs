@@ -4,8 +4,8 @@
 
 use crate::dim::Dim;
 use crate::disjoint::Disjoint;
-use crate::material::{Elastic, Plane};
-use crate::particles::Particles;
+use crate::material::{Material, Plane};
+use crate::plastic::Hardened;
 use crate::shape::{Rows, Stencil};
 use crate::sym::SymTensor;
 use crate::with_shape;
@@ -24,18 +24,18 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let materials = &world.materials;
     let stencils = &world.tiles.stencils;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
-    let Particles {
-        grad_v,
-        grad_u,
-        stress,
-        material,
-        ..
-    } = &mut world.particles;
-    let material = &*material;
+    let p = &mut world.particles;
+    let (n, material) = (p.len(), &p.material);
+    let columns = StressColumns::<D>::new(
+        &mut p.stress,
+        &mut p.grad_v,
+        &mut p.grad_u,
+        &mut p.plastic_strain,
+        &mut p.hardened,
+    );
     let stride = &grid.geom.stride;
-    let body = |c: usize, s: &mut [D::Sym], mut grads: Grads<D>| {
-        with_shape!(shape, S, N => for k in 0..s.len() {
-            let i = c * CHUNK + k;
+    (0..n.div_ceil(CHUNK)).into_par_iter().for_each(|c| {
+        with_shape!(shape, S, N => for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
             // Particles near a crack are updated from their fields' entries afterwards.
             if fields.is_some_and(|f| f.is_coded(i)) {
                 continue;
@@ -43,30 +43,12 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
             let st = Stencil::<N>::cached::<D>(S, stencils, i);
             let l = velocity_gradient::<D, N>(&st, &st.rows::<D>(stride), &grid.velocity);
             let m = &materials[material[i] as usize];
-            let grads = grads.as_mut().map(|(gv, gu)| (&mut gv[k], &mut gu[k]));
-            apply::<D>(l, dt, plane, m, &mut s[k], grads);
+            // SAFETY: the chunks partition the particles and each chunk is one task.
+            unsafe { columns.update(i, l, dt, plane, m) };
         })
-    };
-    if grad_u.is_empty() {
-        stress
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(c, s)| body(c, s, None));
-    } else {
-        (
-            stress.par_chunks_mut(CHUNK),
-            grad_v.par_chunks_mut(CHUNK),
-            grad_u.par_chunks_mut(CHUNK),
-        )
-            .into_par_iter()
-            .enumerate()
-            .for_each(|(c, (s, gv, gu))| body(c, s, Some((gv, gu))));
-    }
+    });
     update_coded(world, dt);
 }
-
-/// A chunk's grad v and grad u columns, when they are kept.
-type Grads<'a, D> = Option<(&'a mut [<D as Dim>::Mat], &'a mut [<D as Dim>::Mat])>;
 
 /// The update of the particles near a crack: grad v over each stencil node's entry for the
 /// particle's side (Guo & Nairn 3D (2006) Eq. 20), sequentially in particle order.
@@ -77,7 +59,14 @@ pub(crate) fn update_coded<D: Dim>(world: &mut World<D>, dt: f64) {
     let (shape, plane) = (world.settings.shape, world.settings.plane);
     let (grid, f) = (&world.grid, &c.scratch.fields);
     let p = &mut world.particles;
-    let keep = !p.grad_u.is_empty();
+    let material = &p.material;
+    let columns = StressColumns::<D>::new(
+        &mut p.stress,
+        &mut p.grad_v,
+        &mut p.grad_u,
+        &mut p.plastic_strain,
+        &mut p.hardened,
+    );
     for &i in &f.coded {
         let i = i as usize;
         let targets = f.targets_of(i).expect("coded particle");
@@ -88,58 +77,49 @@ pub(crate) fn update_coded<D: Dim>(world: &mut World<D>, dt: f64) {
                 l = l + D::outer(grid.velocity[n], g);
             });
         });
-        let m = &world.materials[p.material[i] as usize];
-        let grads = keep.then(|| (&mut p.grad_v[i], &mut p.grad_u[i]));
-        apply::<D>(l, dt, plane, m, &mut p.stress[i], grads);
+        let m = &world.materials[material[i] as usize];
+        // SAFETY: one thread runs this loop.
+        unsafe { columns.update(i, l, dt, plane, m) };
     }
-}
-
-/// One particle's update from its velocity gradient `l`: the stress over `dt`, and grad v
-/// and grad u when they are kept.
-#[inline(always)]
-fn apply<D: Dim>(
-    l: D::Mat,
-    dt: f64,
-    plane: Plane,
-    m: &Elastic,
-    s: &mut D::Sym,
-    grads: Option<(&mut D::Mat, &mut D::Mat)>,
-) {
-    if let Some((gv, gu)) = grads {
-        *gv = l;
-        *gu = *gu + l * dt;
-    }
-    let mut sigma = s.to_sym3();
-    m.update(plane, D::sym_part(&l) * dt, &mut sigma);
-    *s = D::Sym::from_sym3(sigma);
 }
 
 /// The particle columns a stress update writes, borrowed for writes from the threads of a
-/// fused pass: the stress, and grad v and grad u when J-integrals keep them.
+/// parallel pass: the stress; grad v and grad u when J-integrals keep them; the plastic
+/// strain and hardening state when a material is plastic.
 pub(crate) struct StressColumns<'a, D: Dim> {
     stress: Disjoint<'a, D::Sym>,
     grad_v: Disjoint<'a, D::Mat>,
     grad_u: Disjoint<'a, D::Mat>,
+    plastic_strain: Disjoint<'a, D::Sym>,
+    hardened: Disjoint<'a, Hardened>,
     keep: bool,
+    plastic: bool,
 }
 
 impl<'a, D: Dim> StressColumns<'a, D> {
-    /// Borrows the columns (grad v and grad u are empty unless J-integrals keep them).
+    /// Borrows the columns (grad v and grad u are empty unless J-integrals keep them, the
+    /// plastic ones unless a material is plastic).
     pub(crate) fn new(
         stress: &'a mut [D::Sym],
         grad_v: &'a mut [D::Mat],
         grad_u: &'a mut [D::Mat],
+        plastic_strain: &'a mut [D::Sym],
+        hardened: &'a mut [Hardened],
     ) -> Self {
         StressColumns {
             keep: !grad_u.is_empty(),
+            plastic: !hardened.is_empty(),
             stress: Disjoint::new(stress),
             grad_v: Disjoint::new(grad_v),
             grad_u: Disjoint::new(grad_u),
+            plastic_strain: Disjoint::new(plastic_strain),
+            hardened: Disjoint::new(hardened),
         }
     }
 
-    /// Particle `i`'s update from its velocity gradient `l` (as [`apply`]); returns its new
-    /// stress.
+    /// Particle `i`'s update from its velocity gradient `l` over `dt`: grad v and grad u
+    /// when they are kept, then the stress (with the return map for a plastic material).
+    /// Returns the new stress.
     ///
     /// # Safety
     /// No other thread may access particle `i`'s entries during the call.
@@ -150,19 +130,26 @@ impl<'a, D: Dim> StressColumns<'a, D> {
         l: D::Mat,
         dt: f64,
         plane: Plane,
-        m: &Elastic,
+        m: &Material,
     ) -> D::Sym {
         // SAFETY: the caller's guarantee, passed on.
         unsafe {
-            let mut s = self.stress.get(i);
             if self.keep {
-                let (mut gv, mut gu) = (self.grad_v.get(i), self.grad_u.get(i));
-                apply::<D>(l, dt, plane, m, &mut s, Some((&mut gv, &mut gu)));
-                self.grad_v.set(i, gv);
-                self.grad_u.set(i, gu);
-            } else {
-                apply::<D>(l, dt, plane, m, &mut s, None);
+                self.grad_v.set(i, l);
+                self.grad_u.set(i, self.grad_u.get(i) + l * dt);
             }
+            let mut sigma = self.stress.get(i).to_sym3();
+            let de = D::sym_part(&l) * dt;
+            if self.plastic && m.j2.is_some() {
+                let mut ep = self.plastic_strain.get(i).to_sym3();
+                let mut h = self.hardened.get(i);
+                m.update_plastic(plane, de, &mut sigma, &mut ep, &mut h);
+                self.plastic_strain.set(i, D::Sym::from_sym3(ep));
+                self.hardened.set(i, h);
+            } else {
+                m.update(plane, de, &mut sigma);
+            }
+            let s = D::Sym::from_sym3(sigma);
             self.stress.set(i, s);
             s
         }

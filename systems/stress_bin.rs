@@ -6,7 +6,7 @@
 use crate::crack::Fields;
 use crate::dim::Dim;
 use crate::error::Unstable;
-use crate::material::{Elastic, Plane};
+use crate::material::{Material, Plane};
 use crate::particles::Particles;
 use crate::shape::{ShapeKind, Stencil};
 use crate::systems::bin::{BeforeBin, outside, place};
@@ -30,6 +30,8 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) -> Result<(), Unstable> 
         grad_v,
         grad_u,
         material,
+        plastic_strain,
+        hardened,
         ..
     } = &mut world.particles;
     let work = ClosingStress::<D> {
@@ -41,7 +43,7 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) -> Result<(), Unstable> 
         material,
         materials: &world.materials,
         fields: world.cracks.as_ref().map(|c| &c.scratch.fields),
-        columns: StressColumns::new(stress, grad_v, grad_u),
+        columns: StressColumns::new(stress, grad_v, grad_u, plastic_strain, hardened),
     };
     let shape = world.settings.shape;
     match place(x, half, &grid.geom, shape, &mut world.tiles, &work) {
@@ -61,7 +63,7 @@ struct ClosingStress<'a, D: Dim> {
     stride: [usize; 3],
     inv_h: [f64; 3],
     material: &'a [u16],
-    materials: &'a [Elastic],
+    materials: &'a [Material],
     fields: Option<&'a Fields>,
     columns: StressColumns<'a, D>,
 }

@@ -34,9 +34,11 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
         grad_u,
         volume,
         material,
+        plastic_strain,
+        hardened,
         ..
     } = &mut world.particles;
-    let columns = StressColumns::<D>::new(stress, grad_v, grad_u);
+    let columns = StressColumns::<D>::new(stress, grad_v, grad_u, plastic_strain, hardened);
     let (tiles, materials) = (&world.tiles, &world.materials);
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     tiles.for_each_coloured(|t| {

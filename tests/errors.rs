@@ -754,3 +754,79 @@ fn bad_growth_tables_name_the_key() {
     );
     assert_error(&e, "crack[0].growth", None, "2D for now");
 }
+
+/// GOOD with `keys` added to its material (from line 15 on).
+fn plastic_steel(keys: &str) -> String {
+    GOOD.replace("rho = 7800.0\n", &format!("rho = 7800.0\n{keys}"))
+}
+
+#[test]
+fn bad_plasticity_parameters_name_the_key() {
+    let j2 = "model = \"j2\"\n";
+    let cases: [(String, &str, usize, &str); 7] = [
+        (j2.into(), "material[0].model", 15, "sigma_y"),
+        (
+            format!("{j2}sigma_y = -1.0\n"),
+            "material[0].sigma_y",
+            16,
+            "positive",
+        ),
+        (
+            format!("{j2}sigma_y = 30e9\n"),
+            "material[0].sigma_y",
+            16,
+            "yield strain",
+        ),
+        (
+            format!("{j2}sigma_y = 250e6\nH = -1e9\n"),
+            "material[0].H",
+            17,
+            "zero or positive",
+        ),
+        (
+            format!("{j2}sigma_y = 250e6\nn = 1.0\n"),
+            "material[0].n",
+            17,
+            "1 < n",
+        ),
+        (
+            format!("{j2}sigma_y = 250e6\nn = 10\nH = 1e9\n"),
+            "material[0].n",
+            17,
+            "not both",
+        ),
+        (
+            "sigma_y = 250e6\n".into(),
+            "material[0].sigma_y",
+            15,
+            "model = \"j2\"",
+        ),
+    ];
+    for (keys, key, line, words) in cases {
+        assert_error(&refused(&plastic_steel(&keys)), key, Some(line), words);
+    }
+    let e = Source::parse("bad.toml", &plastic_steel("model = \"tresca\"\n"), &[]).unwrap_err();
+    assert_eq!(e.line, Some(15), "{e}");
+    assert!(
+        e.to_string().contains("tresca") && e.to_string().contains("j2"),
+        "{e}"
+    );
+}
+
+#[test]
+fn bad_time_tables_name_the_key() {
+    let load = |points: &str| {
+        format!(
+            "[[load]]\nregion = {{ min = [0.004, 0.004], max = [0.006, 0.016] }}\n\
+             force = [1.0, 0.0]\ntime = {{ kind = \"table\", points = {points} }}\n"
+        )
+    };
+    for (points, words) in [
+        ("[]", "at least one"),
+        ("[[0.0, 0.0], [0.0, 1.0]]", "strictly increasing"),
+        ("[[1e-5, 0.0], [0.5e-5, 1.0]]", "strictly increasing"),
+    ] {
+        let e = refused(&format!("{GOOD}{}", load(points)));
+        assert_error(&e, "load[0].time", Some(21), words);
+    }
+}

@@ -141,6 +141,15 @@ fn restart_is_bit_exact_2d_one_and_two_threads() {
     restart_is_bit_exact(&text, 33, 2, "2d-2");
 }
 
+/// A plastic scene resumes bit for bit: the plastic strain and hardening columns are in the
+/// snapshot (energy.csv's plastic work and the final snapshot are compared).
+#[test]
+fn restart_is_bit_exact_with_plastic_state() {
+    let text = common::plastic(&scene(2, "ugimp", "usavg"), 2e7, "n = 5")
+        .replace("dimension = 2", "dimension = 2\nplane = \"stress\"");
+    restart_is_bit_exact(&text, 33, 2, "plastic");
+}
+
 #[test]
 fn restart_is_bit_exact_with_a_crack() {
     let crack = "[[crack]]\nline = { start = [0.02, 0.0005], end = [0.02, 0.0135], spacing = 5e-4 }\ntips = []\n";

@@ -27,12 +27,22 @@ interval = 1e-6
 
 #[test]
 fn vtu_offsets_and_pvd_are_consistent() {
-    let dir = std::env::temp_dir().join(format!("fissure-vtk-{}", std::process::id()));
+    offsets_and_pvd_are_consistent(SCENE, "elastic");
+    // A plastic scene adds the equivalent plastic strain.
+    let plastic = SCENE.replace(
+        "rho = 1000.0",
+        "rho = 1000.0\nmodel = \"j2\"\nsigma_y = 1e7",
+    );
+    offsets_and_pvd_are_consistent(&plastic, "plastic");
+}
+
+fn offsets_and_pvd_are_consistent(scene: &str, name: &str) {
+    let dir = std::env::temp_dir().join(format!("fissure-vtk-{name}-{}", std::process::id()));
     let opts = RunOptions {
         out: Some(dir.clone()),
         ..RunOptions::default()
     };
-    let out = run(&source(SCENE), &opts).unwrap();
+    let out = run(&source(scene), &opts).unwrap();
     let n = out.summary.particles;
     // 6 x 6 x 4 mm at 2 mm cells and 2 particles per cell per axis.
     assert_eq!(n, 6 * 6 * 4);
@@ -57,6 +67,14 @@ fn vtu_offsets_and_pvd_are_consistent() {
     let doc = roxmltree::Document::parse(&xml).expect("vtu header is well-formed XML");
     let data = &bytes[at + marker.len()..];
     let mut expected_offset = 0;
+    let names: Vec<_> = (doc.descendants().filter(|e| e.has_tag_name("DataArray")))
+        .filter_map(|e| e.attribute("Name"))
+        .collect();
+    assert_eq!(
+        names.contains(&"plastic_strain"),
+        name == "plastic",
+        "{names:?}"
+    );
     for array in doc.descendants().filter(|e| e.has_tag_name("DataArray")) {
         let offset: usize = array.attribute("offset").unwrap().parse().unwrap();
         assert_eq!(offset, expected_offset, "arrays are packed back to back");

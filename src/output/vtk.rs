@@ -20,11 +20,12 @@ fn f64s(values: impl Iterator<Item = f64>) -> Vec<u8> {
 }
 
 /// Writes the particles as vertex cells to `path` with velocity, displacement, stress
-/// (ParaView's symmetric-tensor order xx, yy, zz, xy, yz, xz), mass and material.
+/// (ParaView's symmetric-tensor order xx, yy, zz, xy, yz, xz), mass and material, and in a
+/// plastic scene the equivalent plastic strain.
 pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result<()> {
     let n = p.len();
     let vec3 = |c: &[D::Vec]| f64s(c.iter().flat_map(|v| D::to_xyz(*v)));
-    let point_data = vec![
+    let mut point_data = vec![
         Array {
             attrs: r#"type="Float64" Name="velocity" NumberOfComponents="3""#.into(),
             bytes: vec3(&p.v),
@@ -55,6 +56,12 @@ pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result
                 .collect(),
         },
     ];
+    if !p.hardened.is_empty() {
+        point_data.push(Array {
+            attrs: r#"type="Float64" Name="plastic_strain" NumberOfComponents="1""#.into(),
+            bytes: f64s(p.hardened.iter().map(|h| h.equivalent)),
+        });
+    }
     let points = Array {
         attrs: r#"type="Float64" Name="Points" NumberOfComponents="3""#.into(),
         bytes: vec3(&p.x),

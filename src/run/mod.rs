@@ -675,7 +675,7 @@ fn plot_paths<D: Dim>(path: &Path, name: &str, cracks: &Cracks<D>) -> Result<(),
 /// uses, so a drift too small to see on the energies' scale still shows.
 fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
     let pick = |f: &dyn Fn(&Row) -> f64| h.rows.iter().map(|r| (r.time, f(r))).collect();
-    let energies = Panel {
+    let mut energies = Panel {
         y_label: "energy (J)",
         series: vec![
             Series {
@@ -696,10 +696,16 @@ fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
             },
         ],
     };
+    if h.rows.iter().any(|r| r.energies.plastic_work != 0.0) {
+        energies.series.push(Series {
+            label: "plastic work W_p",
+            points: pick(&|r| r.energies.plastic_work),
+        });
+    }
     let balance = Panel {
         y_label: "balance drift (relative)",
         series: vec![Series {
-            label: "(K + W - W_ext + W_damp - E(0)) / largest energy or work",
+            label: "(K + W + W_p - W_ext + W_damp - E(0)) / largest energy or work",
             points: balance_drift(h).unwrap_or_default(),
         }],
     };

@@ -86,7 +86,7 @@ impl Writers {
         let mut energy = create("energy.csv")?;
         writeln!(
             energy,
-            "step,time,kinetic,strain,external_work,damping_work"
+            "step,time,kinetic,strain,external_work,damping_work,plastic_work"
         )?;
         let mut probes = create("probes.csv")?;
         let names: String = probe_names.iter().map(|n| format!(",{n}")).collect();
@@ -147,8 +147,14 @@ impl Writers {
         let e = &row.energies;
         writeln!(
             self.energy,
-            "{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
-            row.step, row.time, e.kinetic, e.strain, e.external_work, e.damping_work
+            "{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
+            row.step,
+            row.time,
+            e.kinetic,
+            e.strain,
+            e.external_work,
+            e.damping_work,
+            e.plastic_work
         )?;
         // Probes are sampled once per step from step 0, so the sample index is the step.
         let k = row.step as usize;

@@ -10,7 +10,7 @@ use crate::error::ScenarioError;
 use crate::fracture::FracturePlan;
 use crate::grid::{Grid, GridGeom};
 use crate::loads::{Load, VelocityBc};
-use crate::material::{Elastic, Plane};
+use crate::material::{Material, Plane};
 use crate::measure::{Expect, Measure, Probe, ProbeQty};
 use crate::particles::Particles;
 use crate::shape::ShapeKind;
@@ -245,47 +245,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     }
     let geom = GridGeom::<D>::new(to_vec::<D>(gmin), to_vec::<D>(h), cells);
 
-    // Materials: the count is checked first and names through a set, so that a scenario
-    // with tens of thousands of tables is refused at once.
-    if sc.materials.len() > u16::MAX as usize {
-        return Err(src.error(
-            "material",
-            format!(
-                "{} materials: at most {} per scene",
-                sc.materials.len(),
-                u16::MAX
-            ),
-        ));
-    }
-    let mut materials = Vec::new();
-    let mut names = std::collections::HashSet::new();
-    for (i, m) in sc.materials.iter().enumerate() {
-        let key = |k: &str| format!("material[{i}].{k}");
-        if !names.insert(m.name.as_str()) {
-            return Err(src.error(&key("name"), format!("duplicate material `{}`", m.name)));
-        }
-        positive(src, &key("E"), m.youngs, "Pa")?;
-        positive(src, &key("rho"), m.rho, "kg/m^3")?;
-        if !(m.nu > -1.0 && m.nu < 0.5) {
-            return Err(src.error(
-                &key("nu"),
-                format!("Poisson's ratio must satisfy -1 < nu < 0.5, got {}", m.nu),
-            ));
-        }
-        let e = Elastic::new(&m.name, m.youngs, m.nu, m.rho);
-        let c = e.wave_speed(Plane::Strain).max(e.wave_speed(Plane::Stress));
-        if !(c.is_finite() && c > 0.0 && e.lambda.is_finite() && e.mu.is_finite()) {
-            return Err(src.error(
-                &key("E"),
-                format!(
-                    "E = {:e} Pa with rho = {:e} kg/m^3 and nu = {} overflow the derived \
-                     moduli or wave speed",
-                    m.youngs, m.rho, m.nu
-                ),
-            ));
-        }
-        materials.push(e);
-    }
+    let materials = super::material::materials(src, &sc.materials)?;
 
     // Bodies.
     if sc.bodies.is_empty() {
@@ -427,7 +387,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             nodes,
             axes,
             velocity: to_vec::<D>(velocity),
-            time: bc.time,
+            time: bc.time.clone(),
         });
     }
 
@@ -475,7 +435,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         loads.push(Load {
             forces,
             particles: sel,
-            time: l.time,
+            time: l.time.clone(),
         });
     }
 
@@ -547,10 +507,12 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let tip_qty = ["KI", "KII", "J1", "J2"]
             .iter()
             .position(|q| *q == e.quantity);
-        if e.from.is_some() && !["K_drift", "kinetic_fraction"].contains(&e.quantity.as_str()) {
+        if e.from.is_some()
+            && !["K_drift", "kinetic_fraction", "slope"].contains(&e.quantity.as_str())
+        {
             return Err(src.error(
                 &key("from"),
-                "`from` applies to K_drift and kinetic_fraction",
+                "`from` applies to K_drift, kinetic_fraction and slope",
             ));
         }
         let front_qty = ["KI_front", "KII_front", "KIII_front", "J1_front"]
@@ -633,7 +595,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             return Err(src.error(&key("length"), "`length` applies to cycles"));
         }
         let need = match e.quantity.as_str() {
-            "wave_speed" => 2,
+            "wave_speed" | "slope" => 2,
             "final" | "max" | "min" | "frequency" => 1,
             "momentum_drift" | "energy_drift" | "angular_momentum_drift" | "kinetic_fraction" => 0,
             other => {
@@ -641,7 +603,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     &key("quantity"),
                     format!(
                         "unknown quantity `{other}` (final, max, min, frequency, wave_speed, \
-                         momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2, \
+                         slope, momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2, \
                          J_path, K_drift, kinetic_fraction, KI_front, KII_front, KIII_front, \
                          J1_front, kink, path_angle, turn, cycles)"
                     ),
@@ -664,6 +626,25 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             "min" => Measure::Min(ids[0]),
             "frequency" => Measure::Frequency(ids[0]),
             "wave_speed" => Measure::WaveSpeed(ids[0], ids[1]),
+            "slope" => {
+                let end = src.scenario.simulation.duration;
+                match e.from {
+                    Some(from) if (0.0..end).contains(&from) => Measure::Slope {
+                        rise: ids[0],
+                        run: ids[1],
+                        from,
+                    },
+                    _ => {
+                        return Err(src.error(
+                            &key("from"),
+                            format!(
+                                "`slope` is the change of its first probe over its second's \
+                                 from `from` to the end: give `from`, 0 to {end:.4e} s"
+                            ),
+                        ));
+                    }
+                }
+            }
             "momentum_drift" => Measure::MomentumDrift,
             "energy_drift" => Measure::EnergyDrift,
             "kinetic_fraction" => {
@@ -718,6 +699,14 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     if fracture.is_some() {
         particles.grad_u = vec![D::mat_zero(); particles.len()];
         particles.grad_v = vec![D::mat_zero(); particles.len()];
+    }
+    // Plastic state is kept only when a body is made of a plastic material.
+    if materials
+        .iter()
+        .zip(&used)
+        .any(|(m, &u)| u && m.j2.is_some())
+    {
+        particles.make_plastic();
     }
     let min_mass = particles.mass.iter().copied().fold(f64::INFINITY, f64::min);
     let world = World {
@@ -882,7 +871,7 @@ fn add_body<D: Dim>(
     b: usize,
     body: &BodySpec,
     geom: &GridGeom<D>,
-    materials: &[Elastic],
+    materials: &[Material],
     used: &mut [bool],
     shape: ShapeKind,
     thickness: f64,

@@ -10,7 +10,7 @@ use crate::error::ScenarioError;
 use crate::fracture::{FracturePlan, KMethod};
 use crate::grid::GridGeom;
 use crate::growth::TipState;
-use crate::material::Elastic;
+use crate::material::Material;
 use crate::measure::{Along, Expect, Measure, Shape};
 use crate::particles::Particles;
 use glam::DVec3;
@@ -29,7 +29,7 @@ const REACH_CELLS: f64 = 2.0;
 pub(super) fn build<D: Dim>(
     src: &Source,
     particles: &Particles<D>,
-    materials: &[Elastic],
+    materials: &[Material],
     geom: &GridGeom<D>,
     dt: f64,
 ) -> R<Option<Cracks<D>>> {

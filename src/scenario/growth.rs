@@ -6,7 +6,7 @@ use super::source::Source;
 use crate::dim::Dim;
 use crate::error::ScenarioError;
 use crate::growth::{Direction, Growth, Initiation, Paris};
-use crate::material::Elastic;
+use crate::material::Material;
 use crate::measure::{GrowthQty, Measure};
 
 type R<T> = Result<T, ScenarioError>;
@@ -24,7 +24,7 @@ pub(super) fn growth<D: Dim>(
     src: &Source,
     c: usize,
     spec: &CrackSpec,
-    materials: &[Elastic],
+    materials: &[Material],
     cell: f64,
     dt: f64,
     measured: bool,
@@ -205,7 +205,7 @@ fn initiation(src: &Source, c: usize, g: &GrowthSpec) -> R<Initiation> {
 }
 
 /// Rayleigh wave speed (m/s), Viktorov's approximation c_s (0.862 + 1.14 nu) / (1 + nu).
-fn rayleigh_speed(m: &Elastic) -> f64 {
+fn rayleigh_speed(m: &Material) -> f64 {
     (m.mu / m.density).sqrt() * (0.862 + 1.14 * m.poisson) / (1.0 + m.poisson)
 }
 

@@ -5,6 +5,7 @@ pub mod build;
 mod crack_meet;
 mod cracks;
 mod growth;
+mod material;
 mod memory;
 mod region;
 pub mod schema;

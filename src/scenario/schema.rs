@@ -104,6 +104,27 @@ pub struct MaterialSpec {
     pub nu: f64,
     /// Density (kg/m^3).
     pub rho: f64,
+    /// Constitutive model: "elastic" (default) or "j2" (von Mises plasticity).
+    #[serde(default)]
+    pub model: ModelKind,
+    /// j2: initial yield stress (Pa).
+    pub sigma_y: Option<f64>,
+    /// j2: linear isotropic hardening modulus (Pa); 0 (the default) is perfectly plastic.
+    #[serde(rename = "H")]
+    pub hardening: Option<f64>,
+    /// j2: modified Ramberg-Osgood exponent n (> 1), instead of `H`.
+    pub n: Option<f64>,
+}
+
+/// A material's constitutive model.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelKind {
+    /// Small-strain isotropic linear elasticity.
+    #[default]
+    Elastic,
+    /// J2 (von Mises) plasticity with isotropic hardening.
+    J2,
 }
 
 /// An axis-aligned box (m).
@@ -547,7 +568,8 @@ pub struct CheckpointSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ExpectSpec {
-    /// One of: final, max, min, frequency, wave_speed, momentum_drift, energy_drift,
+    /// One of: final, max, min, frequency, wave_speed, slope (the change of the first probe
+    /// over the second's from `from` to the end), momentum_drift, energy_drift,
     /// angular_momentum_drift; KI, KII, J1, J2 (at a crack tip: the last value, or at `at`);
     /// J_path (largest difference of J on the `[fracture] compare` contours from the main
     /// one, relative to the main one's largest |J|; in 3D the worst front vertex, or the
@@ -559,7 +581,7 @@ pub struct ExpectSpec {
     /// (-90, 90]), turn (the chord from the tip's start to its last new vertex, as a turn
     /// from the crack, degrees) and cycles (fatigue: load cycles to grow by `length`).
     pub quantity: String,
-    /// Probe(s) the quantity is measured on (wave_speed takes two).
+    /// Probe(s) the quantity is measured on (wave_speed and slope take two).
     #[serde(default)]
     pub probes: Vec<String>,
     /// Crack name, for KI, KII, J1, J2.
@@ -568,7 +590,7 @@ pub struct ExpectSpec {
     pub tip: Option<String>,
     /// For KI, KII, J1, J2: the value at this time (s) instead of the last one.
     pub at: Option<f64>,
-    /// For K_drift: the start of the window (s).
+    /// For K_drift, kinetic_fraction and slope: the start of the window (s).
     pub from: Option<f64>,
     /// For cycles: the length grown (m) whose cycles are compared.
     pub length: Option<f64>,

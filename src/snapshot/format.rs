@@ -69,7 +69,8 @@ macro_rules! columnar {
     ($($t:ty => $e:ident),*) => { $(impl Columnar for $t { const ELEM: Elem = Elem::$e; })* };
 }
 columnar!(f64 => F64, u64 => U64, u16 => U16, u8 => U8, DVec2 => F64, DVec3 => F64,
-    DMat2 => F64, DMat3 => F64, crate::sym::Sym2 => F64, crate::sym::Sym3 => F64);
+    DMat2 => F64, DMat3 => F64, crate::sym::Sym2 => F64, crate::sym::Sym3 => F64,
+    crate::plastic::Hardened => F64);
 
 /// One entry of the column table.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]

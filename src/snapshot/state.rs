@@ -9,7 +9,6 @@ use super::topology::{self, Encoded};
 use crate::dim::Dim;
 use crate::fracture::{PathResult, TipResult};
 use crate::growth::{GrowthRow, TipState};
-use crate::material::Elastic;
 use crate::measure::{History, Row};
 use crate::run::state::RunState;
 use crate::scenario::{Scene, Source, build};
@@ -59,7 +58,7 @@ fn path_data(p: &PathResult) -> [f64; PATH_WIDTH] {
     [p.time, p.line[0], p.line[1], p.area[0], p.area[1]]
 }
 
-fn row_from(step: u64, d: &[f64]) -> Row {
+fn row_from(step: u64, d: &[f64], plastic_work: f64) -> Row {
     Row {
         step,
         time: d[0],
@@ -68,6 +67,7 @@ fn row_from(step: u64, d: &[f64]) -> Row {
             strain: d[2],
             external_work: d[3],
             damping_work: d[4],
+            plastic_work,
         },
         momentum: [d[5], d[6], d[7]],
         momentum_scale: d[8],
@@ -92,6 +92,7 @@ pub fn write<D: Dim>(
     let h = &state.history;
     let row_steps: Vec<u64> = h.rows.iter().map(|r| r.step).collect();
     let rows: Vec<f64> = h.rows.iter().flat_map(row_data).collect();
+    let rows_plastic: Vec<f64> = h.rows.iter().map(|r| r.energies.plastic_work).collect();
     let tip_steps: Vec<u64> = h.fracture.iter().map(|t| t.step).collect();
     let tip_ids: Vec<u64> = h.fracture.iter().map(|t| tip_id(t.crack, t.tip)).collect();
     let tip_data: Vec<f64> = h.fracture.iter().flat_map(tip_data).collect();
@@ -123,6 +124,8 @@ pub fn write<D: Dim>(
     c.add("particles.material", &p.material);
     c.add("particles.half", &p.half);
     c.add("particles.grad_u", &p.grad_u);
+    c.add("particles.plastic_strain", &p.plastic_strain);
+    c.add("particles.hardened", &p.hardened);
     c.add("materials.youngs", &youngs);
     c.add("materials.poisson", &poisson);
     c.add("materials.density", &density);
@@ -153,6 +156,7 @@ pub fn write<D: Dim>(
     c.add("history.growth.data", &growth_data);
     c.add("history.rows.step", &row_steps);
     c.add("history.rows.data", &rows);
+    c.add("history.rows.plastic", &rows_plastic);
     let header = Header {
         dimension: D::D as u8,
         particles: p.len() as u64,
@@ -245,12 +249,16 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
         p.grad_u = r.column("particles.grad_u", n)?;
         p.grad_v = r.column("particles.grad_v", n)?;
     }
+    if !p.hardened.is_empty() {
+        p.plastic_strain = r.column("particles.plastic_strain", n)?;
+        p.hardened = r.column("particles.hardened", n)?;
+    }
     let nm = w.materials.len();
     let youngs: Vec<f64> = r.column("materials.youngs", nm)?;
     let poisson: Vec<f64> = r.column("materials.poisson", nm)?;
     let density: Vec<f64> = r.column("materials.density", nm)?;
     for (k, m) in w.materials.iter_mut().enumerate() {
-        *m = Elastic::new(&m.name, youngs[k], poisson[k], density[k]);
+        *m = m.with_elastic(youngs[k], poisson[k], density[k]);
     }
     let run: Vec<f64> = r.column("run.work", 2)?;
     w.work.external = run[0];
@@ -294,10 +302,15 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     }
     let steps: Vec<u64> = r.column_any("history.rows.step")?;
     let data: Vec<f64> = r.column("history.rows.data", steps.len() * ROW_WIDTH)?;
-    history.rows = steps
-        .iter()
+    // A snapshot from a build without plasticity has no plastic work: there was none.
+    let plastic: Vec<f64> = if r.offset_of("history.rows.plastic").is_some() {
+        r.column("history.rows.plastic", steps.len())?
+    } else {
+        vec![0.0; steps.len()]
+    };
+    history.rows = (steps.iter().zip(&plastic))
         .zip(data.chunks_exact(ROW_WIDTH))
-        .map(|(&s, d)| row_from(s, d))
+        .map(|((&s, &wp), d)| row_from(s, d, wp))
         .collect();
     let tip_steps: Vec<u64> = r.column_any("history.fracture.step")?;
     let tip_ids: Vec<u64> = r.column("history.fracture.tip", tip_steps.len())?;

@@ -1,0 +1,90 @@
+//! J2 plasticity in whole runs: the plastic state is deterministic across thread counts,
+//! the energy balance with the plastic work closes, and an elastic scene carries no plastic
+//! columns.
+
+mod common;
+use common::{final_world, history, mixed_scene, plastic};
+use fissure::dim::{D2, D3, Dim};
+use fissure::measure::energy_balance;
+use fissure::sym::SymTensor;
+use fissure::world::World;
+
+/// Every bit of the stress and plastic state.
+fn bits<D: Dim>(w: &World<D>) -> Vec<u64> {
+    let p = &w.particles;
+    let mut out = Vec::new();
+    for i in 0..p.len() {
+        out.extend(D::to_xyz(p.x[i]).map(f64::to_bits));
+        out.extend(p.stress[i].to_sym3().to_array().map(f64::to_bits));
+        out.extend(p.plastic_strain[i].to_sym3().to_array().map(f64::to_bits));
+        let h = p.hardened[i];
+        out.extend([h.equivalent, h.flow_stress, h.work].map(f64::to_bits));
+    }
+    out
+}
+
+/// The fraction of particles that have yielded.
+fn yielded<D: Dim>(w: &World<D>) -> f64 {
+    let p = &w.particles;
+    p.hardened.iter().filter(|h| h.equivalent > 0.0).count() as f64 / p.len() as f64
+}
+
+fn same_bits_for_thread_counts<D: Dim>(text: &str) {
+    let one = final_world::<D>(text, 1);
+    let y = yielded(&one);
+    assert!(
+        y > 0.05 && y < 0.95,
+        "{}D: {y} of the particles yielded",
+        D::D
+    );
+    let one = bits(&one);
+    for threads in [2, 3] {
+        assert!(
+            one == bits(&final_world::<D>(text, threads)),
+            "{}D plastic results differ between 1 and {threads} threads",
+            D::D
+        );
+    }
+}
+
+/// The mixed scene (an impact on a clamp, a load, damping) with yield at 20 MPa: part of
+/// the body yields, and every bit matches for 1, 2 and 3 threads, in plane strain, plane
+/// stress (whose return iterates) and 3D.
+#[test]
+fn plastic_results_are_bitwise_identical_across_thread_counts() {
+    let text = plastic(&mixed_scene(2, "ugimp", "usavg"), 2e7, "n = 5");
+    same_bits_for_thread_counts::<D2>(&text);
+    let stress = text.replace("dimension = 2", "dimension = 2\nplane = \"stress\"");
+    same_bits_for_thread_counts::<D2>(&stress);
+    let text = plastic(&mixed_scene(3, "linear", "usf"), 2e7, "H = 5e9");
+    same_bits_for_thread_counts::<D3>(&text);
+}
+
+/// Without damping, the kinetic energy of the impact goes into elastic energy and plastic
+/// work: K + W + W_p - W_ext stays at its start to the accuracy of the elastic scene's own
+/// balance (the explicit step's O(dt) error), while W_p is a sizeable share of the energy.
+#[test]
+fn energy_balance_with_plastic_work_closes() {
+    let elastic = mixed_scene(2, "ugimp", "usavg").replace("damping = 1000.0", "damping = 0.0");
+    let h = history(&plastic(&elastic, 2e7, "H = 2e9"));
+    let last = h.rows.last().unwrap().energies;
+    let share = last.plastic_work / last.internal();
+    assert!(
+        share > 0.05,
+        "plastic work is {share} of the energy: too little to test"
+    );
+    let drift = energy_balance(&h).unwrap();
+    let reference = energy_balance(&history(&elastic)).unwrap();
+    assert!(
+        drift < 2.0 * reference.max(1e-4),
+        "balance drift {drift:e} (elastic scene: {reference:e})"
+    );
+}
+
+/// A scene without plastic materials keeps no plastic columns and reports no plastic work.
+#[test]
+fn elastic_scene_has_no_plastic_state() {
+    let w = final_world::<D2>(&mixed_scene(2, "linear", "usl"), 1);
+    assert!(w.particles.hardened.is_empty() && w.particles.plastic_strain.is_empty());
+    assert_eq!(w.energies().plastic_work, 0.0);
+}
