@@ -21,8 +21,12 @@ pub enum ProbeQty {
     Position,
     /// Stress component (Pa).
     Stress,
-    /// Strain component.
+    /// Strain component (elastic plus plastic).
     Strain,
+    /// Opening along the component's axis (m): the mean displacement of the particles
+    /// initially beyond the probe's centroid on that axis minus that of those short of it;
+    /// across a crack, a clip gauge (e.g. the crack-mouth opening, CMOD).
+    Opening,
 }
 
 /// Average of one component over a fixed particle set.
@@ -43,6 +47,9 @@ pub struct Probe {
 impl Probe {
     /// Current average.
     pub fn sample<D: Dim>(&self, p: &Particles<D>, materials: &[Material]) -> f64 {
+        if self.qty == ProbeQty::Opening {
+            return self.opening(p);
+        }
         let mut sum = 0.0;
         for &i in &self.particles {
             let i = i as usize;
@@ -59,9 +66,24 @@ impl Probe {
                     };
                     strain.to_array()[self.comp]
                 }
+                ProbeQty::Opening => unreachable!("sampled by `opening`"),
             };
         }
         sum / self.particles.len() as f64
+    }
+
+    /// The [`ProbeQty::Opening`] sample.
+    fn opening<D: Dim>(&self, p: &Particles<D>) -> f64 {
+        let c = self.comp;
+        let mut sides = [(0.0, 0usize); 2];
+        for &i in &self.particles {
+            let i = i as usize;
+            let side = &mut sides[usize::from(p.x0[i][c] > self.centre[c])];
+            side.0 += p.displacement(i)[c];
+            side.1 += 1;
+        }
+        let mean = |(sum, n): (f64, usize)| sum / n as f64;
+        mean(sides[1]) - mean(sides[0])
     }
 }
 

@@ -127,8 +127,10 @@ fn fixed_free_bar_first_mode_3d() {
     );
 }
 
-/// A ramped end force on a clamped bar, damped to rest: elongation P L / (E A).
-fn damped_elongation_case(dim: usize) -> f64 {
+/// A ramped end force on a clamped bar, damped to rest: elongation P L / (E A), and the
+/// opening across the middle 0.4 L (a clip gauge: the halves' centroids 0.2 L apart) of
+/// P / (E A) x 0.2 L. Returns both relative errors.
+fn damped_elongation_case(dim: usize) -> (f64, f64) {
     let omega1 = 2.0 * std::f64::consts::PI * 5000.0 / (4.0 * 0.1);
     let mut bar = Bar {
         dim,
@@ -139,29 +141,32 @@ fn damped_elongation_case(dim: usize) -> f64 {
     };
     let p = 1e4;
     bar.extra = format!(
-        "\n[[boundary]]\nregion = {}\nfix = [\"x\"]\n{}\n[[load]]\nregion = {}\nforce = {}\ntime = {{ kind = \"ramp\", rise = {:e} }}\n",
+        "\n[[boundary]]\nregion = {}\nfix = [\"x\"]\n{}{}\n[[load]]\nregion = {}\nforce = {}\ntime = {{ kind = \"ramp\", rise = {:e} }}\n",
         bar.left_nodes(),
         probe(&bar, "tip", bar.len - bar.h, bar.len, "displacement"),
+        probe(&bar, "gauge", 0.3 * bar.len, 0.7 * bar.len, "opening"),
         bar.region(bar.len - bar.h, bar.len),
         common::v(dim, p, 0.0),
         2.0 / omega1
     );
     let hist = history(&bar.toml());
-    let got = *hist.probes[0].last().unwrap();
-    let want = p * bar.len / (200e9 * bar.area());
-    (got - want) / want
+    let strain = p / (200e9 * bar.area());
+    let error = |k: usize, want: f64| (hist.probes[k].last().unwrap() - want) / want;
+    (error(0, strain * bar.len), error(1, strain * 0.2 * bar.len))
 }
 
 #[test]
 fn damped_bar_elongation_2d() {
-    let err = damped_elongation_case(2);
-    assert!(err.abs() < 0.02, "2D elongation error {err}");
+    let (tip, gauge) = damped_elongation_case(2);
+    assert!(tip.abs() < 0.02, "2D elongation error {tip}");
+    assert!(gauge.abs() < 0.02, "2D clip-gauge opening error {gauge}");
 }
 
 #[test]
 fn damped_bar_elongation_3d() {
-    let err = damped_elongation_case(3);
-    assert!(err.abs() < 0.02, "3D elongation error {err}");
+    let (tip, gauge) = damped_elongation_case(3);
+    assert!(tip.abs() < 0.02, "3D elongation error {tip}");
+    assert!(gauge.abs() < 0.02, "3D clip-gauge opening error {gauge}");
 }
 
 /// Non-cubic cells (1 x 2.5 mm): the front still travels at c0 along the bar.

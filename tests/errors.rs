@@ -830,3 +830,12 @@ fn bad_time_tables_name_the_key() {
         assert_error(&e, "load[0].time", Some(21), words);
     }
 }
+
+#[test]
+fn opening_probe_needs_both_sides() {
+    // One column of particles (x = 4.5 mm): none lies beyond the centroid along x.
+    let probe = "[[probe]]\nname = \"cmod\"\nregion = { min = [0.004, 0.004], max = [0.0049, 0.016] }\n\
+                 quantity = \"opening\"\ncomponent = \"x\"\n";
+    let e = refused(&format!("{GOOD}{probe}"));
+    assert_error(&e, "probe[0].region", Some(20), "both sides");
+}

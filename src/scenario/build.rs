@@ -452,11 +452,13 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             "position" => ProbeQty::Position,
             "stress" => ProbeQty::Stress,
             "strain" => ProbeQty::Strain,
+            "opening" => ProbeQty::Opening,
             other => {
                 return Err(src.error(
                     &key("quantity"),
                     format!(
-                        "unknown quantity `{other}` (displacement, velocity, position, stress, strain)"
+                        "unknown quantity `{other}` (displacement, velocity, position, stress, \
+                         strain, opening)"
                     ),
                 ));
             }
@@ -480,6 +482,21 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             let x = D::to_xyz(particles.x[q as usize]);
             for a in 0..3 {
                 centre[a] += x[a] / sel.len() as f64;
+            }
+        }
+        if qty == ProbeQty::Opening {
+            let beyond = (sel.iter())
+                .filter(|&&q| D::to_xyz(particles.x[q as usize])[comp] > centre[comp])
+                .count();
+            if beyond == 0 || beyond == sel.len() {
+                return Err(src.error(
+                    &key("region"),
+                    format!(
+                        "an opening probe needs particles on both sides of its region's \
+                         centroid along {}: this region has them on one side",
+                        p.component
+                    ),
+                ));
             }
         }
         probes.push(Probe {

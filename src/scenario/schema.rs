@@ -465,7 +465,8 @@ pub struct ProbeSpec {
     pub name: String,
     /// Particles initially inside this region are averaged.
     pub region: RegionSpec,
-    /// "displacement", "velocity", "position", "stress" or "strain".
+    /// "displacement", "velocity", "position", "stress", "strain" or "opening" (the mean
+    /// displacement beyond the region's centroid minus that short of it, along `component`).
     pub quantity: String,
     /// "x", "y", "z" for vectors; "xx", "yy", "zz", "yz", "xz", "xy" for tensors.
     pub component: String,
