@@ -218,6 +218,11 @@ pub(crate) fn tip(
         KMethod::Interaction => res.k_interaction,
         KMethod::Opening => res.k_opening,
     };
+    if main.plastic {
+        // K comes from J only while the contour runs through elastic material.
+        let none = [f64::NAN, f64::NAN, 0.0];
+        (res.k, res.k_interaction, res.k_opening) = (none, none, none);
+    }
     (res, paths)
 }
 
@@ -231,6 +236,9 @@ struct ContourJ {
     area: [f64; 2],
     /// Particle nearest the tip.
     nearest: usize,
+    /// Whether a particle within the interpolation reach of the contour has yielded: J is
+    /// then taken through plastic material, and K (an elastic quantity) is not reported.
+    plastic: bool,
 }
 
 /// J on the square contour `n` cells from the node nearest the tip `xt` of crack `c` (shrunk
@@ -300,6 +308,7 @@ fn contour_j(
     let reach = 2.0 * geom.h[0].max(geom.h[1]);
     let mut area = [0.0; 2];
     let mut nearest = (f64::INFINITY, 0usize);
+    let mut plastic = false;
     let half = 0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
     let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
     for i in near(world, DVec2::from(centre), half + reach) {
@@ -315,6 +324,11 @@ fn contour_j(
         if d2 < nearest.0 {
             nearest = (d2, i);
         }
+        let well_inside = x[0] > lo[0] + reach
+            && x[0] < hi[0] - reach
+            && x[1] > lo[1] + reach
+            && x[1] < hi[1] - reach;
+        plastic |= !well_inside && p.hardened.get(i).is_some_and(|h| h.equivalent > 0.0);
         let m = p.mass[i];
         let mat = &world.materials[p.material[i] as usize];
         let st = p.stress[i].to_sym3();
@@ -423,6 +437,7 @@ fn contour_j(
         line: j,
         area,
         nearest: nearest.1,
+        plastic,
     })
 }
 

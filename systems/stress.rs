@@ -5,6 +5,7 @@
 use crate::dim::Dim;
 use crate::disjoint::Disjoint;
 use crate::material::{Material, Plane};
+use crate::particles::Particles;
 use crate::plastic::Hardened;
 use crate::shape::{Rows, Stencil};
 use crate::sym::SymTensor;
@@ -24,15 +25,8 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let materials = &world.materials;
     let stencils = &world.tiles.stencils;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
-    let p = &mut world.particles;
-    let (n, material) = (p.len(), &p.material);
-    let columns = StressColumns::<D>::new(
-        &mut p.stress,
-        &mut p.grad_v,
-        &mut p.grad_u,
-        &mut p.plastic_strain,
-        &mut p.hardened,
-    );
+    let n = world.particles.len();
+    let (columns, material) = StressColumns::of(&mut world.particles);
     let stride = &grid.geom.stride;
     (0..n.div_ceil(CHUNK)).into_par_iter().for_each(|c| {
         with_shape!(shape, S, N => for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
@@ -58,15 +52,7 @@ pub(crate) fn update_coded<D: Dim>(world: &mut World<D>, dt: f64) {
     };
     let (shape, plane) = (world.settings.shape, world.settings.plane);
     let (grid, f) = (&world.grid, &c.scratch.fields);
-    let p = &mut world.particles;
-    let material = &p.material;
-    let columns = StressColumns::<D>::new(
-        &mut p.stress,
-        &mut p.grad_v,
-        &mut p.grad_u,
-        &mut p.plastic_strain,
-        &mut p.hardened,
-    );
+    let (columns, material) = StressColumns::of(&mut world.particles);
     for &i in &f.coded {
         let i = i as usize;
         let targets = f.targets_of(i).expect("coded particle");
@@ -115,6 +101,21 @@ impl<'a, D: Dim> StressColumns<'a, D> {
             plastic_strain: Disjoint::new(plastic_strain),
             hardened: Disjoint::new(hardened),
         }
+    }
+
+    /// Borrows the stress-update columns of `p`, with its material column beside them.
+    pub(crate) fn of(p: &'a mut Particles<D>) -> (Self, &'a [u16]) {
+        let Particles {
+            stress,
+            grad_v,
+            grad_u,
+            plastic_strain,
+            hardened,
+            material,
+            ..
+        } = p;
+        let columns = Self::new(stress, grad_v, grad_u, plastic_strain, hardened);
+        (columns, material)
     }
 
     /// Particle `i`'s update from its velocity gradient `l` over `dt`: grad v and grad u

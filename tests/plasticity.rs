@@ -88,3 +88,30 @@ fn elastic_scene_has_no_plastic_state() {
     assert!(w.particles.hardened.is_empty() && w.particles.plastic_strain.is_empty());
     assert_eq!(w.energies().plastic_work, 0.0);
 }
+
+/// The edge-cracked plate of the growth tests, its crack held still.
+fn edge_plate() -> String {
+    common::edge_plate("", 1.5e-5).replace("[crack.growth]\n\n", "")
+}
+
+/// K comes from J only while the contour runs through elastic material: a plate whose
+/// remote stress (100 MPa) is twice the yield stress reports J but no K; one whose yield
+/// stress is never reached gives bitwise the elastic run's J and K.
+#[test]
+fn k_is_reported_only_while_the_contour_is_elastic() {
+    let last = |text: &str| *history(text).fracture.last().expect("a tip row");
+    let elastic = last(&edge_plate());
+    assert!(elastic.k[0] > 0.0 && elastic.j[0] > 0.0);
+    let unyielded = last(&plastic(&edge_plate(), 1e10, "H = 0"));
+    assert_eq!(
+        unyielded.values().map(f64::to_bits),
+        elastic.values().map(f64::to_bits)
+    );
+    let yielded = last(&plastic(&edge_plate(), 5e7, "H = 0"));
+    assert!(
+        yielded.j[0].is_finite() && yielded.j[0] > 0.0,
+        "J {:?}",
+        yielded.j
+    );
+    assert!(yielded.k[0].is_nan() && yielded.k_interaction[0].is_nan());
+}

@@ -359,9 +359,11 @@ paris = { C = 1.0e-29, m = 3.0, R = 0.25 }"#;
 /// `text` with its first material made von Mises plastic with `hardening` (e.g. "n = 5" or
 /// "H = 1e9") and yield stress `sigma_y` (Pa).
 pub fn plastic(text: &str, sigma_y: f64, hardening: &str) -> String {
-    text.replacen(
-        "rho = 2700.0\n",
-        &format!("rho = 2700.0\nmodel = \"j2\"\nsigma_y = {sigma_y:e}\n{hardening}\n"),
-        1,
+    let at = text.find("\nrho = ").expect("a material") + 1;
+    let end = at + text[at..].find('\n').expect("a line") + 1;
+    format!(
+        "{}model = \"j2\"\nsigma_y = {sigma_y:e}\n{hardening}\n{}",
+        &text[..end],
+        &text[end..]
     )
 }
