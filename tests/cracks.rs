@@ -327,3 +327,49 @@ fn j_after_a_kept_step_matches_the_unfused_schedule() {
     assert_eq!(j(&kept), j(&apart));
     assert_ne!(j(&fused), j(&apart));
 }
+
+/// `[fracture] lengths = "m"`: the contours, tube and domain stay where they are when the
+/// grid is refined (whole cells for the contours), so a refinement study converges
+/// instead of shrinking them; a fraction of a cell in cells, or an unknown unit, is
+/// refused.
+#[test]
+fn fracture_sizes_in_metres_follow_the_grid() {
+    let plate = |fracture: &str, cell: f64| {
+        common::edge_plate("", 1e-6)
+            .replace("[crack.growth]\n\n", "")
+            .replace("contour = 2\n", fracture)
+            .replace(
+                "cell = [0.0005, 0.0005]",
+                &format!("cell = [{cell:e}, {cell:e}]"),
+            )
+            .replace("start = [-0.0005, 0.0]", "start = [-0.0004, 0.0]")
+    };
+    let metres = "lengths = \"m\"\ncontour = 1.0e-3\ncompare = [2.0e-3]\ndomain = 3.0e-3\n";
+    for (cell, n) in [(5e-4, 2), (2.5e-4, 4)] {
+        let src = common::source(&plate(metres, cell));
+        let plan = fissure::scenario::build::<D2>(&src)
+            .unwrap()
+            .fracture
+            .unwrap();
+        assert_eq!(
+            (plan.contour, plan.compare.clone()),
+            (n, vec![2 * n]),
+            "cell {cell}"
+        );
+        assert!(
+            (plan.domain - 3.0 * n as f64).abs() < 1e-9,
+            "{}",
+            plan.domain
+        );
+    }
+    for (fracture, words) in [
+        ("contour = 1.5\n", "whole number of cells"),
+        ("lengths = \"mm\"\n", "unknown unit"),
+    ] {
+        let src = common::source(&plate(fracture, 5e-4));
+        let Err(e) = fissure::scenario::build::<D2>(&src) else {
+            panic!("`{fracture}` must be refused");
+        };
+        assert!(e.to_string().contains(words), "{e}");
+    }
+}

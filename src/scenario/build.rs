@@ -570,7 +570,9 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let crack_measure = match (tip_qty, front_qty) {
             (Some(qty), _) => Some(super::cracks::tip_measure(src, i, e, qty)?),
             (_, Some(qty)) => Some(super::cracks::front_measure(src, i, e, qty)?),
-            _ if e.quantity == "J_path" => Some(super::cracks::path_measure::<D>(src, i, e)?),
+            _ if e.quantity == "J_path" => {
+                Some(super::cracks::path_measure::<D>(src, i, e, &geom)?)
+            }
             _ if e.quantity == "K_drift" => Some(super::cracks::drift_measure(src, i, e)?),
             _ if ["kink", "path_angle", "turn", "cycles"].contains(&e.quantity.as_str()) => {
                 if D::D == 3 {

@@ -1,7 +1,7 @@
 //! Building the crack store from `[[crack]]` tables, with every check a crack needs.
 
 use super::build::{positive, to_vec, vec3};
-use super::schema::{AlongSpec, CrackSpec, ExpectSpec};
+use super::schema::{AlongSpec, CrackSpec, ExpectSpec, FractureSpec};
 use super::source::Source;
 use super::surface;
 use crate::crack::{Contact, Cracks, Element, Law, MAX_CRACKS};
@@ -444,6 +444,58 @@ fn self_crossing<D: Dim>(pts: &[D::Vec]) -> Option<(usize, usize)> {
     first
 }
 
+/// The `[fracture]` sizes in cells: the square contour (2D), the compared contours or
+/// tubes, the interaction domain and the opening window, converted from metres when
+/// `lengths = "m"` (whole cells for the contours and tubes, by rounding).
+pub(super) struct Sizes {
+    /// Half-size of the main contour (2D), if given.
+    pub contour: Option<usize>,
+    /// The compared contours or tubes.
+    pub compare: Vec<usize>,
+    /// The interaction domain's or tube's radius, if given.
+    pub domain: Option<f64>,
+    /// The opening fit's window, if given.
+    pub opening: Option<f64>,
+}
+
+/// Reads [`Sizes`] from `f` on the grid `geom`.
+pub(super) fn sizes<D: Dim>(src: &Source, f: &FractureSpec, geom: &GridGeom<D>) -> R<Sizes> {
+    let scale = match f.lengths.as_deref() {
+        None | Some("cells") => None,
+        Some("m") => Some(1.0 / (0..D::D).map(|a| geom.h[a]).fold(0.0, f64::max)),
+        Some(other) => {
+            return Err(src.error(
+                "fracture.lengths",
+                format!("unknown unit `{other}`: give \"cells\" or \"m\""),
+            ));
+        }
+    };
+    let cells = |v: f64| scale.map_or(v, |s| v * s);
+    let whole = |key: &str, v: f64| -> R<usize> {
+        let n = cells(v);
+        let n = if scale.is_some() { n.round() } else { n };
+        if !(n.is_finite() && n >= 0.0 && n.fract() == 0.0 && n <= 1e6) {
+            let unit = if scale.is_some() { "m" } else { "cells" };
+            return Err(src.error(
+                key,
+                format!("give a whole number of cells (or a length with lengths = \"m\"), got {v} {unit}"),
+            ));
+        }
+        Ok(n as usize)
+    };
+    Ok(Sizes {
+        contour: f
+            .contour
+            .map(|v| whole("fracture.contour", v))
+            .transpose()?,
+        compare: (f.compare.iter().flatten())
+            .map(|&v| whole("fracture.compare", v))
+            .collect::<R<_>>()?,
+        domain: f.domain.map(cells),
+        opening: f.opening.map(cells),
+    })
+}
+
 /// The `[fracture]` table, checked against the cracks: they must exist and have tips, and
 /// the contour around each tip must fit inside the grid.
 pub(super) fn fracture_plan<D: Dim>(
@@ -494,8 +546,9 @@ pub(super) fn fracture_plan<D: Dim>(
         }
         Ok(())
     };
-    let n = f.contour.unwrap_or(2);
-    let compare = f.compare.clone().unwrap_or_default();
+    let sizes = sizes(src, f, geom)?;
+    let n = sizes.contour.unwrap_or(2);
+    let compare = sizes.compare;
     if D::D == 2 {
         fits("fracture.contour", n)?;
         for &m in &compare {
@@ -526,11 +579,11 @@ pub(super) fn fracture_plan<D: Dim>(
     if compare_from.is_nan() || compare_from < 0.0 {
         return Err(src.error("fracture.compare_from", "give a time >= 0 (s)"));
     }
-    let opening = f.opening.unwrap_or(8.0);
+    let opening = sizes.opening.unwrap_or(8.0);
     if opening.is_nan() || opening < 2.0 {
         return Err(src.error(
             "fracture.opening",
-            "the opening is fitted from 1 cell to `opening` cells behind the tip: give at least 2",
+            "the opening is fitted from 1 cell to `opening` behind the tip: give at least 2 cells",
         ));
     }
     let k_method = match f.k_from.as_deref() {
@@ -550,11 +603,11 @@ pub(super) fn fracture_plan<D: Dim>(
             ));
         }
     };
-    let domain = f.domain.unwrap_or(if D::D == 2 { 6.0 } else { 3.0 });
+    let domain = sizes.domain.unwrap_or(if D::D == 2 { 6.0 } else { 3.0 });
     if !(domain.is_finite() && domain >= 2.0) {
         return Err(src.error(
             "fracture.domain",
-            "the interaction integral's domain radius is in cells: give at least 2",
+            "the interaction integral's domain radius must be at least 2 cells",
         ));
     }
     // In 3D the compared tubes are set against the main one, of `domain` cells.
@@ -799,7 +852,12 @@ pub(super) fn drift_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure
 /// The measure of a `J_path` expect: J with the area term on the compared contours against
 /// the main one at a crack tip (3D: J with the volume term on the compared tubes, at every
 /// front vertex or the one `near` a point), from `[fracture] compare_from` on.
-pub(super) fn path_measure<D: Dim>(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure> {
+pub(super) fn path_measure<D: Dim>(
+    src: &Source,
+    i: usize,
+    e: &ExpectSpec,
+    geom: &GridGeom<D>,
+) -> R<Measure> {
     let key = |k: &str| format!("expect[{i}].{k}");
     let (crack, tip, near) = if D::D == 2 {
         let (crack, tip) = expect_tip(src, i, e)?;
@@ -825,10 +883,10 @@ pub(super) fn path_measure<D: Dim>(src: &Source, i: usize, e: &ExpectSpec) -> R<
         ));
     }
     let f = src.scenario.fracture.as_ref();
-    let compare: Vec<u32> = f
-        .and_then(|f| f.compare.as_ref())
-        .map(|c| c.iter().map(|&n| n as u32).collect())
-        .unwrap_or_default();
+    let sizes = f.map(|f| sizes(src, f, geom)).transpose()?;
+    let compare: Vec<u32> = (sizes.iter())
+        .flat_map(|s| s.compare.iter().map(|&n| n as u32))
+        .collect();
     if compare.is_empty() {
         return Err(src.error(
             &format!("expect[{i}].quantity"),
@@ -836,9 +894,9 @@ pub(super) fn path_measure<D: Dim>(src: &Source, i: usize, e: &ExpectSpec) -> R<
         ));
     }
     let main = if D::D == 2 {
-        f.and_then(|f| f.contour).unwrap_or(2) as u32
+        sizes.as_ref().and_then(|s| s.contour).unwrap_or(2) as u32
     } else {
-        f.and_then(|f| f.domain).unwrap_or(3.0) as u32
+        sizes.as_ref().and_then(|s| s.domain).unwrap_or(3.0) as u32
     };
     Ok(Measure::PathDifference {
         crack,

@@ -505,14 +505,14 @@ pub struct OutputSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FractureSpec {
-    /// Half-size n of the n x n square contour, in cells (default 2).
-    pub contour: Option<usize>,
+    /// Half-size n of the square contour, in cells (default 2), or in m with `lengths = "m"`.
+    pub contour: Option<f64>,
     /// Include the area term of Guo & Nairn 2D (2004) Eq. 8 (default true).
     pub area_term: Option<bool>,
     /// Further contour sizes (cells) on which J is also measured, its line and area parts
     /// apart, for the path-independence record paths.csv; in 3D tube radii (each with its
     /// half-length, at least 2), set against the main tube of `domain` cells.
-    pub compare: Option<Vec<usize>>,
+    pub compare: Option<Vec<f64>>,
     /// Start of the window (s) over which summary.json and `J_path` expects compare the
     /// contours (default 0), e.g. once the first stress wave has passed the tip.
     pub compare_from: Option<f64>,
@@ -529,6 +529,10 @@ pub struct FractureSpec {
     /// Radius of the interaction integral's domain around the tip, in cells (default 6 in
     /// 2D; in 3D the radius and half-length of the tube around the front, default 3).
     pub domain: Option<f64>,
+    /// The unit of `contour`, `compare`, `domain` and `opening`: "cells" (default) or "m",
+    /// so that a refined grid keeps the contours where they were (rounded to whole cells
+    /// for the square contours and compared tubes).
+    pub lengths: Option<String>,
 }
 
 /// `along = { shape, zero, normal }` of a front expect: the reference at a front vertex is
