@@ -129,17 +129,25 @@ impl J2 {
         }
     }
 
+    /// Whether the stress `trial` lies outside the yield surface of state `h`: its
+    /// effective stress sqrt(3 J_2) = sqrt(3/2 S : S) above the yield stress.
+    #[inline(always)]
+    pub fn yields(&self, trial: &Sym3, h: &Hardened) -> bool {
+        let s = trial.deviator();
+        1.5 * s.ddot(&s) > self.flow_stress(h).powi(2)
+    }
+
     /// Returns `trial` (an elastic predictor) to the yield surface if it lies outside,
     /// updating the plastic strain and hardening state; a trial inside is kept.
     #[inline]
     pub fn radial_return(&self, trial: &mut Sym3, plastic: &mut Sym3, h: &mut Hardened) {
+        if !self.yields(trial, h) {
+            return;
+        }
         let p = trial.trace() / 3.0;
         let s = trial.deviator();
         let q = (1.5 * s.ddot(&s)).sqrt();
         let y0 = self.flow_stress(h);
-        if q <= y0 {
-            return;
-        }
         let (dl, y) = self.consistency(q, y0, h);
         // Eq. 56: S = (1 - 3 G dl / q) S_trial; the flow direction is S_trial / q.
         let shrink = 1.0 - 3.0 * self.mu * dl / q;

@@ -139,16 +139,21 @@ impl<'a, D: Dim> StressColumns<'a, D> {
                 self.grad_v.set(i, l);
                 self.grad_u.set(i, self.grad_u.get(i) + l * dt);
             }
-            let mut sigma = self.stress.get(i).to_sym3();
+            let start = self.stress.get(i).to_sym3();
             let de = D::sym_part(&l) * dt;
-            if self.plastic && m.j2.is_some() {
-                let mut ep = self.plastic_strain.get(i).to_sym3();
+            let mut sigma = start;
+            m.update(plane, de, &mut sigma);
+            // A plastic particle whose elastic trial stays inside the yield surface keeps
+            // its plastic state untouched (the common case, and no extra traffic).
+            if let Some(j2) = m.j2.as_ref().filter(|_| self.plastic) {
                 let mut h = self.hardened.get(i);
-                m.update_plastic(plane, de, &mut sigma, &mut ep, &mut h);
-                self.plastic_strain.set(i, D::Sym::from_sym3(ep));
-                self.hardened.set(i, h);
-            } else {
-                m.update(plane, de, &mut sigma);
+                if j2.yields(&sigma, &h) {
+                    let mut ep = self.plastic_strain.get(i).to_sym3();
+                    sigma = start;
+                    m.update_plastic(plane, de, &mut sigma, &mut ep, &mut h);
+                    self.plastic_strain.set(i, D::Sym::from_sym3(ep));
+                    self.hardened.set(i, h);
+                }
             }
             let s = D::Sym::from_sym3(sigma);
             self.stress.set(i, s);
