@@ -153,7 +153,7 @@ impl Material {
                     * n_zz;
             de.zz -= f0 / slope;
             now = trial(&de);
-            for _ in 0..60 {
+            for _ in 0..crate::plastic::MAX_ITERATIONS {
                 let f1 = now.0.zz;
                 if f1.abs() <= tol || f1 == f0 {
                     break;

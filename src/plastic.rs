@@ -51,7 +51,7 @@ pub struct Hardened {
 
 /// Most iterations of a scalar solve (the Ramberg-Osgood return, the plane-stress zz
 /// strain); both converge in a handful.
-const MAX_ITERATIONS: usize = 60;
+pub(crate) const MAX_ITERATIONS: usize = 60;
 
 /// Relative tolerance of the scalar solves.
 const TOLERANCE: f64 = 1e-13;
