@@ -45,6 +45,9 @@ pub struct Summary {
     pub bytes_per_particle: usize,
     /// Bytes per node held by the grid store.
     pub bytes_per_node: usize,
+    /// The process's peak resident memory so far (bytes; Linux `VmHWM`), None where the
+    /// system does not report it.
+    pub peak_resident_bytes: Option<u64>,
     /// Energies at the end (J).
     pub energies: Energies,
     /// Results of the scenario's `[[expect]]` blocks (only for a completed run).
@@ -119,4 +122,13 @@ pub struct GrowthReport {
     pub cycles: Option<f64>,
     /// Why it stopped growing for good, if it did.
     pub stopped: Option<String>,
+}
+
+/// The process's peak resident set size (bytes), from `VmHWM` in /proc/self/status; None
+/// where that file does not exist (not Linux) or lacks the line.
+pub fn peak_resident_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }

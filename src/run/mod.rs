@@ -452,6 +452,7 @@ fn drive<D: Dim>(
             .collect(),
         bytes_per_particle: world.bytes_per_particle(),
         bytes_per_node: crate::grid::Grid::<D>::bytes_per_node(),
+        peak_resident_bytes: crate::output::summary::peak_resident_bytes(),
         energies: world.energies(),
         expects: results,
         paths: reports::paths(&world, fracture.as_ref(), &state.history),
