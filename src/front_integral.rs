@@ -55,6 +55,9 @@ pub struct FrontIntegrals {
     pub radius: f64,
     /// Material of the particle nearest the vertex (None without particles in the tube).
     pub material: Option<u16>,
+    /// Whether a particle within a cell of the tube's surface has yielded: J is then taken
+    /// through plastic material and K (an elastic quantity) is not reported.
+    pub plastic: bool,
 }
 
 impl FrontIntegrals {
@@ -64,6 +67,7 @@ impl FrontIntegrals {
         j_volume: f64::NAN,
         k: [f64::NAN; 3],
         radius: 0.0,
+        plastic: false,
         material: None,
     };
 }
@@ -178,6 +182,8 @@ struct Sample {
     vol: f64,
     /// Coefficients of J and of modes I, II, III.
     c: [[f64; 3]; 4],
+    /// Whether the particle has yielded.
+    yielded: bool,
 }
 
 /// The actual fields at a particle, in the frame of its nearest front point.
@@ -193,9 +199,12 @@ struct Fields {
     /// Volume (m^3) and mass (kg).
     vol: f64,
     mass: f64,
-    /// Stress-work density of a plastic particle, elastic energy plus plastic work
-    /// (J/m^3); None for an elastic one, whose density is sigma : grad u / 2.
-    work: Option<f64>,
+    /// What plasticity adds to the stress-work density sigma : grad u / 2: the plastic work
+    /// less sigma : eps_p / 2, so that the density is the elastic energy plus the plastic
+    /// work (J/m^3; 0 for an elastic particle).
+    plastic: f64,
+    /// Whether the particle has yielded.
+    yielded: bool,
 }
 
 fn mv(m: &M3, v: [f64; 3]) -> [f64; 3] {
@@ -229,8 +238,7 @@ impl Sample {
                 f.vol * p(g1, s1, g2, s2, w, de1, e3) + inertia,
             ]
         };
-        let stored = f.work.unwrap_or_else(|| 0.5 * contract(&f.s, &f.gu));
-        let w = stored + 0.5 * f.mass / f.vol * dot(f.v, f.v);
+        let w = 0.5 * contract(&f.s, &f.gu) + f.plastic + 0.5 * f.mass / f.vol * dot(f.v, f.v);
         let col1 = |g: &M3| [g[0][0], g[1][0], g[2][0]];
         let mut c = [[0.0; 3]; 4];
         c[0] = coeffs(
@@ -256,6 +264,7 @@ impl Sample {
             s: place.s,
             vol: f.vol,
             c,
+            yielded: f.yielded,
         }
     }
 }
@@ -315,12 +324,20 @@ pub fn front_integrals(
     let mut r = tube.radius;
     while r >= tube.min_radius {
         if let Some((i, [j, j_volume])) = integrate(&samples, r, tube.length) {
+            let (band, len) = (tube.step, tube.length);
+            let plastic = samples.iter().any(|q| {
+                q.yielded
+                    && q.r < r
+                    && q.s.abs() < len
+                    && (q.r >= r - band || q.s.abs() >= len - band)
+            });
             return FrontIntegrals {
                 j,
                 j_volume,
                 k: el.k_of(i),
                 radius: r,
                 material: Some(material),
+                plastic,
             };
         }
         r -= tube.step;
@@ -478,9 +495,9 @@ fn gather(
             a: to_local(&at.e, accel(world, cracks, i)),
             vol: p.volume[i],
             mass: p.mass[i],
-            work: (!p.hardened.is_empty()).then(|| {
-                world.materials[p.material[i] as usize].energy_density(&st) + p.plastic_work(i)
-            }),
+            plastic: (p.plastic_strain.get(i))
+                .map_or(0.0, |ep| p.plastic_work(i) - 0.5 * st.ddot(&ep.to_sym3())),
+            yielded: p.hardened.get(i).is_some_and(|h| h.equivalent > 0.0),
         };
         out.push(Sample::new(&at, &fields, &elastic(p.material[i])));
     }
@@ -582,7 +599,8 @@ mod tests {
                         a: [0.0; 3],
                         vol: h * h * h,
                         mass: 0.0,
-                        work: None,
+                        plastic: 0.0,
+                        yielded: false,
                     };
                     out.push(Sample::new(&place, &fields, &el));
                 }

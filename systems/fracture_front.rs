@@ -147,6 +147,17 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                     k_opening,
                     domain: fi.radius,
                 };
+                // K comes from J only while the tube's surface runs through elastic material.
+                let row = if fi.plastic {
+                    TipResult {
+                        k: [f64::NAN; 3],
+                        k_interaction: [f64::NAN; 3],
+                        k_opening: [f64::NAN; 3],
+                        ..row
+                    }
+                } else {
+                    row
+                };
                 (row, path_rows)
             })
             .collect();
