@@ -99,14 +99,18 @@ pub struct TipResult {
     pub k_opening: [f64; 3],
     /// Radius of the interaction integral's domain (m); 0 when none fitted.
     pub domain: f64,
+    /// The crack's length along its polyline (m; 2D; NaN in 3D): it grows with the crack.
+    pub length: f64,
+    /// The tip's speed (m/s): 0 unless the crack grows at a set speed.
+    pub speed: f64,
 }
 
 impl TipResult {
     /// Number of [`TipResult::values`].
-    pub const VALUES: usize = 15;
+    pub const VALUES: usize = 17;
 
-    /// Position, J, the reported K, the interaction integral's and the opening split's K and
-    /// the domain radius, in fracture.csv's column order.
+    /// Position, J, the reported K, the interaction integral's and the opening split's K,
+    /// the domain radius, the crack length and the tip speed, in fracture.csv's column order.
     pub fn values(&self) -> [f64; Self::VALUES] {
         [
             self.x[0],
@@ -124,6 +128,8 @@ impl TipResult {
             self.k_opening[1],
             self.k_opening[2],
             self.domain,
+            self.length,
+            self.speed,
         ]
     }
 
@@ -146,6 +152,8 @@ impl TipResult {
             k_interaction: [v[8], v[9], v[10]],
             k_opening: [v[11], v[12], v[13]],
             domain: v[14],
+            length: v[15],
+            speed: v[16],
         }
     }
 }

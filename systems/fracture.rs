@@ -143,6 +143,11 @@ pub(crate) fn tip(
         k_interaction: [f64::NAN, f64::NAN, 0.0],
         k_opening: [f64::NAN, f64::NAN, 0.0],
         domain: 0.0,
+        length: path
+            .windows(2)
+            .map(|w| dist(xy(cracks.geometry.x[w[0]]), xy(cracks.geometry.x[w[1]])))
+            .sum(),
+        speed,
     };
 
     let Some(main) = contour_j(world, cracks, c, &path, xt, plan.contour, plan.area_term) else {
@@ -190,11 +195,7 @@ pub(crate) fn tip(
         .iter()
         .any(|f| f.crack == front.crack && f.end != front.end);
     if other_end {
-        let length: f64 = path
-            .windows(2)
-            .map(|w| dist(xy(cracks.geometry.x[w[0]]), xy(cracks.geometry.x[w[1]])))
-            .sum();
-        window = window.min(0.5 * length);
+        window = window.min(0.5 * res.length);
     }
     let [d_i, d_ii] = opening_amplitudes(cracks, &walk, end, xt, dir, h, window);
     let mat = &world.materials[world.particles.material[main.nearest] as usize];

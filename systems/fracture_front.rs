@@ -146,6 +146,8 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                     k_interaction: fi.k,
                     k_opening,
                     domain: fi.radius,
+                    length: f64::NAN,
+                    speed: 0.0,
                 };
                 // K comes from J only while the tube's surface runs through elastic material.
                 let row = if fi.plastic {

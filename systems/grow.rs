@@ -150,7 +150,8 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
             0.0
         };
         st.grown += grown;
-        st.speed = grown / over;
+        // A tip that stopped runs no more (its last move may carry it a cell past a surface).
+        st.speed = if st.stopped == 0 { grown / over } else { 0.0 };
         if let Some(c) = world.cracks.as_mut() {
             c.tips[f] = st;
         }

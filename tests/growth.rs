@@ -48,6 +48,17 @@ fn fatigue_cycles_follow_the_paris_law() {
     assert_eq!((g.crack.as_str(), g.tip.as_str()), ("edge", "end"));
     assert!(g.stopped.is_none());
     assert!((g.grown - 5.0e-4 * rows.len() as f64).abs() < 1e-12);
+    // fracture.csv's crack length grows by the length grown (the polyline also stretches
+    // with the body, by far less than 1 % of that).
+    let tips = &out.history.fracture;
+    let (first, last) = (tips.first().unwrap(), tips.last().unwrap());
+    assert!((first.length - 2.5e-3).abs() < 1e-9, "{}", first.length);
+    let grown = last.length - first.length;
+    assert!(
+        (grown - g.grown).abs() < 0.01 * g.grown,
+        "{grown} against {}",
+        g.grown
+    );
 }
 
 /// A tip running straight across the plate stops at the far surface, says so, and grows
@@ -68,6 +79,16 @@ fn a_tip_stops_at_the_free_surface() {
         g.x[0]
     );
     assert!(g.x[1].abs() < 1e-12, "straight on: {}", g.x[1]);
+    // fracture.csv's tip speed is the set speed while the tip runs, 0 before it starts and
+    // once it has stopped.
+    let speeds: Vec<f64> = out.history.fracture.iter().map(|t| t.speed).collect();
+    let running = |v: f64| (v - 2000.0).abs() < 1e-6;
+    assert!(speeds.iter().all(|&v| v == 0.0 || running(v)), "{speeds:?}");
+    assert!(
+        speeds[0] == 0.0 && running(speeds[speeds.len() / 2]),
+        "{speeds:?}"
+    );
+    assert_eq!(*speeds.last().unwrap(), 0.0, "stopped");
 }
 
 /// A tip carried past the surface beyond the grid's edge makes the run unstable, with a

@@ -98,7 +98,7 @@ impl Writers {
                     f,
                     "step,time,crack,tip,x,y,z,J1,J2,KI,KII,KIII,\
                      KI_interaction,KII_interaction,KIII_interaction,\
-                     KI_opening,KII_opening,KIII_opening,domain"
+                     KI_opening,KII_opening,KIII_opening,domain,length,speed"
                 )?;
                 Some((f, names.to_vec()))
             }

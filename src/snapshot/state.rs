@@ -314,14 +314,24 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
         .collect();
     let tip_steps: Vec<u64> = r.column_any("history.fracture.step")?;
     let tip_ids: Vec<u64> = r.column("history.fracture.tip", tip_steps.len())?;
-    let data: Vec<f64> = r.column("history.fracture.data", tip_steps.len() * TIP_WIDTH)?;
+    // A snapshot from a build without the length and speed columns has two values fewer
+    // per row: the length is then unknown and the tip was still.
+    let data: Vec<f64> = r.column_any("history.fracture.data")?;
+    let width = [TIP_WIDTH, TIP_WIDTH - 2]
+        .into_iter()
+        .find(|w| data.len() == tip_steps.len() * w)
+        .ok_or_else(|| r.invalid("history.fracture.data: rows of an unknown width"))?;
     history.fracture = tip_steps
         .iter()
         .zip(&tip_ids)
-        .zip(data.chunks_exact(TIP_WIDTH))
+        .zip(data.chunks_exact(width))
         .map(|((&step, &id), d)| {
-            let v = d[1..].try_into().expect("chunks of TIP_WIDTH");
-            TipResult::from_values(step, d[0], (id >> 32) as u32, id as u32, v)
+            let mut v = [f64::NAN; TipResult::VALUES];
+            v[..width - 1].copy_from_slice(&d[1..]);
+            if width < TIP_WIDTH {
+                v[TipResult::VALUES - 1] = 0.0;
+            }
+            TipResult::from_values(step, d[0], (id >> 32) as u32, id as u32, &v)
         })
         .collect();
     let path_steps: Vec<u64> = r.column_any("history.paths.step")?;
