@@ -521,7 +521,8 @@ fn drive<D: Dim>(
 }
 
 /// K_I and K_II over time at every tip, with each K expect's reference (a flat line, or a
-/// curve through the references at given times); divided by `k0` when given.
+/// curve through the references at given times); divided by `k0` when given. When a crack
+/// grows, a panel below draws the crack lengths.
 fn plot_fracture(
     path: &Path,
     name: &str,
@@ -584,14 +585,34 @@ fn plot_fracture(
             },
         }
     }
-    k_plot(
-        path,
-        &format!("{name}: stress intensity factors"),
-        "time (s)",
-        &labels,
-        points,
-        k0,
-    )
+    let title = format!("{name}: stress intensity factors");
+    if h.growth.is_empty() {
+        return k_plot(path, &title, "time (s)", &labels, points, k0);
+    }
+    // A growing crack: its length below K, on the same time axis.
+    let length_labels: Vec<String> = (tips.iter())
+        .map(|&(c, tip)| format!("length {}", label(c, tip)))
+        .collect();
+    let lengths = (tips.iter())
+        .map(|&(c, tip)| {
+            (h.fracture.iter())
+                .filter(|t| (t.crack, t.tip) == (c, tip))
+                .map(|t| (t.time, t.length))
+                .collect()
+        })
+        .collect();
+    let axis = k_axis(k0);
+    let panels = [
+        Panel {
+            y_label: &axis,
+            series: series(&labels, points),
+        },
+        Panel {
+            y_label: "crack length (m)",
+            series: series(&length_labels, lengths),
+        },
+    ];
+    plot::panels(path, &title, "time (s)", &panels, 0.62)
 }
 
 /// Draws K series (over `k0` when given, which the y axis then says) into a PNG.
@@ -603,19 +624,26 @@ fn k_plot(
     points: Vec<Vec<(f64, f64)>>,
     k0: Option<f64>,
 ) -> Result<(), String> {
-    let series: Vec<Series> = labels
-        .iter()
-        .zip(points)
+    let series = series(labels, points);
+    plot::lines(path, title, x_label, &k_axis(k0), &series)
+}
+
+/// The K axis's label: K, or K over `k0` when given.
+fn k_axis(k0: Option<f64>) -> String {
+    match k0 {
+        Some(k0) => format!("K / K0 (K0 = {k0:.4e} Pa sqrt(m))"),
+        None => "K (Pa sqrt(m))".to_string(),
+    }
+}
+
+/// Series from labels and their points.
+fn series(labels: &[String], points: Vec<Vec<(f64, f64)>>) -> Vec<Series<'_>> {
+    (labels.iter().zip(points))
         .map(|(l, p)| Series {
             label: l,
             points: p,
         })
-        .collect();
-    let axis = match k0 {
-        Some(k0) => format!("K / K0 (K0 = {k0:.4e} Pa sqrt(m))"),
-        None => "K (Pa sqrt(m))".to_string(),
-    };
-    plot::lines(path, title, x_label, &axis, &series)
+        .collect()
 }
 
 /// K_I, K_II and K_III along every 3D crack front at the last measurement, against the
