@@ -370,8 +370,9 @@ fn plots(csv: &Path, vary: &[Vary], expects: &[String], out: &Path) -> anyhow::R
 }
 
 /// sweep_<k>_cell.png when `grid.cell` (key `c`) is swept: expect k's error against the
-/// cell size on log-log axes, one curve per setting of the other keys, with the fitted
-/// order of convergence in its label.
+/// cell size on log-log axes, one curve per setting of the other keys (those given one
+/// value are the same on every curve and left out of the labels), with the fitted order
+/// of convergence in its label.
 fn convergence(
     rows: &[Vec<String>],
     vary: &[Vary],
@@ -382,7 +383,7 @@ fn convergence(
     let keys = vary.len();
     let others = |r: &[String]| -> String {
         (0..keys)
-            .filter(|&j| j != c)
+            .filter(|&j| j != c && vary[j].values.len() > 1)
             .map(|j| format!("{}={}", vary[j].key, r.get(j).map_or("", String::as_str)))
             .collect::<Vec<_>>()
             .join(" ")
