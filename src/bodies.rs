@@ -10,12 +10,15 @@ pub enum Geometry {
         /// Upper corner (m).
         max: [f64; 3],
     },
-    /// Disc (2D, ignores z) or sphere (3D).
+    /// Disc (2D, ignores z) or sphere (3D), hollow (a ring, a spherical shell) when
+    /// `inner` > 0.
     Round {
         /// Centre (m).
         center: [f64; 3],
         /// Radius (m).
         radius: f64,
+        /// Radius of the hole (m), 0 for a full disc or sphere.
+        inner: f64,
         /// Whether z counts (sphere).
         sphere: bool,
     },
@@ -49,10 +52,12 @@ impl Geometry {
             Geometry::Round {
                 center,
                 radius,
+                inner,
                 sphere,
             } => {
                 let n = if *sphere { 3 } else { 2 };
-                (0..n).map(|a| (x[a] - center[a]).powi(2)).sum::<f64>() <= radius * radius
+                let r2: f64 = (0..n).map(|a| (x[a] - center[a]).powi(2)).sum();
+                r2 <= radius * radius && r2 >= inner * inner
             }
             Geometry::Cylinder {
                 center,
@@ -87,6 +92,7 @@ impl Geometry {
                 center,
                 radius,
                 sphere,
+                ..
             } => {
                 let mut lo = *center;
                 let mut hi = *center;
@@ -199,18 +205,22 @@ pub fn fill(
 mod tests {
     use super::*;
 
-    /// A filled disc's particle count times the particle area approaches pi r^2.
+    /// A filled disc's or ring's particle count times the particle area approaches
+    /// pi (r^2 - r_i^2).
     #[test]
     fn disc_fill_area_converges() {
-        let g = Geometry::Round {
-            center: [0.5, 0.5, 0.0],
-            radius: 0.3,
-            sphere: false,
-        };
-        let pts = fill(&g, 2, [0.0; 3], [0.01, 0.01, 1.0], [100, 100, 1], 2);
-        let area = pts.len() as f64 * 0.005 * 0.005;
-        let exact = std::f64::consts::PI * 0.09;
-        assert!((area - exact).abs() / exact < 2e-3, "{area} vs {exact}");
+        for inner in [0.0, 0.1] {
+            let g = Geometry::Round {
+                center: [0.5, 0.5, 0.0],
+                radius: 0.3,
+                inner,
+                sphere: false,
+            };
+            let pts = fill(&g, 2, [0.0; 3], [0.01, 0.01, 1.0], [100, 100, 1], 2);
+            let area = pts.len() as f64 * 0.005 * 0.005;
+            let exact = std::f64::consts::PI * (0.09 - inner * inner);
+            assert!((area - exact).abs() / exact < 2e-3, "{area} vs {exact}");
+        }
     }
 
     #[test]

@@ -27,6 +27,9 @@ pub enum ProbeQty {
     /// initially beyond the probe's centroid on that axis minus that of those short of it;
     /// across a crack, a clip gauge (e.g. the crack-mouth opening, CMOD).
     Opening,
+    /// Largest initial distance (m) from the probe's centre of a particle that has yielded
+    /// (0 while none has): the radius of a plastic zone spreading from a bore or a load.
+    PlasticRadius,
 }
 
 /// Average of one component over a fixed particle set.
@@ -40,15 +43,18 @@ pub struct Probe {
     pub qty: ProbeQty,
     /// Component index (0..3 for vectors, 0..6 in xx, yy, zz, yz, xz, xy order for tensors).
     pub comp: usize,
-    /// Initial centroid of the particles (m).
+    /// Initial centroid of the particles (m); for a plastic radius, the centre of its disc
+    /// or ball region.
     pub centre: [f64; 3],
 }
 
 impl Probe {
     /// Current average.
     pub fn sample<D: Dim>(&self, p: &Particles<D>, materials: &[Material]) -> f64 {
-        if self.qty == ProbeQty::Opening {
-            return self.opening(p);
+        match self.qty {
+            ProbeQty::Opening => return self.opening(p),
+            ProbeQty::PlasticRadius => return self.plastic_radius(p),
+            _ => {}
         }
         let mut sum = 0.0;
         for &i in &self.particles {
@@ -66,7 +72,9 @@ impl Probe {
                     };
                     strain.to_array()[self.comp]
                 }
-                ProbeQty::Opening => unreachable!("sampled by `opening`"),
+                ProbeQty::Opening | ProbeQty::PlasticRadius => {
+                    unreachable!("sampled by their own methods")
+                }
             };
         }
         sum / self.particles.len() as f64
@@ -84,6 +92,20 @@ impl Probe {
         }
         let mean = |(sum, n): (f64, usize)| sum / n as f64;
         mean(sides[1]) - mean(sides[0])
+    }
+
+    /// The [`ProbeQty::PlasticRadius`] sample; 0 in a scene without plastic columns.
+    fn plastic_radius<D: Dim>(&self, p: &Particles<D>) -> f64 {
+        let mut radius = 0.0f64;
+        for &i in &self.particles {
+            let i = i as usize;
+            if p.hardened.get(i).is_some_and(|h| h.equivalent > 0.0) {
+                let x = D::to_xyz(p.x0[i]);
+                let d = [0, 1, 2].map(|a| x[a] - self.centre[a]);
+                radius = radius.max((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt());
+            }
+        }
+        radius
     }
 }
 
@@ -172,8 +194,13 @@ impl Along {
 /// What an expect measures.
 #[derive(Clone, Debug)]
 pub enum Measure {
-    /// Last sample of a probe.
-    Final(usize),
+    /// Last sample of a probe, or its last sample at or before time `at` (s).
+    Final {
+        /// The probe.
+        probe: usize,
+        /// The time, if not the end.
+        at: Option<f64>,
+    },
     /// Largest sample of a probe.
     Max(usize),
     /// Smallest sample of a probe.
@@ -354,7 +381,11 @@ impl Expect {
 fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
     let finite = |v: f64| v.is_finite().then_some(v);
     match *m {
-        Measure::Final(p) => h.probes[p].last().copied().and_then(finite),
+        Measure::Final { probe, at } => {
+            let samples = &h.probes[probe];
+            let k = at.map_or(samples.len(), |t| h.time.partition_point(|&s| s <= t));
+            samples[..k].last().copied().and_then(finite)
+        }
         Measure::Tip {
             crack,
             tip,
@@ -667,6 +698,22 @@ pub fn path_difference(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `final` at a time reads the last sample at or before it; before the first sample
+    /// there is none.
+    #[test]
+    fn final_at_a_time_reads_the_sample_then() {
+        let h = History {
+            time: vec![0.0, 1.0, 2.0, 3.0],
+            probes: vec![vec![10.0, 11.0, 12.0, 13.0]],
+            ..History::default()
+        };
+        let at = |at| measure(&Measure::Final { probe: 0, at }, &h, &[]);
+        assert_eq!(at(None), Some(13.0));
+        assert_eq!(at(Some(2.0)), Some(12.0));
+        assert_eq!(at(Some(2.5)), Some(12.0));
+        assert_eq!(at(Some(-1.0)), None);
+    }
 
     /// A front expect with a reference varying as cos(theta) about a ring's centre reads
     /// the reference plus the largest departure from it, at whichever vertex that is, or at

@@ -155,7 +155,8 @@ fn a_scene_too_large_for_memory_is_refused_at_once() {
     }
 }
 
-/// A body with no particle, also once clipped, and a tube whose bore is not inside it.
+/// A body with no particle, also once clipped, and a tube or ring whose hole is not inside
+/// it.
 #[test]
 fn empty_body() {
     let e = error_with(&["body[0].box.max=[0.0045, 0.0045]"]);
@@ -167,6 +168,11 @@ fn empty_body() {
          axis = \"z\", radius = 0.003, inner_radius = 0.003, length = 0.01 }\n",
     );
     assert_error(&e, "body[1].cylinder.inner_radius", None, "bore's radius");
+    let e = error_with_text(
+        "[[body]]\nmaterial = \"steel\"\ndisc = { center = [0.01, 0.01], radius = 0.003, \
+         inner_radius = -0.001 }\n",
+    );
+    assert_error(&e, "body[1].disc.inner_radius", None, "hole's radius");
 }
 
 #[test]
@@ -276,7 +282,7 @@ fn bad_fracture_requests_name_the_key() {
     let e = error_with_text(&expect("quantity = \"KI\"\nat = 1.0\n"));
     assert_error(&e, "expect[0].at", None, "must lie in the run");
     let e = error_with_text(&expect("quantity = \"max\"\nat = 1e-5\n"));
-    assert_error(&e, "expect[0].at", None, "applies to KI");
+    assert_error(&e, "expect[0].at", None, "applies to final");
     let e = error_with_text(&expect("quantity = \"K_drift\"\n"));
     assert_error(&e, "expect[0].from", None, "give its start");
     let e = error_with_text(&expect("quantity = \"KI\"\nfrom = 1e-5\n"));
@@ -346,7 +352,21 @@ fn bad_loads_name_the_key() {
     let e = error_with_text(&format!(
         "[[load]]\n{region}force = [1.0, 0.0]\nnormal = [1.0, 0.0]\n"
     ));
-    assert_error(&e, "load[0].normal", None, "traction field");
+    assert_error(&e, "load[0].normal", None, "goes with a traction");
+    let pressure = |p: &str| error_with_text(&format!("[[load]]\n{region}pressure = {p}\n"));
+    let e = pressure("{ value = nan }");
+    assert_error(&e, "load[0].pressure.value", None, "finite");
+    let e = pressure("{ value = 1e6 }");
+    assert_error(&e, "load[0].normal", None, "outward normal");
+    let e = pressure("{ value = 1e6, center = [0.01, 0.01] }");
+    assert_error(&e, "load[0].pressure.face", None, "\"inner\"");
+    let e = pressure("{ value = 1e6, face = \"inner\" }\nnormal = [1.0, 0.0]");
+    assert_error(&e, "load[0].pressure.face", None, "round face's `center`");
+    let e =
+        pressure("{ value = 1e6, center = [0.01, 0.01], face = \"outer\" }\nnormal = [1.0, 0.0]");
+    assert_error(&e, "load[0].normal", None, "leave out `normal`");
+    let e = pressure(&format!("{{ value = 1e6 }}\nnormal = [1.0, 0.0]\n{field}"));
+    assert_error(&e, "load[0].pressure", None, "give one traction");
 }
 
 #[test]
@@ -370,6 +390,12 @@ fn bad_regions_name_the_key() {
     assert_error(&e, "load[0].region", None, "exactly one shape");
     let e = load("{ center = [0.03, 0.03], half = [0.001, 0.001], angle = 45.0 }");
     assert_error(&e, "load[0].region", None, "no particle");
+    let e = load("{ center = [0.01, 0.01], radius = -0.001 }");
+    assert_error(&e, "load[0].region.radius", None, "positive");
+    let e = load("{ center = [0.01, 0.01], radius = 0.001, half = [0.001, 0.001] }");
+    assert_error(&e, "load[0].region", None, "not both");
+    let e = load("{ min = [0.005, 0.005], max = [0.01, 0.01], radius = 0.001 }");
+    assert_error(&e, "load[0].region.radius", None, "`center`");
 }
 
 /// `GOOD` in 3D (a 12 mm cube in a 20 mm grid) with `extra` appended, and its error.
@@ -838,4 +864,30 @@ fn opening_probe_needs_both_sides() {
                  quantity = \"opening\"\ncomponent = \"x\"\n";
     let e = refused(&format!("{GOOD}{probe}"));
     assert_error(&e, "probe[0].region", Some(20), "both sides");
+}
+
+/// A plastic radius needs a plastic material and a disc region, and has no component;
+/// every other probe needs its component.
+#[test]
+fn plastic_radius_probes_are_checked() {
+    let probe = |region: &str, extra: &str| {
+        format!(
+            "[[probe]]\nname = \"zone\"\nregion = {region}\nquantity = \"plastic_radius\"\n{extra}"
+        )
+    };
+    let disc = "{ center = [0.01, 0.01], radius = 0.005 }";
+    let plastic = plastic_steel("model = \"j2\"\nsigma_y = 250e6\nH = 0.0\n");
+    let e = refused(&format!("{GOOD}{}", probe(disc, "")));
+    assert_error(&e, "probe[0].quantity", None, "plastic material");
+    let e = refused(&format!(
+        "{plastic}{}",
+        probe("{ min = [0.004, 0.004], max = [0.016, 0.016] }", "")
+    ));
+    assert_error(&e, "probe[0].region", None, "disc or ball");
+    let e = refused(&format!("{plastic}{}", probe(disc, "component = \"x\"\n")));
+    assert_error(&e, "probe[0].component", None, "no component");
+    let e = refused(&format!(
+        "{GOOD}[[probe]]\nname = \"u\"\nregion = {disc}\nquantity = \"displacement\"\n"
+    ));
+    assert_error(&e, "probe[0].component", None, "give the probed component");
 }

@@ -1,7 +1,7 @@
 //! Building a World from a parsed scenario, validating every value on the way.
 
-use super::region::region;
-use super::schema::{BodySpec, BoxSpec, RegionSpec};
+use super::region::{Region, region};
+use super::schema::{BodySpec, BoxSpec, RegionSpec, RoundSpec};
 use super::source::Source;
 use super::traction::{Face, Field, tractions};
 use crate::bodies::{Geometry, fill};
@@ -410,25 +410,26 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         if let Some(msg) = l.time.check() {
             return Err(src.error(&key("time"), msg));
         }
-        let forces = match (&l.force, Field::of(src, &key, l)?) {
+        let forces = match (&l.force, Field::of::<D>(src, &key, l)?) {
             (Some(f), None) => {
                 if l.normal.is_some() {
-                    return Err(src.error(&key("normal"), "`normal` goes with a traction field"));
+                    return Err(src.error(&key("normal"), "`normal` goes with a traction"));
                 }
                 let f = vec3::<D>(src, &key("force"), f)?;
                 vec![to_vec::<D>(f.map(|c| c / sel.len() as f64)); sel.len()]
             }
             (None, Some(field)) => {
-                let face = Face::new::<D>(src, &key, l.normal.as_deref(), geom.h)?;
+                let face = Face::new::<D>(src, &key, l, geom.h)?;
                 tractions(src, &face, &field, &sel, &particles, &ppc)?
             }
             (Some(_), Some(_)) => {
-                return Err(src.error(&key("force"), "give a force or a traction field, not both"));
+                return Err(src.error(&key("force"), "give a force or a traction, not both"));
             }
             (None, None) => {
                 return Err(src.error(
                     &format!("load[{i}]"),
-                    "give `force` (total N), or a traction field: `williams` or `centre_crack`",
+                    "give `force` (total N), or a traction: `pressure`, `williams` or \
+                     `centre_crack`",
                 ));
             }
         };
@@ -453,28 +454,39 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             "stress" => ProbeQty::Stress,
             "strain" => ProbeQty::Strain,
             "opening" => ProbeQty::Opening,
+            "plastic_radius" => ProbeQty::PlasticRadius,
             other => {
                 return Err(src.error(
                     &key("quantity"),
                     format!(
                         "unknown quantity `{other}` (displacement, velocity, position, stress, \
-                         strain, opening)"
+                         strain, opening, plastic_radius)"
                     ),
                 ));
             }
         };
-        let comp = if matches!(qty, ProbeQty::Stress | ProbeQty::Strain) {
-            ["xx", "yy", "zz", "yz", "xz", "xy"]
+        let component = match (&p.component, qty) {
+            (None, ProbeQty::PlasticRadius) => None,
+            (Some(_), ProbeQty::PlasticRadius) => {
+                return Err(src.error(&key("component"), "a plastic radius has no component"));
+            }
+            (Some(c), _) => Some(c.as_str()),
+            (None, _) => {
+                return Err(src.error(&key("component"), "give the probed component"));
+            }
+        };
+        let comp = match (component, qty) {
+            (None, _) => 0,
+            (Some(c), ProbeQty::Stress | ProbeQty::Strain) => ["xx", "yy", "zz", "yz", "xz", "xy"]
                 .iter()
-                .position(|c| *c == p.component)
+                .position(|t| *t == c)
                 .ok_or_else(|| {
                     src.error(
                         &key("component"),
                         "tensor component must be xx, yy, zz, yz, xz or xy",
                     )
-                })?
-        } else {
-            axis_index::<D>(src, &key("component"), &p.component)?
+                })?,
+            (Some(c), _) => axis_index::<D>(src, &key("component"), c)?,
         };
         let sel = select(&key("region"), &p.region)?;
         let mut centre = [0.0; 3];
@@ -482,6 +494,24 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             let x = D::to_xyz(particles.x[q as usize]);
             for a in 0..3 {
                 centre[a] += x[a] / sel.len() as f64;
+            }
+        }
+        if qty == ProbeQty::PlasticRadius {
+            if !materials.iter().any(|m| m.j2.is_some()) {
+                return Err(src.error(
+                    &key("quantity"),
+                    "a plastic radius needs a plastic material (model = \"j2\")",
+                ));
+            }
+            match region::<D>(src, &key("region"), &p.region)? {
+                Region::Round { center, .. } => centre = center,
+                _ => {
+                    return Err(src.error(
+                        &key("region"),
+                        "a plastic radius is measured from the centre of a disc or ball \
+                         region: give `center` and `radius`",
+                    ));
+                }
             }
         }
         if qty == ProbeQty::Opening {
@@ -494,7 +524,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     format!(
                         "an opening probe needs particles on both sides of its region's \
                          centroid along {}: this region has them on one side",
-                        p.component
+                        component.unwrap_or_default()
                     ),
                 ));
             }
@@ -607,8 +637,17 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             });
             continue;
         }
-        if e.at.is_some() {
-            return Err(src.error(&key("at"), "`at` applies to KI, KII, J1 and J2"));
+        if let Some(at) = e.at {
+            let end = src.scenario.simulation.duration;
+            if e.quantity != "final" {
+                return Err(src.error(&key("at"), "`at` applies to final, KI, KII, J1 and J2"));
+            }
+            if !(0.0..=end).contains(&at) {
+                return Err(src.error(
+                    &key("at"),
+                    format!("the time must lie in the run, 0 to {end:.4e} s"),
+                ));
+            }
         }
         if e.length.is_some() {
             return Err(src.error(&key("length"), "`length` applies to cycles"));
@@ -640,7 +679,10 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             ));
         }
         let measure = match e.quantity.as_str() {
-            "final" => Measure::Final(ids[0]),
+            "final" => Measure::Final {
+                probe: ids[0],
+                at: e.at,
+            },
             "max" => Measure::Max(ids[0]),
             "min" => Measure::Min(ids[0]),
             "frequency" => Measure::Frequency(ids[0]),
@@ -795,6 +837,21 @@ fn checkpoint_plan(src: &Source) -> R<CheckpointPlan> {
     })
 }
 
+/// The radius of a ring's or a spherical shell's hole: in [0, radius) (m).
+fn hole(src: &Source, key: &str, round: &RoundSpec) -> R<f64> {
+    if (0.0..round.radius).contains(&round.inner_radius) {
+        Ok(round.inner_radius)
+    } else {
+        Err(src.error(
+            key,
+            format!(
+                "the hole's radius must lie in [0, radius = {:e}) m",
+                round.radius
+            ),
+        ))
+    }
+}
+
 /// The geometry of body `b`, from exactly one geometry key.
 fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
     let key = |k: &str| format!("body[{b}].{k}");
@@ -822,6 +879,7 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
         return Ok(Geometry::Round {
             center: vec3::<D>(src, &key("disc.center"), &d.center)?,
             radius: positive(src, &key("disc.radius"), d.radius, "m")?,
+            inner: hole(src, &key("disc.inner_radius"), d)?,
             sphere: false,
         });
     }
@@ -832,6 +890,7 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
         return Ok(Geometry::Round {
             center: vec3::<D>(src, &key("sphere.center"), &s.center)?,
             radius: positive(src, &key("sphere.radius"), s.radius, "m")?,
+            inner: hole(src, &key("sphere.inner_radius"), s)?,
             sphere: true,
         });
     }

@@ -1,5 +1,5 @@
 //! Regions that boundaries, loads and probes select nodes or particles with: axis-aligned
-//! boxes, polygons (2D), oriented boxes and half-spaces, so that a specimen rotated in the
+//! boxes, polygons (2D), oriented boxes, discs or balls and half-spaces, so that a specimen rotated in the
 //! grid is as easy to describe as an aligned one.
 
 use super::build::vec3;
@@ -26,6 +26,8 @@ pub(super) enum Region {
         axes: [[f64; 3]; 3],
         half: [f64; 3],
     },
+    /// The points within `radius` of `center` (a disc in 2D, a ball in 3D).
+    Round { center: [f64; 3], radius: f64 },
     /// The points on the side of the plane through `point` that the unit `normal` points to.
     HalfSpace { point: [f64; 3], normal: [f64; 3] },
 }
@@ -54,6 +56,10 @@ impl Region {
             Region::Oriented { center, axes, half } => {
                 let d = sub(x, *center);
                 (0..dims).all(|a| dot(d, axes[a]).abs() <= half[a] + tol)
+            }
+            Region::Round { center, radius } => {
+                let d = sub(x, *center);
+                dot(d, d).sqrt() <= radius + tol
             }
             Region::HalfSpace { point, normal } => dot(sub(x, *point), *normal) >= -tol,
         }
@@ -125,9 +131,12 @@ pub(super) fn region<D: Dim>(src: &Source, key: &str, r: &RegionSpec) -> R<Regio
         return Err(src.error(
             key,
             "give exactly one shape: `min` and `max` (a box), `polygon` (2D), `center` with \
-             `half` and `angle` (2D) or `axes` (3D) (an oriented box), or `point` with `normal` \
-             (a half-space)",
+             `half` and `angle` (2D) or `axes` (3D) (an oriented box), `center` with `radius` \
+             (a disc or ball), or `point` with `normal` (a half-space)",
         ));
+    }
+    if r.radius.is_some() && r.center.is_none() {
+        return Err(src.error(&k("radius"), "a disc or ball needs its `center` too"));
     }
     if let (Some(min), Some(max)) = (&r.min, &r.max) {
         let lo = vec3::<D>(src, &k("min"), min)?;
@@ -145,6 +154,19 @@ pub(super) fn region<D: Dim>(src: &Source, key: &str, r: &RegionSpec) -> R<Regio
     }
     if let Some(c) = &r.center {
         let center = vec3::<D>(src, &k("center"), c)?;
+        if let Some(radius) = r.radius {
+            if r.half.is_some() || r.angle.is_some() || r.axes.is_some() {
+                return Err(src.error(
+                    key,
+                    "give `radius` (a disc or ball) or `half` with `angle` or `axes` (an \
+                     oriented box), not both",
+                ));
+            }
+            if !(radius.is_finite() && radius > 0.0) {
+                return Err(src.error(&k("radius"), "the radius must be positive (m)"));
+            }
+            return Ok(Region::Round { center, radius });
+        }
         let half = vec3::<D>(
             src,
             &k("half"),

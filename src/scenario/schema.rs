@@ -140,7 +140,8 @@ pub struct BoxSpec {
 /// A region of boundary nodes, loaded particles or probed particles (m). Exactly one shape:
 /// `min` and `max` (an axis-aligned box, inclusive); `polygon` (2D); `center`, `half` and
 /// `angle` (2D, degrees from +x) or `axes` (3D, the first two axis directions) (an
-/// oriented box); `point` and `normal` (the half-space the normal points into).
+/// oriented box); `center` and `radius` (a disc in 2D, a ball in 3D); `point` and `normal`
+/// (the half-space the normal points into).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RegionSpec {
@@ -150,8 +151,10 @@ pub struct RegionSpec {
     pub max: Option<Vec<f64>>,
     /// Polygon vertices [[x, y], ...], either winding, not crossing itself.
     pub polygon: Option<Vec<Vec<f64>>>,
-    /// Centre of an oriented box.
+    /// Centre of an oriented box, disc or ball.
     pub center: Option<Vec<f64>>,
+    /// Radius of a disc (2D) or ball (3D).
+    pub radius: Option<f64>,
     /// Half-sizes of an oriented box along its axes.
     pub half: Option<Vec<f64>>,
     /// 2D oriented box: angle of its first axis, degrees from +x.
@@ -164,7 +167,7 @@ pub struct RegionSpec {
     pub normal: Option<Vec<f64>>,
 }
 
-/// A disc (2D) or sphere (3D).
+/// A disc (2D) or sphere (3D), or a ring or spherical shell when `inner_radius` is given.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RoundSpec {
@@ -172,6 +175,9 @@ pub struct RoundSpec {
     pub center: Vec<f64>,
     /// Radius (m).
     pub radius: f64,
+    /// Radius of the hole (m); default 0, a full disc or sphere.
+    #[serde(default)]
+    pub inner_radius: f64,
 }
 
 /// A 3D circular cylinder, or a tube when `inner_radius` is given.
@@ -421,7 +427,9 @@ pub struct BoundarySpec {
 }
 
 /// `[[load]]`: on the particles initially inside a region, either a total force spread
-/// equally (`force`) or the traction of a stress field on a face (`williams` + `normal`).
+/// equally (`force`) or a traction on a face: a `pressure`, or the stress of a closed-form
+/// field (`williams`, `centre_crack`), with the face's outward `normal` or, for a pressure,
+/// a round face's centre.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSpec {
@@ -429,6 +437,8 @@ pub struct LoadSpec {
     pub region: RegionSpec,
     /// Total force (N).
     pub force: Option<Vec<f64>>,
+    /// A uniform pressure on a face.
+    pub pressure: Option<PressureSpec>,
     /// Traction of the near-tip (Williams) stress field, 2D only.
     pub williams: Option<WilliamsSpec>,
     /// Traction of the exact field of a centre crack in an infinite plate, 2D only.
@@ -438,6 +448,19 @@ pub struct LoadSpec {
     /// Time multiplier.
     #[serde(default)]
     pub time: TimeFn,
+}
+
+/// A uniform pressure on a planar face (the load's `normal`) or on a circle (2D) or sphere
+/// (3D) about `center`, such as a bore.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PressureSpec {
+    /// Pressure (Pa); positive pushes on the face, against its outward normal.
+    pub value: f64,
+    /// Centre of a round face (m).
+    pub center: Option<Vec<f64>>,
+    /// Which side of the loaded layer a round face is: "inner" (a bore) or "outer".
+    pub face: Option<String>,
 }
 
 /// The leading (Williams / Irwin) term of the stress field around a crack tip.
@@ -465,11 +488,13 @@ pub struct ProbeSpec {
     pub name: String,
     /// Particles initially inside this region are averaged.
     pub region: RegionSpec,
-    /// "displacement", "velocity", "position", "stress", "strain" or "opening" (the mean
-    /// displacement beyond the region's centroid minus that short of it, along `component`).
+    /// "displacement", "velocity", "position", "stress", "strain", "opening" (the mean
+    /// displacement beyond the region's centroid minus that short of it, along `component`)
+    /// or "plastic_radius" (on a disc or ball region: the largest initial distance from its
+    /// centre of a particle that has yielded; no component).
     pub quantity: String,
     /// "x", "y", "z" for vectors; "xx", "yy", "zz", "yz", "xz", "xy" for tensors.
-    pub component: String,
+    pub component: Option<String>,
 }
 
 /// A straight crack in an infinite plate under a uniform remote stress.
@@ -593,7 +618,8 @@ pub struct ExpectSpec {
     pub crack: Option<String>,
     /// Tip of that crack: "start" or "end" (default "end").
     pub tip: Option<String>,
-    /// For KI, KII, J1, J2: the value at this time (s) instead of the last one.
+    /// For final, KI, KII, J1, J2: the value at this time (s) instead of the last one (a
+    /// probe: its last sample at or before it).
     pub at: Option<f64>,
     /// For K_drift, kinetic_fraction and slope: the start of the window (s).
     pub from: Option<f64>,

@@ -1,8 +1,8 @@
-//! Traction loads: the stress of a closed-form 2D field applied on a body face, as a force
-//! on each face particle.
+//! Traction loads: a pressure, or the stress of a closed-form 2D field, applied on a body
+//! face (planar, or a circle or sphere about a centre) as a force on each face particle.
 
 use super::build::{to_vec, vec3};
-use super::schema::LoadSpec;
+use super::schema::{LoadSpec, PressureSpec};
 use super::source::Source;
 use crate::dim::Dim;
 use crate::error::ScenarioError;
@@ -12,8 +12,10 @@ use crate::particles::Particles;
 
 type R<T> = Result<T, ScenarioError>;
 
-/// A closed-form plane stress field, in global axes.
+/// A stress field on a face, in global axes.
 pub(super) enum Field {
+    /// A uniform pressure (Pa): the stress -p I, so the traction is -p n.
+    Pressure(f64),
     /// Williams near-tip field: K_I, K_II (Pa sqrt(m)), tip (m), crack direction (rad).
     Williams {
         k: [f64; 2],
@@ -32,12 +34,40 @@ pub(super) enum Field {
 
 impl Field {
     /// The field a `[[load]]` names, if any (at most one).
-    pub fn of(src: &Source, key: &dyn Fn(&str) -> String, l: &LoadSpec) -> R<Option<Field>> {
+    pub fn of<D: Dim>(
+        src: &Source,
+        key: &dyn Fn(&str) -> String,
+        l: &LoadSpec,
+    ) -> R<Option<Field>> {
+        let named = [
+            l.pressure.is_some(),
+            l.williams.is_some(),
+            l.centre_crack.is_some(),
+        ];
+        if named.iter().filter(|&&n| n).count() > 1 {
+            return Err(src.error(
+                &key("pressure"),
+                "give one traction: `pressure`, `williams` or `centre_crack`",
+            ));
+        }
+        if let Some(p) = &l.pressure {
+            if !p.value.is_finite() {
+                return Err(src.error(&key("pressure.value"), "the pressure must be finite (Pa)"));
+            }
+            return Ok(Some(Field::Pressure(p.value)));
+        }
+        if D::D != 2 && (l.williams.is_some() || l.centre_crack.is_some()) {
+            return Err(src.error(
+                &key(if l.williams.is_some() {
+                    "williams"
+                } else {
+                    "centre_crack"
+                }),
+                "the williams and centre_crack fields are 2D only",
+            ));
+        }
         match (&l.williams, &l.centre_crack) {
-            (Some(_), Some(_)) => Err(src.error(
-                &key("centre_crack"),
-                "give one traction field: `williams` or `centre_crack`",
-            )),
+            (Some(_), Some(_)) => unreachable!("checked above"),
             (Some(w), None) => {
                 if !(w.k1.is_finite() && w.k2.is_finite() && w.direction.is_finite()) {
                     return Err(src.error(
@@ -82,8 +112,18 @@ impl Field {
         }
     }
 
-    /// Global stress at `x`, or None where the field is singular (a tip, a crack face).
-    fn stress(&self, x: [f64; 2]) -> Option<[f64; 3]> {
+    /// Traction on the face with outward unit normal `n` at `x`, or None where the field
+    /// is singular (a tip, a crack face).
+    fn traction(&self, x: [f64; 3], n: [f64; 3]) -> Option<[f64; 3]> {
+        if let Field::Pressure(p) = self {
+            return Some(n.map(|c| -p * c));
+        }
+        let [sxx, syy, sxy] = self.plane_stress([x[0], x[1]])?;
+        Some([sxx * n[0] + sxy * n[1], sxy * n[0] + syy * n[1], 0.0])
+    }
+
+    /// Global plane stress (xx, yy, xy) of a 2D field at `x`, or None where it is singular.
+    fn plane_stress(&self, x: [f64; 2]) -> Option<[f64; 3]> {
         let local = |origin: &[f64; 3], angle: f64| {
             let (sn, cs) = angle.sin_cos();
             let d = [x[0] - origin[0], x[1] - origin[1]];
@@ -105,6 +145,7 @@ impl Field {
                 let [xl, yl] = local(center, *angle);
                 centre_crack_stress(*remote, *a, xl, yl).map(|s| rotate_stress(s, *angle))
             }
+            Field::Pressure(_) => unreachable!("a pressure has no plane stress"),
         }
     }
 }
@@ -117,55 +158,115 @@ fn coords(src: &Source, key: &str, v: &[f64]) -> R<[f64; 3]> {
     Ok([v[0], v[1], 0.0])
 }
 
+/// The shape of a loaded face.
+enum Shape {
+    /// A plane with this outward unit normal.
+    Plane([f64; 3]),
+    /// A circle (2D) or sphere (3D) about `center`: the loaded layer's inner side (a bore,
+    /// outward normal towards the centre) or its outer side.
+    Round { center: [f64; 3], inner: bool },
+}
+
 /// The face a traction load acts on.
 pub(super) struct Face<'a> {
     /// Scenario key of the load, for errors.
     key: &'a dyn Fn(&str) -> String,
-    /// Outward unit normal (any direction in the plane).
-    normal: [f64; 3],
+    /// Its shape.
+    shape: Shape,
     /// Cell sizes (m).
     h: [f64; 3],
+    /// Dimensions used.
+    dims: usize,
 }
 
 impl<'a> Face<'a> {
-    /// Checks the scenario's `normal`: present, finite and not zero (it is normalised).
+    /// The face of load `l`: round when its pressure names a `center`, otherwise planar with
+    /// the load's `normal` (present, finite, not zero; it is normalised).
     pub fn new<D: Dim>(
         src: &Source,
         key: &'a dyn Fn(&str) -> String,
-        normal: Option<&[f64]>,
+        l: &LoadSpec,
         h: D::Vec,
     ) -> R<Face<'a>> {
-        if D::D != 2 {
-            return Err(src.error(&key("normal"), "traction fields are 2D only"));
+        let face = |shape| Face {
+            key,
+            shape,
+            h: D::to_xyz(h),
+            dims: D::D,
+        };
+        if let Some(PressureSpec {
+            center: Some(c),
+            face: side,
+            ..
+        }) = &l.pressure
+        {
+            if l.normal.is_some() {
+                return Err(src.error(
+                    &key("normal"),
+                    "a pressure about a `center` acts along the radius: leave out `normal`",
+                ));
+            }
+            let inner = match side.as_deref() {
+                Some("inner") => true,
+                Some("outer") => false,
+                _ => {
+                    return Err(src.error(
+                        &key("pressure.face"),
+                        "a round face is the loaded layer's \"inner\" side (a bore) or its \
+                         \"outer\" side",
+                    ));
+                }
+            };
+            let center = vec3::<D>(src, &key("pressure.center"), c)?;
+            return Ok(face(Shape::Round { center, inner }));
         }
-        let n = normal.ok_or_else(|| {
+        if let Some(PressureSpec { face: Some(_), .. }) = &l.pressure {
+            return Err(src.error(
+                &key("pressure.face"),
+                "`face` goes with a round face's `center`",
+            ));
+        }
+        let n = l.normal.as_deref().ok_or_else(|| {
             src.error(
                 &key("normal"),
-                "a traction needs the outward normal of its face, e.g. normal = [1.0, 0.0]",
+                "a traction needs the outward normal of its face, e.g. normal = [1.0, 0.0], \
+                 or for a pressure a round face's `center`",
             )
         })?;
         let n = vec3::<D>(src, &key("normal"), n)?;
-        let len = n[0].hypot(n[1]);
+        let len = n[0].hypot(n[1]).hypot(n[2]);
         if len == 0.0 {
             return Err(src.error(&key("normal"), "the normal must not be zero"));
         }
-        Ok(Face {
-            key,
-            normal: [n[0] / len, n[1] / len, 0.0],
-            h: D::to_xyz(h),
-        })
+        Ok(face(Shape::Plane(n.map(|c| c / len))))
+    }
+
+    /// Signed distance of `x` along the outward normal (for a round face, the radius, negated
+    /// on a bore) and the outward unit normal there; None at a round face's centre.
+    fn locate(&self, x: [f64; 3]) -> Option<(f64, [f64; 3])> {
+        match self.shape {
+            Shape::Plane(n) => Some(((0..3).map(|a| x[a] * n[a]).sum(), n)),
+            Shape::Round { center, inner } => {
+                let d = [0, 1, 2].map(|a| if a < self.dims { x[a] - center[a] } else { 0.0 });
+                let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                let s = if inner { -1.0 } else { 1.0 };
+                (r > 0.0).then(|| (s * r, d.map(|c| s * c / r)))
+            }
+        }
     }
 }
 
-/// Forces on the face particles `sel`: the traction s . n at each particle's face point
-/// times the face area it carries. The selected particles fill a layer under the face;
-/// their positions along n fall on k distinct rows, and the layer is as deep as the rows
-/// span plus one mean row spacing (a single row: the particle size along n), so each
-/// particle carries its volume over that depth and the areas add up to the face's, on a
-/// face along a grid line or turned in the grid (where the particles sit on a staircase
-/// and the rows are many and close). The face lies half a row spacing beyond the outermost
-/// row, and a particle's face point is its projection on it. `ppc` is each particle's
-/// particles per cell per direction.
+/// Forces on the face particles `sel`: the traction at each particle's face point times
+/// the face area it carries. The selected particles fill a layer under the face; their
+/// distances along the outward normal fall on k distinct rows, and the layer is as deep as
+/// the rows span plus one mean row spacing (a single row: the particle size along n), so
+/// each particle carries its volume over that depth and the areas add up to the face's, on
+/// a face along a grid line or turned in the grid or round (where the particles sit on a
+/// staircase and the rows are many and close). The face lies half a row spacing beyond the
+/// outermost row, and a particle's face point is its projection on it. On a round face of
+/// radius R a particle at radius r carries (R / r)^(d-1) of its share, so that the shares of
+/// a curved layer add up to the face's area. `ppc` is each particle's particles per cell
+/// per direction.
 pub(super) fn tractions<D: Dim>(
     src: &Source,
     face: &Face,
@@ -174,30 +275,38 @@ pub(super) fn tractions<D: Dim>(
     particles: &Particles<D>,
     ppc: &[f64],
 ) -> R<Vec<D::Vec>> {
-    let n = face.normal;
-    let along = |p: u32| {
+    let mut placed = Vec::with_capacity(sel.len());
+    for &p in sel {
         let x = D::to_xyz(particles.x[p as usize]);
-        x[0] * n[0] + x[1] * n[1]
-    };
-    let mut rows: Vec<f64> = sel.iter().map(|&p| along(p)).collect();
+        let (along, n) = face.locate(x).ok_or_else(|| {
+            src.error(
+                &(face.key)("region"),
+                "a loaded particle sits at the round face's centre, where it has no normal",
+            )
+        })?;
+        placed.push((x, along, n));
+    }
+    let mut rows: Vec<f64> = placed.iter().map(|q| q.1).collect();
     rows.sort_unstable_by(f64::total_cmp);
-    let tol = 1e-9 * face.h[0].min(face.h[1]);
+    let tol = 1e-9
+        * face.h[..face.dims]
+            .iter()
+            .fold(f64::INFINITY, |a, &b| a.min(b));
     rows.dedup_by(|a, b| (*a - *b).abs() <= tol);
     let (first, last) = (rows[0], rows[rows.len() - 1]);
     let spacing = if rows.len() > 1 {
         (last - first) / (rows.len() - 1) as f64
     } else {
-        let p = sel[0] as usize;
-        (face.h[0] * n[0].abs() + face.h[1] * n[1].abs()) / ppc[p]
+        let n = placed[0].2;
+        (0..face.dims).map(|a| face.h[a] * n[a].abs()).sum::<f64>() / ppc[sel[0] as usize]
     };
     let depth = last - first + spacing;
     let outer = last + 0.5 * spacing;
     let mut forces = Vec::with_capacity(sel.len());
-    for &p in sel {
-        let x = D::to_xyz(particles.x[p as usize]);
-        let to_face = outer - along(p);
-        let at = [x[0] + to_face * n[0], x[1] + to_face * n[1]];
-        let [sxx, syy, sxy] = field.stress(at).ok_or_else(|| {
+    for (&p, &(x, along, n)) in sel.iter().zip(&placed) {
+        let to_face = outer - along;
+        let at = [0, 1, 2].map(|a| x[a] + to_face * n[a]);
+        let t = field.traction(at, n).ok_or_else(|| {
             src.error(
                 &(face.key)("region"),
                 format!(
@@ -207,8 +316,11 @@ pub(super) fn tractions<D: Dim>(
                 ),
             )
         })?;
-        let area = particles.volume[p as usize] / depth;
-        let t = [sxx * n[0] + sxy * n[1], sxy * n[0] + syy * n[1], 0.0];
+        let curved = match face.shape {
+            Shape::Plane(_) => 1.0,
+            Shape::Round { .. } => (outer / along).abs().powi(face.dims as i32 - 1),
+        };
+        let area = particles.volume[p as usize] / depth * curved;
         forces.push(to_vec::<D>(t.map(|c| c * area)));
     }
     Ok(forces)
