@@ -56,7 +56,24 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
         .cracks
         .as_ref()
         .map_or(0, |c| c.topology.fronts().len());
-    for f in 0..fronts {
+    // K_I, K_II and G along each tip's direction where this check reads them, all before
+    // any tip moves.
+    let readings: Vec<_> = (0..fronts).map(|f| reading(world, plan, f)).collect();
+    // Fatigue: every tip sees the same load cycles, so the fastest tip checked now grows one
+    // extension and the others the share their rates give them.
+    let fastest = (0..fronts)
+        .filter_map(|f| {
+            let cracks = world.cracks.as_ref()?;
+            let front = &cracks.topology.fronts()[f];
+            let paris = cracks.topology.cracks()[front.crack as usize]
+                .growth?
+                .paris?;
+            let (k1, k2, _) = readings[f]?;
+            (cracks.tips[f].stopped == 0).then(|| paris.rate(k1, k2).0)
+        })
+        .filter(|r| r.is_finite())
+        .fold(0.0, f64::max);
+    for (f, &measured) in readings.iter().enumerate() {
         let Some(cracks) = &world.cracks else {
             return Ok(());
         };
@@ -72,14 +89,6 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
         let (tip, behind) = tip_and_behind(cracks, f);
         let dir = (tip - behind).normalize();
         let check = world.step.is_multiple_of(g.check);
-        // K_I, K_II and G along the tip's direction, where this check reads them.
-        let measured = match plan {
-            Some(p) if check && reads_k(&g, &st) => {
-                let r = fracture::tip(world, cracks, front, p, st.speed).0;
-                Some((r.k[0], r.k[1], r.j[0] * dir.x + r.j[1] * dir.y))
-            }
-            _ => None,
-        };
         let holds = match g.initiation {
             Initiation::Time { at } => world.time >= at,
             Initiation::Hoop { k_ic } => {
@@ -107,7 +116,13 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
         let dt = world.settings.dt;
         let (mut ds, over) = match g.speed {
             Some(v) => (v * dt, dt),
-            None if check && holds => (g.extension, g.check as f64 * dt),
+            None if check && holds => {
+                let share = match (g.paris, measured) {
+                    (Some(p), Some((k1, k2, _))) if fastest > 0.0 => p.rate(k1, k2).0 / fastest,
+                    _ => 1.0,
+                };
+                (g.extension * share, g.check as f64 * dt)
+            }
             None => (0.0, dt),
         };
         let fatigue = match (g.paris, measured) {
@@ -122,9 +137,13 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
             _ => [f64::NAN; 2],
         };
         let grown = if ds > 0.0 {
-            let segment = (tip - behind).length();
-            let (grown, stop, fresh) =
-                advance(world, f, tip, dir, segment, heading, ds, g.extension)?;
+            // A new segment when the last one would pass the extension length; under fatigue
+            // at every check, unless the share is below a hundredth of a cell.
+            let h = world.grid.geom.h[0].max(world.grid.geom.h[1]);
+            let turn = (tip - behind).length() + ds > g.extension
+                || (fatigue[0].is_finite() && ds >= 0.01 * h);
+            let (grown, stop, fresh) = advance(world, f, tip, dir, heading, ds, turn)?;
+            let taken = if turn { heading } else { dir };
             if let Some(s) = stop {
                 st.stopped = s as u8;
             }
@@ -139,8 +158,8 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
                         grown: st.grown,
                         x: tip.to_array(),
                         k,
-                        kink: dir.perp_dot(heading).atan2(dir.dot(heading)),
-                        heading: heading.y.atan2(heading.x),
+                        kink: dir.perp_dot(taken).atan2(dir.dot(taken)),
+                        heading: taken.y.atan2(taken.x),
                         fatigue,
                     });
                 }
@@ -157,6 +176,22 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
         }
     }
     Ok(())
+}
+
+/// K_I, K_II and G along the direction of front `f`'s tip, where this step is a check of
+/// its crack's growth and the tip reads them.
+fn reading(world: &World<D2>, plan: Option<&FracturePlan>, f: usize) -> Option<(f64, f64, f64)> {
+    let cracks = world.cracks.as_ref()?;
+    let front = &cracks.topology.fronts()[f];
+    let g = cracks.topology.cracks()[front.crack as usize].growth?;
+    let st = &cracks.tips[f];
+    if st.stopped != 0 || !world.step.is_multiple_of(g.check) || !reads_k(&g, st) {
+        return None;
+    }
+    let (tip, behind) = tip_and_behind(cracks, f);
+    let dir = (tip - behind).normalize();
+    let r = fracture::tip(world, cracks, front, plan?, st.speed).0;
+    Some((r.k[0], r.k[1], r.j[0] * dir.x + r.j[1] * dir.y))
 }
 
 /// Fatigue at a check: the growth rate from K_I and K_II at the largest load, and the
@@ -186,27 +221,24 @@ fn tip_and_behind(cracks: &Cracks<D2>, f: usize) -> (DVec2, DVec2) {
     (x[t as usize], x[p as usize])
 }
 
-/// Moves the tip of front `f` (at `tip`, its last segment of length `segment` along `dir`)
-/// by `ds`: when the segment would pass `extension`, a new vertex is left at the tip and a
-/// new segment starts along `heading`; otherwise the tip slides on along `dir`. Returns the
-/// length grown, why the tip stopped (if it did) and whether a new segment started.
-#[allow(clippy::too_many_arguments)]
+/// Moves the tip of front `f` (at `tip`, its last segment along `dir`) by `ds`: when
+/// `fresh`, a new vertex is left at the tip and a new segment starts along `heading`;
+/// otherwise the tip slides on along `dir`. Returns the length grown, why the tip stopped
+/// (if it did) and whether a new segment started.
 fn advance(
     world: &mut World<D2>,
     f: usize,
     tip: DVec2,
     dir: DVec2,
-    segment: f64,
     heading: DVec2,
     ds: f64,
-    extension: f64,
+    fresh: bool,
 ) -> Result<(f64, Option<Stopped>, bool), Unstable> {
     let geom = &world.grid.geom;
     let h = geom.h[0].max(geom.h[1]);
     let cracks = world.cracks.as_ref().expect("a growing crack");
     let front = &cracks.topology.fronts()[f];
     let name = &cracks.topology.cracks()[front.crack as usize].name;
-    let fresh = segment + ds > extension;
     let heading = if fresh { heading } else { dir };
     let mut to = tip + heading * ds;
     let mut stop = None;

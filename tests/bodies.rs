@@ -112,3 +112,37 @@ fn sphere_and_extruded_polygon_volumes() {
     let vol: f64 = w.particles.volume.iter().sum();
     assert!((vol - 3.2e-5).abs() / 3.2e-5 < 1e-9, "prism volume {vol}");
 }
+
+/// A 60 x 60 mm plate with two holes (r = 8 and 5 mm): area 3.6e-3 - pi (r1^2 + r2^2)
+/// within 1 % (0.5 mm particle spacing); a hollow sphere (6 and 15 mm) in 3D:
+/// 4/3 pi (r^3 - r_i^3) within 1 % (0.5 mm spacing; at 1 mm it reads 1.4 % high).
+#[test]
+fn holes_and_hollow_spheres() {
+    let text = scene(
+        2,
+        0.001,
+        "box = { min = [0.02, 0.02], max = [0.08, 0.08] }\n\
+         holes = [{ center = [0.04, 0.045], radius = 0.008 }, \
+         { center = [0.065, 0.035], radius = 0.005 }]",
+    );
+    let w = build::<D2>(&source(&text)).unwrap().world;
+    let vol: f64 = w.particles.volume.iter().sum();
+    let want = 3.6e-3 - std::f64::consts::PI * (0.008f64.powi(2) + 0.005f64.powi(2));
+    assert!(
+        (vol - want).abs() / want < 0.01,
+        "plate area {vol} vs {want}"
+    );
+    let text = scene(
+        3,
+        0.001,
+        "sphere = { center = [0.025, 0.025, 0.025], radius = 0.015, inner_radius = 0.006 }",
+    )
+    .replace("max = [1e-1, 1e-1, 1e-1]", "max = [5e-2, 5e-2, 5e-2]");
+    let w = build::<D3>(&source(&text)).unwrap().world;
+    let vol: f64 = w.particles.volume.iter().sum();
+    let want = 4.0 / 3.0 * std::f64::consts::PI * (0.015f64.powi(3) - 0.006f64.powi(3));
+    assert!(
+        (vol - want).abs() / want < 0.01,
+        "shell volume {vol} vs {want}"
+    );
+}

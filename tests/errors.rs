@@ -162,7 +162,7 @@ fn empty_body() {
     let e = error_with(&["body[0].box.max=[0.0045, 0.0045]"]);
     assert_error(&e, "body[0]", None, "no particle");
     let e = error_with(&["body[0].clip={ point = [0.0, 0.017], normal = [0.0, 1.0] }"]);
-    assert_error(&e, "body[0]", None, "clipped away");
+    assert_error(&e, "body[0]", None, "clipped or cut away");
     let e = error_3d(
         "[[body]]\nmaterial = \"steel\"\ncylinder = { center = [0.01, 0.01, 0.005], \
          axis = \"z\", radius = 0.003, inner_radius = 0.003, length = 0.01 }\n",
@@ -173,6 +173,22 @@ fn empty_body() {
          inner_radius = -0.001 }\n",
     );
     assert_error(&e, "body[1].disc.inner_radius", None, "hole's radius");
+    let e = error_with(&["body[0].holes=[{ center = [0.01, 0.01], radius = 0.0 }]"]);
+    assert_error(&e, "body[0].holes[0].radius", None, "positive");
+    let e = error_with(&[
+        "body[0].holes=[{ center = [0.01, 0.01], radius = 0.002, inner_radius = 0.001 }]",
+    ]);
+    assert_error(&e, "body[0].holes[0].inner_radius", None, "does not apply");
+    let e = error_with(&["body[0].holes=[{ center = [0.01, 0.01], radius = 0.02 }]"]);
+    assert_error(&e, "body[0]", None, "or cut away");
+}
+
+#[test]
+fn bad_grid_anchors_name_the_key() {
+    let e = error_with(&["grid.anchor={ point = [0.0, 0.0], offset = [0.0, 1.0] }"]);
+    assert_error(&e, "grid.anchor.offset", None, "[0, 1)");
+    let e = error_with(&["grid.anchor={ point = [0.0] }"]);
+    assert_error(&e, "grid.anchor.point", None, "2 components");
 }
 
 #[test]

@@ -61,6 +61,55 @@ fn fatigue_cycles_follow_the_paris_law() {
     );
 }
 
+/// Two edge cracks of different depths in one plate under one cyclic load: at every check
+/// the deeper one grows a whole extension and the shallower one the share of it that the
+/// ratio of their Paris rates (from the Delta K_eq each row records) gives, a new segment
+/// each, so that both see the same load cycles. Each tip sums its cycles by the
+/// trapezoidal rule on its own rates; the counts agree to the order of the extension (a
+/// quarter of the depth in this small plate, where they part by 10 %).
+#[test]
+fn two_fatigue_cracks_grow_by_their_rates() {
+    let right = format!(
+        "[[crack]]\nname = \"right\"\nline = {{ start = [0.0085, -0.002], end = [0.0065, -0.002] }}\n\
+         [crack.growth]\n{PARIS_GROWTH}\n[[load]]"
+    );
+    let text = edge_plate(PARIS_GROWTH, 2.8e-5)
+        .replace("[0.002, 0.0] }", "[0.002, 0.002] }")
+        .replace("[-0.0005, 0.0]", "[-0.0005, 0.002]")
+        .replacen("[[load]]", &right, 1);
+    let out = run_with(&text, 2);
+    let rate = |g: &GrowthRow| 1.0e-29 * g.fatigue[0].powi(3);
+    let rows = |crack: u32| -> Vec<&GrowthRow> {
+        out.history
+            .growth
+            .iter()
+            .filter(|r| r.crack == crack)
+            .collect()
+    };
+    let (deep, shallow) = (rows(0), rows(1));
+    assert!(
+        deep.len() >= 4 && deep.len() == shallow.len(),
+        "{} and {}",
+        deep.len(),
+        shallow.len()
+    );
+    for k in 0..deep.len() - 1 {
+        let (d, s) = (deep[k], shallow[k]);
+        assert_eq!(d.step, s.step, "both tips are checked together");
+        assert!(rate(s) < rate(d), "the shallower crack is slower");
+        let share = 5.0e-4 * rate(s) / rate(d);
+        let grown = (deep[k + 1].grown - d.grown, shallow[k + 1].grown - s.grown);
+        assert!((grown.0 - 5.0e-4).abs() < 1e-12, "{grown:?}");
+        assert!((grown.1 - share).abs() < 1e-12, "{grown:?} against {share}");
+        for r in [&deep, &shallow] {
+            let (a, b) = (r[k], r[k + 1]);
+            let da = b.grown - a.grown;
+            let expected = a.fatigue[1] + 0.5 * da * (1.0 / rate(a) + 1.0 / rate(b));
+            assert!((b.fatigue[1] - expected).abs() <= 1e-9 * expected);
+        }
+    }
+}
+
 /// A tip running straight across the plate stops at the far surface, says so, and grows
 /// no more; the crack then cuts the body through.
 #[test]

@@ -133,3 +133,46 @@ fn bad_sweeps_are_refused_before_the_first_run() {
     }
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// With `[grid] anchor` the lattice follows the cell size: a crack line at y = 12 mm stays
+/// half a cell from the node rows and the clamped edge x = 0 stays on a node column, at
+/// 1 mm (where the anchor agrees with `min`, which is kept exactly), 0.7 mm and 0.3 mm
+/// cells; the grid still covers [min, max].
+#[test]
+fn an_anchored_grid_keeps_the_scene_in_place_when_cells_change() {
+    let text = |cell: f64| {
+        format!(
+            "[simulation]\ndimension = 2\nduration = 1e-6\n[grid]\nmin = [-0.003, -0.0035]\n\
+             max = [0.106, 0.0275]\ncell = [{cell:e}, {cell:e}]\n\
+             anchor = {{ point = [0.0, 0.012], offset = [0.0, 0.5] }}\n\
+             [[material]]\nname = \"m\"\nE = 2.3e9\nnu = 0.33\nrho = 1500.0\n\
+             [[body]]\nmaterial = \"m\"\nbox = {{ min = [0.0, 0.0], max = [0.1, 0.024] }}\n"
+        )
+    };
+    for cell in [0.001, 0.0007, 0.0003] {
+        let w = fissure::scenario::build::<fissure::dim::D2>(&common::source(&text(cell)))
+            .unwrap_or_else(|e| panic!("{e}"))
+            .world;
+        let g = &w.grid.geom;
+        if cell == 0.001 {
+            assert_eq!((g.origin.x, g.origin.y), (-0.003, -0.0035));
+        }
+        let rows = (0.012 - g.origin.y) / cell;
+        assert!((rows - rows.floor() - 0.5).abs() < 1e-9, "{cell}: {rows}");
+        let columns = -g.origin.x / cell;
+        assert!(
+            (columns - columns.round()).abs() < 1e-9,
+            "{cell}: {columns}"
+        );
+        assert!(g.origin.x <= -0.003 && g.origin.y <= -0.0035);
+        let top = [
+            g.origin.x + g.cells[0] as f64 * cell,
+            g.origin.y + g.cells[1] as f64 * cell,
+        ];
+        assert!(
+            top[0] >= 0.106 - 1e-12 && top[1] >= 0.0275 - 1e-12,
+            "{top:?}"
+        );
+        assert!(top[0] < 0.106 + cell && top[1] < 0.0275 + cell, "{top:?}");
+    }
+}

@@ -1,7 +1,7 @@
 //! Building a World from a parsed scenario, validating every value on the way.
 
 use super::region::{Region, region};
-use super::schema::{BodySpec, BoxSpec, RegionSpec, RoundSpec};
+use super::schema::{AnchorSpec, BodySpec, BoxSpec, RegionSpec, RoundSpec};
 use super::source::Source;
 use super::traction::{Face, Field, tractions};
 use crate::bodies::{Geometry, fill};
@@ -216,8 +216,8 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     }
 
     // Grid.
-    let gmin = vec3::<D>(src, "grid.min", &sc.grid.min)?;
-    let gmax = vec3::<D>(src, "grid.max", &sc.grid.max)?;
+    let mut gmin = vec3::<D>(src, "grid.min", &sc.grid.min)?;
+    let mut gmax = vec3::<D>(src, "grid.max", &sc.grid.max)?;
     let cell = vec3::<D>(src, "grid.cell", &sc.grid.cell)?;
     let mut cells = [1usize; 3];
     let mut h = [1.0; 3];
@@ -227,6 +227,11 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         if gmax[a] <= gmin[a] {
             return Err(src.error("grid.max", "grid max must exceed grid min on every axis"));
         }
+    }
+    if let Some(anchor) = &sc.grid.anchor {
+        (gmin, gmax) = anchored::<D>(src, anchor, gmin, gmax, h)?;
+    }
+    for a in 0..D::D {
         let n = (gmax[a] - gmin[a]) / h[a];
         if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
             return Err(src.error(
@@ -837,6 +842,46 @@ fn checkpoint_plan(src: &Source) -> R<CheckpointPlan> {
     })
 }
 
+/// The grid's extent widened to whole cells of the lattice `anchor` lays: nodes at
+/// `point + (k + offset) h` per axis. A bound already on the lattice (to a billionth of a
+/// cell) is kept as given, so an anchor that agrees with `min` changes nothing.
+fn anchored<D: Dim>(
+    src: &Source,
+    anchor: &AnchorSpec,
+    min: [f64; 3],
+    max: [f64; 3],
+    h: [f64; 3],
+) -> R<([f64; 3], [f64; 3])> {
+    let point = vec3::<D>(src, "grid.anchor.point", &anchor.point)?;
+    let offset = match &anchor.offset {
+        Some(o) => vec3::<D>(src, "grid.anchor.offset", o)?,
+        None => [0.0; 3],
+    };
+    if offset.iter().any(|o| !(0.0..1.0).contains(o)) {
+        return Err(src.error(
+            "grid.anchor.offset",
+            "offsets are fractions of a cell in [0, 1)",
+        ));
+    }
+    let (mut lo, mut hi) = (min, max);
+    for a in 0..D::D {
+        let origin = point[a] + offset[a] * h[a];
+        let node = |k: f64| origin + k * h[a];
+        let snap = |x: f64, k: f64| {
+            if (node(k) - x).abs() <= 1e-9 * h[a] {
+                x
+            } else {
+                node(k)
+            }
+        };
+        let first = ((min[a] - origin) / h[a] + 1e-9).floor();
+        let last = ((max[a] - origin) / h[a] - 1e-9).ceil();
+        lo[a] = snap(min[a], first);
+        hi[a] = snap(max[a], last);
+    }
+    Ok((lo, hi))
+}
+
 /// The radius of a ring's or a spherical shell's hole: in [0, radius) (m).
 fn hole(src: &Source, key: &str, round: &RoundSpec) -> R<f64> {
     if (0.0..round.radius).contains(&round.inner_radius) {
@@ -991,11 +1036,23 @@ fn add_body<D: Dim>(
         let clip = super::region::region::<D>(src, &key("clip"), clip)?;
         pts.retain(|x| clip.contains(*x, D::D, 0.0));
     }
+    for (k, hole) in body.holes.iter().enumerate() {
+        let key = key(&format!("holes[{k}]"));
+        let center = vec3::<D>(src, &format!("{key}.center"), &hole.center)?;
+        let r = positive(src, &format!("{key}.radius"), hole.radius, "m")?;
+        if hole.inner_radius != 0.0 {
+            return Err(src.error(
+                &format!("{key}.inner_radius"),
+                "`inner_radius` does not apply to a hole",
+            ));
+        }
+        pts.retain(|x| (0..D::D).map(|a| (x[a] - center[a]).powi(2)).sum::<f64>() >= r * r);
+    }
     if pts.is_empty() {
         return Err(src.error(
             &format!("body[{b}]"),
             "body contains no particle (is it smaller than a particle spacing, outside the grid, or \
-             clipped away?)",
+             clipped or cut away?)",
         ));
     }
     let n = body.ppc as f64;

@@ -89,6 +89,21 @@ pub struct GridSpec {
     pub max: Vec<f64>,
     /// Cell size per axis (m).
     pub cell: Vec<f64>,
+    /// Lays the nodes from a point instead of from `min`, so that a scene keeps its place
+    /// in the lattice when the cell size changes; `min` and `max` are then widened to
+    /// whole cells.
+    pub anchor: Option<AnchorSpec>,
+}
+
+/// `[grid] anchor`: the nodes lie at `point + (k + offset) cell` on each axis.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnchorSpec {
+    /// A point of the lattice (m).
+    pub point: Vec<f64>,
+    /// Per axis, the fraction of a cell the nodes are shifted from the point, in [0, 1)
+    /// (0.5 puts the point at a cell's centre on that axis); default 0.
+    pub offset: Option<Vec<f64>>,
 }
 
 /// `[[material]]`: isotropic linear elastic.
@@ -239,6 +254,9 @@ pub struct BodySpec {
     /// Keep only the part of the geometry inside this region (e.g. the half-space on one
     /// side of a symmetry plane).
     pub clip: Option<RegionSpec>,
+    /// Holes cut out of the geometry: discs (2D) or balls (3D), `{ center, radius }`.
+    #[serde(default)]
+    pub holes: Vec<RoundSpec>,
 }
 
 fn default_ppc() -> usize {
