@@ -123,8 +123,9 @@ impl TipState {
     /// The state from a snapshot's numbers; None when they cannot be one.
     pub fn from_values(v: &[f64]) -> Option<TipState> {
         let stopped = v[5];
-        let code = (stopped == stopped.trunc() && (0.0..=3.0).contains(&stopped))
-            .then_some(stopped as u8)?;
+        let code = (stopped == stopped.trunc() && (0.0..=255.0).contains(&stopped))
+            .then_some(stopped as u8)
+            .filter(|&c| c == 0 || Stopped::from_code(c).is_some())?;
         Some(TipState {
             started: v[0],
             grown: v[1],
@@ -163,6 +164,9 @@ pub enum Stopped {
     Crack = 2,
     /// Fatigue: Delta K_eq is not positive, so it grows no more under this load.
     Arrested = 3,
+    /// Fatigue: K could not be measured at the tip (no J contour fits), so its rate is
+    /// unknown.
+    Unmeasured = 4,
 }
 
 impl Stopped {
@@ -172,6 +176,9 @@ impl Stopped {
             Stopped::Surface => "reached the free surface",
             Stopped::Crack => "reached another crack",
             Stopped::Arrested => "arrested: Delta K_eq is not positive",
+            Stopped::Unmeasured => {
+                "stopped: K could not be measured at the tip (no J contour fits there)"
+            }
         }
     }
 
@@ -181,6 +188,7 @@ impl Stopped {
             1 => Some(Stopped::Surface),
             2 => Some(Stopped::Crack),
             3 => Some(Stopped::Arrested),
+            4 => Some(Stopped::Unmeasured),
             _ => None,
         }
     }

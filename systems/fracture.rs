@@ -212,6 +212,9 @@ pub(crate) fn tip(
     res.k_interaction = [ik.k[0], ik.k[1], 0.0];
     res.domain = ik.radius;
     res.k = match plan.k_method {
+        // Where no interaction domain fits (another crack or the body's edge within two
+        // cells of the tip), the opening split is all there is.
+        KMethod::Mixity | KMethod::Interaction if ik.radius == 0.0 => res.k_opening,
         KMethod::Mixity => {
             let [k1, k2] = k_from_mixity(mat, world.settings.plane, gr, ik.k);
             [k1, k2, 0.0]

@@ -128,7 +128,10 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
         let fatigue = match (g.paris, measured) {
             (Some(p), Some((k1, k2, _))) if ds > 0.0 => {
                 let dk = fatigue(&p, &mut st, k1, k2);
-                if st.rate <= 0.0 || !dk.is_finite() {
+                if !dk.is_finite() {
+                    st.stopped = Stopped::Unmeasured as u8;
+                    ds = 0.0;
+                } else if st.rate <= 0.0 {
                     st.stopped = Stopped::Arrested as u8;
                     ds = 0.0;
                 }
