@@ -252,7 +252,8 @@ pub fn sweep(
     let sources = (combos.iter())
         .map(|set| Source::load(file, set))
         .collect::<Result<Vec<_>, _>>()?;
-    let expects: Vec<String> = (sources[0].scenario.expects.iter())
+    let specs = &sources[0].scenario.expects;
+    let mut expects: Vec<String> = (specs.iter())
         .map(|e| {
             let names: Vec<&str> = (e.crack.iter().chain(&e.tip).chain(&e.probes))
                 .map(String::as_str)
@@ -262,6 +263,16 @@ pub fn sweep(
                 .to_string()
         })
         .collect();
+    // Two expects of one quantity at one place (against two references) are told apart
+    // by their references.
+    let repeated: Vec<bool> = (expects.iter())
+        .map(|e| expects.iter().filter(|f| *f == e).count() > 1)
+        .collect();
+    for ((e, spec), twice) in expects.iter_mut().zip(specs).zip(repeated) {
+        if twice {
+            *e = format!("{e} (reference {:e})", spec.reference);
+        }
+    }
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output folder {}", out.display()))?;
     let csv = out.join("sweep.csv");

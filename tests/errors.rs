@@ -252,7 +252,14 @@ fn error_with_text(extra: &str) -> ScenarioError {
 #[test]
 fn bad_cracks_name_the_key() {
     let e = error_with_text("[[crack]]\npoints = [[0.0001, 0.0001], [0.0001, 0.002]]\n");
-    assert_error(&e, "crack[0].points", Some(19), "outside every body");
+    assert_error(&e, "crack[0].points", Some(19), "front vertex 1");
+    let e = error_with_text("[[crack]]\npoints = [[0.0001, 0.0001], [0.0001, 0.002]]\ntips = []\n");
+    assert_error(
+        &e,
+        "crack[0].points",
+        Some(19),
+        "the crack is outside every body",
+    );
     let e = error_with_text("[[crack]]\npoints = [[0.01, 0.01]]\n");
     assert_error(&e, "crack[0].points", Some(19), "at least two points");
     let e = error_with_text(

@@ -176,3 +176,23 @@ fn an_anchored_grid_keeps_the_scene_in_place_when_cells_change() {
         assert!(top[0] < 0.106 + cell && top[1] < 0.0275 + cell, "{top:?}");
     }
 }
+
+/// Two expects of one quantity against two references get two columns each, told apart
+/// by their references.
+#[test]
+fn repeated_expects_get_their_own_columns() {
+    let (dir, file) = setup("repeated");
+    let text = std::fs::read_to_string(&file).unwrap()
+        + "[[expect]]\nquantity = \"energy_drift\"\nreference = 0.001\nsource = \"s\"\ntolerance = 2.0\n";
+    std::fs::write(&file, text).unwrap();
+    let out = dir.join("out");
+    go(&file, &vary(&["simulation.shape=linear"]), &out);
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let head = csv.lines().next().unwrap();
+    assert!(
+        head.contains("energy_drift (reference 0e0) value")
+            && head.contains("energy_drift (reference 1e-3) value"),
+        "{head}"
+    );
+    std::fs::remove_dir_all(dir).ok();
+}

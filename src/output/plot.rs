@@ -132,19 +132,33 @@ pub fn log_log(
             (all.iter()).fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
         // Half a decade around the data, more above for the legend.
         let (x0, x1) = (x0 / 1.5, x1 * 1.5);
+        // x ticks at the data's own x values (cell sizes, wall times), each at least an
+        // eighth of a decade from the last, so that an axis spanning under a decade still
+        // names every point.
+        let mut ticks: Vec<f64> = all.iter().map(|p| p.0).collect();
+        ticks.sort_by(f64::total_cmp);
+        let mut keep: Vec<f64> = Vec::new();
+        for t in ticks {
+            if keep.last().is_none_or(|&k| (t / k).log10() >= 0.125) {
+                keep.push(t);
+            }
+        }
         let (y0, y1) = (y0 / 2.0, y1 * 2.0 * 10f64.powf(0.25 * series.len() as f64));
         let mut chart = ChartBuilder::on(area)
             .margin(12)
             .margin_right(48)
             .x_label_area_size(45)
             .y_label_area_size(90)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .build_cartesian_2d(
+                (x0..x1).log_scale().with_key_points(keep),
+                (y0..y1).log_scale(),
+            )
             .map_err(err)?;
         chart
             .configure_mesh()
             .x_desc(x_label)
             .y_desc(y_label)
-            .x_label_formatter(&|v| format!("{v:.1e}"))
+            .x_label_formatter(&|v| format!("{v:.2e}"))
             .y_label_formatter(&|v| format!("{v:.1e}"))
             .draw()
             .map_err(err)?;

@@ -69,6 +69,11 @@ pub(super) fn build<D: Dim>(
                 },
             }
         };
+        // Every vertex lies in the grid and every front vertex in a body; the rest may
+        // overhang a body's edge by any length (a crack that cuts through it), so that a
+        // scene keeps its cracks when its cells are refined.
+        let front: Vec<u32> = piece.fronts.iter().flat_map(|f| f.1.clone()).collect();
+        let mut touches = false;
         for (j, x) in piece.points.iter().enumerate() {
             let at = D::to_xyz(*x);
             let at = at[..D::D]
@@ -81,16 +86,27 @@ pub(super) fn build<D: Dim>(
                     format!("vertex {j} at ({}) m lies outside the grid", at.join(", ")),
                 ));
             }
-            if !occupied.near(*x) {
+            let near = occupied.near(*x);
+            touches |= near;
+            if !near && front.contains(&(j as u32)) {
                 return Err(src.error(
                     &piece.key,
                     format!(
-                        "vertex {j} at ({}) m is outside every body (more than {REACH_CELLS} \
-                         cells from any particle)",
+                        "front vertex {j} at ({}) m is outside every body (more than \
+                         {REACH_CELLS} cells from any particle)",
                         at.join(", ")
                     ),
                 ));
             }
+        }
+        if !touches {
+            return Err(src.error(
+                &piece.key,
+                format!(
+                    "the crack is outside every body (no vertex within {REACH_CELLS} cells of a \
+                     particle)"
+                ),
+            ));
         }
         if let Some((k, mine, theirs)) =
             super::crack_meet::meets(&store, &piece.points, &piece.elems)
