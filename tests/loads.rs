@@ -183,29 +183,31 @@ fn totals<V: Copy>(forces: &[V], xyz: impl Fn(V) -> [f64; 3]) -> ([f64; 3], f64)
     })
 }
 
-/// A ring about `c` (radii in m, 0.5 mm cells) with a pressure `p` on the particles
-/// within `layer` of the centre, on the face `side` of that layer.
-fn ring(inner: f64, outer: f64, layer: f64, p: f64, side: &str) -> String {
+/// A steel scene of `dim` dimensions on a grid from -`half` to `half` (m) on every axis at
+/// 0.5 mm cells, with `rest` (bodies and loads) appended.
+fn steel(dim: usize, half: f64, rest: &str) -> String {
+    let v = |x: f64| vec![format!("{x:e}"); dim].join(", ");
     format!(
-        r#"[simulation]
-dimension = 2
-duration = 1e-6
-[grid]
-min = [-0.011, -0.011]
-max = [0.011, 0.011]
-cell = [0.0005, 0.0005]
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 7800.0
-[[body]]
-material = "steel"
-disc = {{ center = [0.0002, 0.0001], radius = {outer}, inner_radius = {inner} }}
-[[load]]
-region = {{ center = [0.0002, 0.0001], radius = {layer} }}
-pressure = {{ value = {p}, center = [0.0002, 0.0001], face = "{side}" }}
-"#
+        "[simulation]\ndimension = {dim}\nduration = 1e-6\n[grid]\nmin = [{}]\nmax = [{}]\n\
+         cell = [{}]\n[[material]]\nname = \"steel\"\nE = 200e9\nnu = 0.3\nrho = 7800.0\n{rest}",
+        v(-half),
+        v(half),
+        v(0.0005)
+    )
+}
+
+/// A ring about (0.2, 0.1) mm (radii in m) with a pressure `p` on the particles within
+/// `layer` of the centre, on the face `side` of that layer.
+fn ring(inner: f64, outer: f64, layer: f64, p: f64, side: &str) -> String {
+    steel(
+        2,
+        0.011,
+        &format!(
+            "[[body]]\nmaterial = \"steel\"\n\
+             disc = {{ center = [0.0002, 0.0001], radius = {outer}, inner_radius = {inner} }}\n\
+             [[load]]\nregion = {{ center = [0.0002, 0.0001], radius = {layer} }}\n\
+             pressure = {{ value = {p}, center = [0.0002, 0.0001], face = \"{side}\" }}\n"
+        ),
     )
 }
 
@@ -246,26 +248,15 @@ fn pressures_on_a_ring_add_up_to_its_circumferences() {
 /// deep: the forces' lengths add up to p 4 pi a^2, within 1 %.
 #[test]
 fn a_pressure_on_a_spherical_bore_adds_up_to_its_area() {
-    let text = r#"[simulation]
-dimension = 3
-duration = 1e-6
-[grid]
-min = [-0.007, -0.007, -0.007]
-max = [0.007, 0.007, 0.007]
-cell = [0.0005, 0.0005, 0.0005]
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 7800.0
-[[body]]
-material = "steel"
-sphere = { center = [0.0, 0.0, 0.0], radius = 0.006, inner_radius = 0.004 }
-[[load]]
-region = { center = [0.0, 0.0, 0.0], radius = 0.005 }
-pressure = { value = 1.0e6, center = [0.0, 0.0, 0.0], face = "inner" }
-"#;
-    let world = build::<D3>(&Source::parse("sphere.toml", text, &[]).unwrap())
+    let text = steel(
+        3,
+        0.007,
+        "[[body]]\nmaterial = \"steel\"\n\
+         sphere = { center = [0.0, 0.0, 0.0], radius = 0.006, inner_radius = 0.004 }\n\
+         [[load]]\nregion = { center = [0.0, 0.0, 0.0], radius = 0.005 }\n\
+         pressure = { value = 1.0e6, center = [0.0, 0.0, 0.0], face = \"inner\" }\n",
+    );
+    let world = build::<D3>(&Source::parse("sphere.toml", &text, &[]).unwrap())
         .unwrap_or_else(|e| panic!("{e}"))
         .world;
     let (sum, length) = totals(&world.loads[0].forces, |f: glam::DVec3| f.to_array());
@@ -278,27 +269,14 @@ pressure = { value = 1.0e6, center = [0.0, 0.0, 0.0], face = "inner" }
 /// pressure times the face's area.
 #[test]
 fn a_pressure_on_a_flat_face_is_p_times_its_area() {
-    let text = r#"[simulation]
-dimension = 2
-duration = 1e-6
-[grid]
-min = [-0.011, -0.011]
-max = [0.011, 0.011]
-cell = [0.0005, 0.0005]
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 7800.0
-[[body]]
-material = "steel"
-box = { min = [-0.005, -0.005], max = [0.005, 0.005] }
-[[load]]
-region = { min = [-0.005, 0.004], max = [0.005, 0.005] }
-pressure = { value = 4.0e6 }
-normal = [0.0, 2.0]
-"#;
-    let world = build::<D2>(&Source::parse("flat.toml", text, &[]).unwrap())
+    let text = steel(
+        2,
+        0.011,
+        "[[body]]\nmaterial = \"steel\"\nbox = { min = [-0.005, -0.005], max = [0.005, 0.005] }\n\
+         [[load]]\nregion = { min = [-0.005, 0.004], max = [0.005, 0.005] }\n\
+         pressure = { value = 4.0e6 }\nnormal = [0.0, 2.0]\n",
+    );
+    let world = build::<D2>(&Source::parse("flat.toml", &text, &[]).unwrap())
         .unwrap_or_else(|e| panic!("{e}"))
         .world;
     let (sum, _) = totals(&world.loads[0].forces, |f: glam::DVec2| [f.x, f.y, 0.0]);
