@@ -171,7 +171,9 @@ fn quote(s: &str) -> String {
 }
 
 /// The varied values of the rows already in `csv` (a sweep resuming), after checking that
-/// its header is `header`; an empty list when there is no such file.
+/// its header is `header`; an empty list when there is no such file. Rows of runs refused
+/// at set-up (status `error`: a setting the scenario could not take, perhaps fixed since)
+/// are dropped from the file, so that those runs are tried again.
 pub fn done(csv: &Path, header: &str, keys: usize) -> Result<Vec<Vec<String>>, UsageError> {
     let Ok(text) = std::fs::read_to_string(csv) else {
         return Ok(Vec::new());
@@ -183,8 +185,19 @@ pub fn done(csv: &Path, header: &str, keys: usize) -> Result<Vec<Vec<String>>, U
             csv.display()
         )));
     }
-    Ok(lines
+    let (kept, refused): (Vec<&str>, Vec<&str>) = lines
         .filter(|l| !l.is_empty())
+        .partition(|l| fields(l).get(keys).is_none_or(|s| s != "error"));
+    if !refused.is_empty() {
+        let text: String = std::iter::once(header)
+            .chain(kept.iter().copied())
+            .map(|l| format!("{l}\n"))
+            .collect();
+        std::fs::write(csv, text)
+            .map_err(|e| UsageError(format!("cannot rewrite {}: {e}", csv.display())))?;
+    }
+    Ok(kept
+        .iter()
         .map(|l| fields(l).into_iter().take(keys).collect())
         .collect())
 }

@@ -196,3 +196,28 @@ fn repeated_expects_get_their_own_columns() {
     );
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// A run refused at set-up (3 mm cells do not divide the 20 mm grid) is written as an
+/// error row, and tried again when the sweep resumes: with the grid anchored (so any cell
+/// size fits) it completes, and sweep.csv keeps one row per run.
+#[test]
+fn refused_runs_are_tried_again_on_resume() {
+    let (dir, file) = setup("retry");
+    let out = dir.join("out");
+    let v = vary(&["grid.cell=[2e-3, 2e-3],[3e-3, 3e-3]"]);
+    assert_eq!(go(&file, &v, &out), vec![(1, true), (2, false)]);
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    assert!(csv.lines().nth(2).unwrap().contains(",error,"), "{csv}");
+    let text = std::fs::read_to_string(&file).unwrap().replacen(
+        "cell = [0.002, 0.002]\n",
+        "cell = [0.002, 0.002]\nanchor = { point = [0.0, 0.0] }\n",
+        1,
+    );
+    std::fs::write(&file, text).unwrap();
+    assert_eq!(go(&file, &v, &out), vec![(1, false), (2, true)]);
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 3, "{csv}");
+    assert!(lines[2].contains(",completed,"), "{csv}");
+    std::fs::remove_dir_all(dir).ok();
+}
