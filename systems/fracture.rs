@@ -1,13 +1,15 @@
 //! `fracture`: the dynamic J-integral around each crack tip on a square contour along grid
 //! lines, split where the crack crosses it (Guo & Nairn 2D (2004) Eqs. 7, 11-13), with the
-//! optional area term (Eq. 8), then G (Eq. 10) and K_I, K_II from the crack opening
-//! (Eqs. 14-22). Runs on output steps only; it reads the world and changes nothing.
+//! optional area term (Eq. 8), then G (Eq. 10) and K_I, K_II from the interaction integral
+//! and from the crack opening (Eqs. 14-22); a tip running at a set speed takes K from the
+//! amplitude of its opening instead. Runs on output steps only; it changes nothing.
 
 use crate::crack::{Cracks, Front};
 use crate::dim::{D2, Dim};
 use crate::fracture::{
-    FracturePlan, KMethod, Measured, PathResult, TipResult, k_from_g, k_from_mixity,
+    FracturePlan, KMethod, Measured, PathResult, TipResult, k_from_g, k_from_mixity, k_from_opening,
 };
+use crate::growth::TipState;
 use crate::interaction::{Tip, interaction_k, near};
 use crate::shape::Stencil;
 use crate::sym::SymTensor;
@@ -65,8 +67,7 @@ pub fn measure(world: &World<D2>, plan: &FracturePlan) -> Measured {
         return m;
     };
     for (f, front) in cracks.topology.fronts().iter().enumerate() {
-        let speed = cracks.tips.get(f).map_or(0.0, |t| t.speed);
-        let (t, p) = tip(world, cracks, front, plan, speed);
+        let (t, p) = tip(world, cracks, front, plan, cracks.tips.get(f));
         m.tips.push(t);
         m.paths.extend(p);
     }
@@ -108,13 +109,14 @@ fn intersect(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> Option<f64> 
     ((0.0..1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
 }
 
-/// J and K at the tip of `front`, running at `speed` (m/s), and J on the compared contours.
+/// J and K at the tip of `front` (whose growth so far is `state`, if it can grow), and J on
+/// the compared contours.
 pub(crate) fn tip(
     world: &World<D2>,
     cracks: &Cracks<D2>,
     front: &Front,
     plan: &FracturePlan,
-    speed: f64,
+    state: Option<&TipState>,
 ) -> (TipResult, Vec<PathResult>) {
     let geom = &world.grid.geom;
     let topo = &cracks.topology;
@@ -131,6 +133,10 @@ pub(crate) fn tip(
         path.clone()
     };
     let (kt, kp) = (walk[0], walk[1]);
+    let speed = state.map_or(0.0, |s| s.speed);
+    // A tip running at a set speed (not one that extends by a segment now and then).
+    let set_speed = topo.cracks()[c].growth.is_some_and(|g| g.speed.is_some());
+    let running = state.filter(|s| set_speed && s.speed > 0.0);
     let xt = xy(cracks.geometry.x[kt]);
     let mut res = TipResult {
         step: world.step,
@@ -197,9 +203,19 @@ pub(crate) fn tip(
     if other_end {
         window = window.min(0.5 * res.length);
     }
+    if let Some(s) = running {
+        // A running tip's field is fitted over the faces it made while running (but over
+        // three cells at least).
+        window = window.min(s.grown.max(3.0 * h));
+    }
     let [d_i, d_ii] = opening_amplitudes(cracks, &walk, end, xt, dir, h, window);
     let mat = &world.materials[world.particles.material[main.nearest] as usize];
-    let [o1, o2] = k_from_g(mat, world.settings.plane, gr, d_i, d_ii, speed);
+    let plane = world.settings.plane;
+    let [o1, o2] = if running.is_some() {
+        k_from_opening(mat, plane, d_i, d_ii, speed)
+    } else {
+        k_from_g(mat, plane, gr, d_i, d_ii)
+    };
     res.k_opening = [o1, o2, 0.0];
     let at = Tip {
         crack: c,
@@ -212,6 +228,10 @@ pub(crate) fn tip(
     res.k_interaction = [ik.k[0], ik.k[1], 0.0];
     res.domain = ik.radius;
     res.k = match plan.k_method {
+        // A running tip's K is its opening's (see `k_from_opening`): J reads the energy the
+        // discrete tip absorbs, and the interaction integral's auxiliary field is a tip's
+        // at rest.
+        _ if running.is_some() => res.k_opening,
         // Where no interaction domain fits (another crack or the body's edge within two
         // cells of the tip), the opening split is all there is.
         KMethod::Mixity | KMethod::Interaction if ik.radius == 0.0 => res.k_opening,

@@ -193,7 +193,7 @@ fn reading(world: &World<D2>, plan: Option<&FracturePlan>, f: usize) -> Option<(
     }
     let (tip, behind) = tip_and_behind(cracks, f);
     let dir = (tip - behind).normalize();
-    let r = fracture::tip(world, cracks, front, plan?, st.speed).0;
+    let r = fracture::tip(world, cracks, front, plan?, Some(st)).0;
     Some((r.k[0], r.k[1], r.j[0] * dir.x + r.j[1] * dir.y))
 }
 
