@@ -38,8 +38,9 @@ pub struct Growth {
     pub initiation: Initiation,
     /// Which way it goes.
     pub direction: Direction,
-    /// Once started, a tip runs at this speed (m/s) whatever K does; None: it extends by
-    /// `extension` at every check at which the criterion holds.
+    /// Once started, a tip runs at this speed (m/s) whatever K does, on the heading it took
+    /// at the start; None: it extends by `extension` at every check at which the
+    /// criterion holds.
     pub speed: Option<f64>,
     /// Length of a new crack segment (m).
     pub extension: f64,

@@ -204,17 +204,17 @@ pub(crate) fn tip(
         window = window.min(0.5 * res.length);
     }
     if let Some(s) = running {
-        // A running tip's field is fitted over the faces it made while running (but over
-        // three cells at least).
-        window = window.min(s.grown.max(3.0 * h));
+        // A running tip's field is fitted over the faces it made while running.
+        window = window.min(s.grown);
     }
     let [d_i, d_ii] = opening_amplitudes(cracks, &walk, end, xt, dir, h, window);
     let mat = &world.materials[world.particles.material[main.nearest] as usize];
     let plane = world.settings.plane;
-    let [o1, o2] = if running.is_some() {
-        k_from_opening(mat, plane, d_i, d_ii, speed)
-    } else {
-        k_from_g(mat, plane, gr, d_i, d_ii)
+    let [o1, o2] = match running {
+        // Until it has run three cells there are too few such faces to fit.
+        Some(s) if s.grown < 3.0 * h => [f64::NAN; 2],
+        Some(_) => k_from_opening(mat, plane, d_i, d_ii, speed),
+        None => k_from_g(mat, plane, gr, d_i, d_ii),
     };
     res.k_opening = [o1, o2, 0.0];
     let at = Tip {

@@ -42,8 +42,8 @@ fn reads_k(g: &Growth, st: &TipState) -> bool {
     let criterion = !matches!(g.initiation, Initiation::Time { .. });
     match (st.stopped, st.started.is_nan()) {
         (0, _) if g.paris.is_some() => true,
-        (0, true) => criterion,
-        (0, false) => g.direction == Direction::Hoop || (g.speed.is_none() && criterion),
+        (0, true) => criterion || g.direction == Direction::Hoop,
+        (0, false) => g.speed.is_none() && (g.direction == Direction::Hoop || criterion),
         _ => false,
     }
 }
@@ -97,14 +97,17 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
             Initiation::Energy { g_c } => measured.is_some_and(|(_, _, g)| g >= g_c),
         };
         if st.started.is_nan() {
-            if !holds {
+            // A tip that turns by the hoop stress starts at a check, where it reads K.
+            if !holds || (g.direction == Direction::Hoop && measured.is_none()) {
                 continue;
             }
             st.started = world.time;
             st.heading = dir.to_array();
         }
         // The direction the next new segment takes: the hoop stress's at the last check
-        // that read K, or straight on.
+        // that read K, or straight on. A tip running at a set speed keeps the heading it
+        // took when it started: the K it reads while running comes from the faces behind
+        // it, which next to a kink still slide as the crack it left did.
         let heading = match (g.direction, measured) {
             (Direction::Hoop, Some((k1, k2, _))) if k1.is_finite() && k2.is_finite() => {
                 DVec2::from_angle(hoop_angle(k1, k2)).rotate(dir)

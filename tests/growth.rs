@@ -140,6 +140,44 @@ fn a_tip_stops_at_the_free_surface() {
     assert_eq!(*speeds.last().unwrap(), 0.0, "stopped");
 }
 
+/// A tip set running under tension and shear turns once, by the hoop angle of the K it
+/// reads at rest, and then keeps that heading; its K is not reported until it has run
+/// three cells (1.5 mm here), and is from then on.
+#[test]
+fn a_running_tip_turns_once_and_reads_k_after_three_cells() {
+    let text = edge_plate(
+        "initiation = \"time\"\nat = 6.0e-6\ndirection = \"hoop\"\nspeed = 1500.0",
+        9.0e-6,
+    )
+    .replace("force = [0.0, 8.0e5]", "force = [4.0e5, 8.0e5]")
+    .replace("force = [0.0, -8.0e5]", "force = [-4.0e5, -8.0e5]")
+    .replace("history_interval = 1.0e-6", "history_interval = 1.0e-7");
+    let out = run_with(&text, 2);
+    let rows = &out.history.growth;
+    assert!(rows.len() > 4, "{} segments", rows.len());
+    assert!(
+        rows[0].kink.abs() > 0.1,
+        "a turn at the start: {}",
+        rows[0].kink
+    );
+    assert!(
+        rows.iter().all(|r| r.heading == rows[0].heading),
+        "one heading"
+    );
+    let length0 = out.history.fracture[0].length;
+    let (mut early, mut late) = (0, 0);
+    for t in out.history.fracture.iter().filter(|t| t.speed > 0.0) {
+        if t.length - length0 < 1.5e-3 - 1e-9 {
+            assert!(t.k[0].is_nan(), "too few faces at {}", t.time);
+            early += 1;
+        } else {
+            assert!(t.k[0].is_finite() && t.k[0] > 0.0, "K at {}", t.time);
+            late += 1;
+        }
+    }
+    assert!(early > 0 && late > 0, "{early} {late}");
+}
+
 /// A tip carried past the surface beyond the grid's edge makes the run unstable, with a
 /// message that names the crack and where its tip went, and the last good snapshot.
 #[test]

@@ -307,8 +307,9 @@ pub struct GrowthSpec {
     pub at: Option<f64>,
     /// "hoop" (the direction of the largest hoop stress; default) or "straight".
     pub direction: Option<String>,
-    /// Once started, run at this speed (m/s) whatever K does (default: extend by
-    /// `extension` at every check at which the criterion holds).
+    /// Once started, run at this speed (m/s) whatever K does, on the heading taken at the
+    /// start (default: extend by `extension` at every check at which the criterion
+    /// holds).
     pub speed: Option<f64>,
     /// Length of a new crack segment (m; default half the smallest cell).
     pub extension: Option<f64>,
