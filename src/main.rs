@@ -262,6 +262,14 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
             s.snapshot_seconds
         );
     }
+    if let Some(n) = s.cell_crossings.filter(|&n| n > 0) {
+        println!(
+            "  note: {n} of {} particles ended in another cell than they started in; with \
+             linear shape functions each crossing jumps the internal force, which can feed \
+             energy in (uGIMP does not)",
+            s.particles
+        );
+    }
     for t in &s.tubes {
         let part = |what: &str, v: &str| (!v.is_empty()).then(|| format!("{what} at vertices {v}"));
         let parts: Vec<String> = [

@@ -48,6 +48,9 @@ pub struct Summary {
     /// The process's peak resident memory so far (bytes; Linux `VmHWM`), None where the
     /// system does not report it.
     pub peak_resident_bytes: Option<u64>,
+    /// With linear shape functions, the particles that ended in another cell than they
+    /// started in (each crossing jumps their internal force); None with the other shapes.
+    pub cell_crossings: Option<usize>,
     /// Energies at the end (J).
     pub energies: Energies,
     /// Results of the scenario's `[[expect]]` blocks (only for a completed run).

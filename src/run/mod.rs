@@ -453,6 +453,7 @@ fn drive<D: Dim>(
         bytes_per_particle: world.bytes_per_particle(),
         bytes_per_node: crate::grid::Grid::<D>::bytes_per_node(),
         peak_resident_bytes: crate::output::summary::peak_resident_bytes(),
+        cell_crossings: world.cell_crossings(),
         energies: world.energies(),
         expects: results,
         paths: reports::paths(&world, fracture.as_ref(), &state.history),
