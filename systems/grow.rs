@@ -29,20 +29,24 @@ pub fn needs_k(world: &World<D2>, step: u64) -> bool {
     };
     let topo = &cracks.topology;
     (topo.fronts().iter().zip(&cracks.tips)).any(|(f, st)| {
-        topo.cracks()[f.crack as usize]
-            .growth
-            .is_some_and(|g| step.is_multiple_of(g.check) && reads_k(&g, st))
+        topo.cracks()[f.crack as usize].growth.is_some_and(|g| {
+            let t = step as f64 * world.settings.dt;
+            step.is_multiple_of(g.check) && reads_k(&g, st, t)
+        })
     })
 }
 
-/// Whether a tip in state `st` reads K or J at a check: to start on a criterion, to turn
-/// by the hoop stress, to keep extending while its criterion holds, or (fatigue) for the
-/// growth rate.
-fn reads_k(g: &Growth, st: &TipState) -> bool {
-    let criterion = !matches!(g.initiation, Initiation::Time { .. });
+/// Whether a tip in state `st` reads K or J at a check at time `t`: to start on a
+/// criterion, to turn by the hoop stress (at its start time on, for a tip started by the
+/// clock), to keep extending while its criterion holds, or (fatigue) for the growth rate.
+fn reads_k(g: &Growth, st: &TipState, t: f64) -> bool {
+    let (criterion, due) = match g.initiation {
+        Initiation::Time { at } => (false, t >= at),
+        _ => (true, true),
+    };
     match (st.stopped, st.started.is_nan()) {
         (0, _) if g.paris.is_some() => true,
-        (0, true) => criterion || g.direction == Direction::Hoop,
+        (0, true) => criterion || (due && g.direction == Direction::Hoop),
         (0, false) => g.speed.is_none() && (g.direction == Direction::Hoop || criterion),
         _ => false,
     }
@@ -191,7 +195,7 @@ fn reading(world: &World<D2>, plan: Option<&FracturePlan>, f: usize) -> Option<(
     let front = &cracks.topology.fronts()[f];
     let g = cracks.topology.cracks()[front.crack as usize].growth?;
     let st = &cracks.tips[f];
-    if st.stopped != 0 || !world.step.is_multiple_of(g.check) || !reads_k(&g, st) {
+    if st.stopped != 0 || !world.step.is_multiple_of(g.check) || !reads_k(&g, st, world.time) {
         return None;
     }
     let (tip, behind) = tip_and_behind(cracks, f);
