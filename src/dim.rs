@@ -53,8 +53,8 @@ pub trait Dim: Copy + Clone + Send + Sync + Debug + Default + 'static {
     /// The fracture system of this dimension (J and K at crack tips in 2D, at every front
     /// vertex in 3D, stored in the crack scratch).
     const FRACTURE: FractureSystem<Self>;
-    /// The growth system of this dimension; None where cracks do not grow yet (3D).
-    const GROWTH: Option<GrowthSystem<Self>>;
+    /// The growth system of this dimension (tips in 2D, fronts in 3D).
+    const GROWTH: GrowthSystem<Self>;
 
     /// The zero vector.
     fn zero() -> Self::Vec;
@@ -161,10 +161,10 @@ impl Dim for D2 {
     type Sym = Sym2;
     type Elem = Segment;
     const FRACTURE: FractureSystem<Self> = crate::systems::fracture::run;
-    const GROWTH: Option<GrowthSystem<Self>> = Some(GrowthSystem {
+    const GROWTH: GrowthSystem<Self> = GrowthSystem {
         run: crate::systems::grow::run,
         needs_k: crate::systems::grow::needs_k,
-    });
+    };
 
     #[inline(always)]
     fn zero() -> DVec2 {
@@ -278,7 +278,10 @@ impl Dim for D3 {
     type Sym = Sym3;
     type Elem = Triangle;
     const FRACTURE: FractureSystem<Self> = crate::systems::fracture_front::run;
-    const GROWTH: Option<GrowthSystem<Self>> = None;
+    const GROWTH: GrowthSystem<Self> = GrowthSystem {
+        run: crate::systems::grow_front::run,
+        needs_k: crate::systems::grow::needs_k,
+    };
 
     #[inline(always)]
     fn zero() -> DVec3 {

@@ -50,6 +50,25 @@ pub struct Growth {
     pub paris: Option<Paris>,
 }
 
+impl Growth {
+    /// Whether a tip or front in state `st` reads K or J at a check at time `t`: to start
+    /// on a criterion, to turn by the hoop stress (at its start time on, for one started by
+    /// the clock), to keep extending while its criterion holds, or (fatigue) for the growth
+    /// rate.
+    pub fn reads_k(&self, st: &TipState, t: f64) -> bool {
+        let (criterion, due) = match self.initiation {
+            Initiation::Time { at } => (false, t >= at),
+            _ => (true, true),
+        };
+        match (st.stopped, st.started.is_nan()) {
+            (0, _) if self.paris.is_some() => true,
+            (0, true) => criterion || (due && self.direction == Direction::Hoop),
+            (0, false) => self.speed.is_none() && (self.direction == Direction::Hoop || criterion),
+            _ => false,
+        }
+    }
+}
+
 /// The Paris-Erdogan law da/dN = C (Delta K_eq)^m (Belytschko et al. 1995, Eq. 38), with the
 /// equivalent mode I range of Eq. 40 ([`delta_k_eq`]). The run holds the cycle's largest
 /// load, so K_min = R K_max (linear elasticity, proportional load).
@@ -137,6 +156,19 @@ impl TipState {
             rate: v[7],
             checked: v[8],
         })
+    }
+}
+
+impl TipState {
+    /// Fatigue at a check whose growth rate (m per cycle) is `rate`: the cycles from the
+    /// last check's length to this one by the trapezoidal rule in the length (second order
+    /// in the extension, where the forward rule would be first).
+    pub fn count_cycles(&mut self, rate: f64) {
+        if !self.rate.is_nan() && rate > 0.0 {
+            self.cycles += (self.grown - self.checked) * 0.5 * (1.0 / self.rate + 1.0 / rate);
+        }
+        self.rate = rate;
+        self.checked = self.grown;
     }
 }
 

@@ -289,10 +289,14 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
     }
     for g in &s.growth {
         if let Some(why) = &g.stopped {
+            let part = match g.tip.as_str() {
+                "front" => "front".to_string(),
+                end => format!("{end} tip"),
+            };
             println!(
-                "  note: the {} tip of crack `{}` {why} at ({:.4e}, {:.4e}) m after growing \
+                "  note: the {part} of crack `{}` {why} at ({:.4e}, {:.4e}) m after growing \
                  {:.4e} m, and stopped there",
-                g.tip, g.crack, g.x[0], g.x[1], g.grown
+                g.crack, g.x[0], g.x[1], g.grown
             );
         }
     }

@@ -147,11 +147,10 @@ impl Schedule {
         if fracture.is_some() {
             s.push(Fracture);
         }
-        let grows = D::GROWTH.is_some()
-            && world
-                .cracks
-                .as_ref()
-                .is_some_and(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()));
+        let grows = world
+            .cracks
+            .as_ref()
+            .is_some_and(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()));
         if grows {
             s.push(Grow);
         }
@@ -208,7 +207,7 @@ impl Schedule {
         keep_stencils: bool,
         measure: bool,
     ) -> Result<(), Unstable> {
-        let growth = D::GROWTH.filter(|_| self.grows);
+        let growth = Some(D::GROWTH).filter(|_| self.grows);
         // A step whose end a growing tip reads K at keeps its stencils, as a measured one.
         let reads = growth
             .as_ref()

@@ -174,7 +174,7 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
 
 /// How far `x` lies from the nearest triangle of a crack other than `c`, looking no further
 /// than `reach` (m; `f64::INFINITY` when none is that near).
-fn room(cracks: &Cracks<D3>, c: usize, x: DVec3, reach: f64) -> f64 {
+pub(crate) fn room(cracks: &Cracks<D3>, c: usize, x: DVec3, reach: f64) -> f64 {
     let topo = &cracks.topology;
     let v = &cracks.geometry.x;
     (topo.elems().iter().zip(topo.elem_crack()))

@@ -9,11 +9,11 @@
 //! contact and measured from the next step on.
 
 use crate::crack::{Cracks, Element};
-use crate::dim::D2;
+use crate::dim::{D2, Dim};
 use crate::error::Unstable;
 use crate::fracture::FracturePlan;
 use crate::growth::{
-    Direction, Growth, GrowthRow, Initiation, Paris, Stopped, TipState, hoop_angle, hoop_k,
+    Direction, GrowthRow, Initiation, Paris, Stopped, TipState, hoop_angle, hoop_k,
 };
 use crate::interaction::near;
 use crate::shape::ShapeKind;
@@ -21,9 +21,9 @@ use crate::systems::fracture;
 use crate::world::World;
 use glam::DVec2;
 
-/// Whether some growing tip reads K or J at the end of step `step` (so that step must keep
-/// its particles' stencils for the measurement).
-pub fn needs_k(world: &World<D2>, step: u64) -> bool {
+/// Whether some growing tip or front reads K or J at the end of step `step` (so that step
+/// must keep its particles' stencils for the measurement).
+pub fn needs_k<D: Dim>(world: &World<D>, step: u64) -> bool {
     let Some(cracks) = &world.cracks else {
         return false;
     };
@@ -31,25 +31,9 @@ pub fn needs_k(world: &World<D2>, step: u64) -> bool {
     (topo.fronts().iter().zip(&cracks.tips)).any(|(f, st)| {
         topo.cracks()[f.crack as usize].growth.is_some_and(|g| {
             let t = step as f64 * world.settings.dt;
-            step.is_multiple_of(g.check) && reads_k(&g, st, t)
+            step.is_multiple_of(g.check) && g.reads_k(st, t)
         })
     })
-}
-
-/// Whether a tip in state `st` reads K or J at a check at time `t`: to start on a
-/// criterion, to turn by the hoop stress (at its start time on, for a tip started by the
-/// clock), to keep extending while its criterion holds, or (fatigue) for the growth rate.
-fn reads_k(g: &Growth, st: &TipState, t: f64) -> bool {
-    let (criterion, due) = match g.initiation {
-        Initiation::Time { at } => (false, t >= at),
-        _ => (true, true),
-    };
-    match (st.stopped, st.started.is_nan()) {
-        (0, _) if g.paris.is_some() => true,
-        (0, true) => criterion || (due && g.direction == Direction::Hoop),
-        (0, false) => g.speed.is_none() && (g.direction == Direction::Hoop || criterion),
-        _ => false,
-    }
 }
 
 /// Advances every growing tip by what this step allows. `plan` is the scene's fracture
@@ -195,7 +179,7 @@ fn reading(world: &World<D2>, plan: Option<&FracturePlan>, f: usize) -> Option<(
     let front = &cracks.topology.fronts()[f];
     let g = cracks.topology.cracks()[front.crack as usize].growth?;
     let st = &cracks.tips[f];
-    if st.stopped != 0 || !world.step.is_multiple_of(g.check) || !reads_k(&g, st, world.time) {
+    if st.stopped != 0 || !world.step.is_multiple_of(g.check) || !g.reads_k(st, world.time) {
         return None;
     }
     let (tip, behind) = tip_and_behind(cracks, f);
@@ -205,15 +189,10 @@ fn reading(world: &World<D2>, plan: Option<&FracturePlan>, f: usize) -> Option<(
 }
 
 /// Fatigue at a check: the growth rate from K_I and K_II at the largest load, and the
-/// cycles from the last check's length to this one by the trapezoidal rule in a (second
-/// order in the extension, where the forward rule would be first). Returns Delta K_eq.
+/// cycles to the tip's length (see [`TipState::count_cycles`]). Returns Delta K_eq.
 fn fatigue(p: &Paris, st: &mut TipState, k1: f64, k2: f64) -> f64 {
     let (rate, _, dk) = p.rate(k1, k2);
-    if !st.rate.is_nan() && rate > 0.0 {
-        st.cycles += (st.grown - st.checked) * 0.5 * (1.0 / st.rate + 1.0 / rate);
-    }
-    st.rate = rate;
-    st.checked = st.grown;
+    st.count_cycles(rate);
     dk
 }
 
@@ -315,16 +294,18 @@ fn first_crossing(cracks: &Cracks<D2>, f: usize, a: DVec2, b: DVec2) -> Option<f
 }
 
 /// Whether `x` lies in the body: within three quarters of a particle spacing (from its
-/// area) of some particle near it, along both axes. A crack line runs half a spacing from
-/// the particle rows on either side of it, so half a spacing would leave it outside.
-fn inside(world: &World<D2>, x: DVec2) -> bool {
+/// area or volume) of some particle near it, along every axis. A crack runs half a spacing
+/// from the particle layers on either side of it, so half a spacing would leave it outside.
+pub(crate) fn inside<D: Dim>(world: &World<D>, x: D::Vec) -> bool {
     let p = &world.particles;
     let thickness = world.settings.thickness;
-    near(world, x, world.grid.geom.h[0].max(world.grid.geom.h[1]))
-        .into_iter()
-        .any(|i| {
-            let half = 0.75 * (p.volume[i] / thickness).sqrt();
-            let d = (x - p.x[i]).abs();
-            d.x <= half && d.y <= half
-        })
+    let h = (0..D::D).map(|a| world.grid.geom.h[a]).fold(0.0, f64::max);
+    near(world, x, h).into_iter().any(|i| {
+        let spacing = if D::D == 2 {
+            (p.volume[i] / thickness).sqrt()
+        } else {
+            p.volume[i].cbrt()
+        };
+        (0..D::D).all(|a| (x[a] - p.x[i][a]).abs() <= 0.75 * spacing)
+    })
 }

@@ -9,6 +9,7 @@ pub mod fracture_front;
 pub mod g2p;
 pub mod grid_update;
 pub mod grow;
+pub mod grow_front;
 pub mod p2g;
 pub mod stress;
 pub mod stress_bin;

@@ -4,9 +4,12 @@
 
 mod common;
 
-use common::{PARIS_GROWTH, edge_plate, source};
+use common::{PARIS_GROWTH, PENNY_FATIGUE, edge_plate, source};
+use fissure::dim::D3;
 use fissure::growth::GrowthRow;
 use fissure::run::{Outcome, RunOptions, run};
+use fissure::world::World;
+use glam::DVec3;
 
 fn run_with(text: &str, threads: usize) -> Outcome {
     let opts = RunOptions {
@@ -246,4 +249,74 @@ fn growth_outputs_are_written() {
     let png = std::fs::read(dir.join("growth.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"), "growth.png is a PNG");
     std::fs::remove_dir_all(dir).ok();
+}
+
+/// A 3D front set growing by the clock with no load: at every check each vertex of the
+/// penny's front moves a whole extension along its radius (the frame's x1 axis of a
+/// regular polygon), so the crack is the polygon of the same vertices at the grown radius
+/// (area N/2 r^2 sin(2 pi / N)), the front keeps its vertices, and growth.csv's mean
+/// advance counts the checks.
+#[test]
+fn a_3d_front_grows_in_its_plane_and_stays_round() {
+    let growth = "initiation = \"time\"\nat = 1.0e-6\nextension = 2.5e-4\ninterval = 1.0e-6";
+    let text = common::penny_block(growth, 0.0, 3.05e-6);
+    let world: World<D3> = common::final_world(&text, 2);
+    let out = run_with(&text, 2);
+    let rows = &out.history.growth;
+    assert_eq!(rows.len(), 3, "checks at 1, 2 and 3 us");
+    for (k, g) in rows.iter().enumerate() {
+        assert!((g.grown - 2.5e-4 * k as f64).abs() < 1e-15, "{}", g.grown);
+    }
+    let cracks = world.cracks.as_ref().unwrap();
+    let front = &cracks.topology.fronts()[0].vertices;
+    let n = front.len() as f64;
+    let centre = DVec3::splat(0.006);
+    let radius = 0.003 + 3.0 * 2.5e-4;
+    for &v in front {
+        let d = cracks.geometry.x[v as usize] - centre;
+        assert!(
+            d.y.abs() < 1e-12 && (d.length() - radius).abs() < 1e-12,
+            "{d}"
+        );
+    }
+    let x = &cracks.geometry.x;
+    let area: f64 = (cracks.topology.elems().iter())
+        .map(|t| {
+            let [a, b, c] = t.map(|k| x[k as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum();
+    let exact = 0.5 * n * radius * radius * (std::f64::consts::TAU / n).sin();
+    assert!(
+        (area - exact).abs() < 1e-12 * exact,
+        "{area} against {exact}"
+    );
+}
+
+/// Fatigue along a 3D front, with the K it reads and the cycles it counts, is bitwise the
+/// same on 1, 2 and 3 threads; the front grows at every check.
+#[test]
+fn front_growth_is_identical_on_one_two_and_three_threads() {
+    let text = common::penny_block(PENNY_FATIGUE, 7.2e3, 6.3e-6);
+    let bits = |o: &Outcome| -> Vec<u64> {
+        (o.history.growth.iter())
+            .flat_map(|g| g.values())
+            .chain(o.history.fracture.iter().flat_map(|t| t.values()))
+            .map(f64::to_bits)
+            .collect()
+    };
+    let one = run_with(&text, 1);
+    assert_eq!(one.history.growth.len(), 3, "checks at 4.1, 5.2 and 6.2 us");
+    assert!(
+        one.history
+            .growth
+            .windows(2)
+            .all(|w| w[1].fatigue[1] > w[0].fatigue[1])
+    );
+    for threads in [2, 3] {
+        assert!(
+            bits(&one) == bits(&run_with(&text, threads)),
+            "{threads} threads"
+        );
+    }
 }

@@ -134,6 +134,15 @@ fn restart_is_bit_exact_with_a_growing_crack() {
     restart_is_bit_exact(&text, 330, 2, "growing");
 }
 
+/// A 3D front growing under fatigue resumes bit for bit: the front's state, the vertices
+/// and triangles it added and the strip's surfaces travel in the snapshot.
+#[test]
+fn restart_is_bit_exact_with_a_growing_front() {
+    let text = common::penny_block(common::PENNY_FATIGUE, 7.2e3, 6.3e-6)
+        + "interval = 2.0e-6\n[checkpoint]\nevery_steps = 100\n";
+    restart_is_bit_exact(&text, 55, 2, "growing-front");
+}
+
 #[test]
 fn restart_is_bit_exact_2d_one_and_two_threads() {
     let text = scene(2, "ugimp", "usavg");

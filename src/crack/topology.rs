@@ -6,6 +6,7 @@ use super::element::Element;
 use super::law::Contact;
 use crate::dim::Dim;
 use crate::growth::Growth;
+use std::collections::HashMap;
 
 /// One crack of the store.
 #[derive(Clone, Debug, PartialEq)]
@@ -158,6 +159,89 @@ impl<D: Dim> Topology<D> {
         self.vertex_count += 1;
         self.version += 1;
         new
+    }
+
+    /// Inserts a strip of triangles behind front `front` of a 3D crack, for a front whose
+    /// vertices flagged in `moves` are about to advance: each of them leaves a new vertex
+    /// (the next free indices, in front order) in its place, which takes it over in the
+    /// crack's triangles, and each front edge gains the triangles that join the vertices
+    /// behind it to the front, oriented as the triangle the edge was on. A front vertex
+    /// keeps its index and its place in the front. Returns the vertex behind each front
+    /// vertex (itself where it does not move), or the first front edge that lies on no
+    /// triangle of the crack (so the strip's orientation is unknown).
+    pub fn insert_behind_front(
+        &mut self,
+        front: usize,
+        moves: &[bool],
+        closed: bool,
+    ) -> Result<Vec<u32>, TopologyError>
+    where
+        D: Dim<Elem = super::element::Triangle>,
+    {
+        let c = self.fronts[front].crack;
+        let fv = self.fronts[front].vertices.clone();
+        let mut next = self.vertex_count as u32;
+        let behind: Vec<u32> = (fv.iter().zip(moves))
+            .map(|(&v, &m)| {
+                if !m {
+                    return v;
+                }
+                next += 1;
+                next - 1
+            })
+            .collect();
+        let taken: HashMap<u32, u32> = (fv.iter().zip(&behind))
+            .filter(|(v, b)| v != b)
+            .map(|(&v, &b)| (v, b))
+            .collect();
+        for (e, _) in (self.elems.iter_mut().zip(&self.elem_crack)).filter(|(_, k)| **k == c) {
+            for v in e.iter_mut() {
+                if let Some(&b) = taken.get(v) {
+                    *v = b;
+                }
+            }
+        }
+        let edges = if closed { fv.len() } else { fv.len() - 1 };
+        let mut strip = Vec::with_capacity(2 * edges);
+        for i in 0..edges {
+            let j = (i + 1) % fv.len();
+            if behind[i] == fv[i] && behind[j] == fv[j] {
+                continue;
+            }
+            let (p, q) = (behind[i], behind[j]);
+            let forward = (self.elems.iter().zip(&self.elem_crack))
+                .filter(|(_, k)| **k == c)
+                .find_map(|(e, _)| {
+                    let at = |v: u32| e.iter().position(|&w| w == v);
+                    let (a, b) = (at(p)?, at(q)?);
+                    Some((a + 1) % 3 == b)
+                })
+                .ok_or_else(|| {
+                    TopologyError(format!(
+                        "front edge {i} of crack `{}` lies on none of its triangles",
+                        self.cracks[c as usize].name
+                    ))
+                })?;
+            // The quadrilateral behind the edge, run against the edge's own triangle,
+            // fanned from its first corner (a corner that did not move closes it to one).
+            let quad = if forward {
+                [q, p, fv[i], fv[j]]
+            } else {
+                [p, q, fv[j], fv[i]]
+            };
+            for t in [[quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]] {
+                if t[0] != t[1] && t[1] != t[2] && t[2] != t[0] {
+                    strip.push(t);
+                }
+            }
+        }
+        self.elem_crack.extend(std::iter::repeat_n(c, strip.len()));
+        self.elems.extend(strip);
+        let first = self.vertex_count as u32;
+        self.cracks[c as usize].vertices.extend(first..next);
+        self.vertex_count = next as usize;
+        self.version += 1;
+        Ok(behind)
     }
 
     /// Topology read back from stored parts, checked: every index in range, every front

@@ -99,9 +99,9 @@ pub fn panels(
 
 /// Draws curves in the plane (x, y in m) into a PNG at `path`, one metre on x as long as
 /// one on y, so that angles read true (crack paths).
-pub fn plane(path: &Path, title: &str, series: &[Series]) -> Result<(), String> {
+pub fn plane(path: &Path, title: &str, labels: [&str; 2], series: &[Series]) -> Result<(), String> {
     figure(path, (760, 800), title, |area| {
-        draw(area, "x (m)", "y (m)", series, true)
+        draw(area, labels[0], labels[1], series, true)
     })
 }
 

@@ -113,11 +113,11 @@ pub struct TubeReport {
 pub struct GrowthReport {
     /// Crack name.
     pub crack: String,
-    /// "start" or "end".
+    /// "start" or "end"; "front" for a 3D front.
     pub tip: String,
-    /// Where the tip is (m).
+    /// Where the tip is (m); for a 3D front the mean of its vertices (x, y).
     pub x: [f64; 2],
-    /// Length grown (m).
+    /// Length grown (m); for a 3D front its mean advance.
     pub grown: f64,
     /// Time it started to grow (s); null if it did not.
     pub started: Option<f64>,

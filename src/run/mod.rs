@@ -7,7 +7,7 @@ pub mod state;
 pub mod stop;
 pub mod writers;
 
-use crate::crack::Cracks;
+use crate::crack::{Cracks, Element};
 use crate::dim::{D2, D3, Dim};
 use crate::error::{Unstable, UsageError};
 use crate::fracture::TipResult;
@@ -683,21 +683,68 @@ fn plot_front(
     )
 }
 
-/// growth.png: every growing crack's path (its whole polyline) at the end of the run.
+/// growth.png: every growing crack's path (its whole polyline) at the end of the run; in
+/// 3D its fronts at the end, seen along the global axis nearest its mean normal.
 fn plot_paths<D: Dim>(path: &Path, name: &str, cracks: &Cracks<D>) -> Result<(), String> {
-    let series: Vec<Series> = (cracks.topology.cracks().iter())
-        .filter(|c| c.growth.is_some())
-        .map(|c| Series {
-            label: &c.name,
-            points: (c.vertices.iter())
-                .map(|&v| {
-                    let x = D::to_xyz(cracks.geometry.x[v as usize]);
-                    (x[0], x[1])
-                })
-                .collect(),
+    let topo = &cracks.topology;
+    let x = &cracks.geometry.x;
+    let growing = |c: usize| topo.cracks()[c].growth.is_some();
+    if D::D == 2 {
+        let series: Vec<Series> = (topo.cracks().iter().enumerate())
+            .filter(|&(c, _)| growing(c))
+            .map(|(_, c)| Series {
+                label: &c.name,
+                points: (c.vertices.iter())
+                    .map(|&v| {
+                        let p = D::to_xyz(x[v as usize]);
+                        (p[0], p[1])
+                    })
+                    .collect(),
+            })
+            .collect();
+        return plot::plane(
+            path,
+            &format!("{name}: crack paths"),
+            ["x (m)", "y (m)"],
+            &series,
+        );
+    }
+    // The axis the cracks face most: the largest component of their summed area normals.
+    let mut normal = [0.0f64; 3];
+    for (e, &c) in topo.elems().iter().zip(topo.elem_crack()) {
+        if growing(c as usize) {
+            let n = D::to_xyz(D::elem_normal(x, *e));
+            (0..3).for_each(|a| normal[a] += n[a].abs());
+        }
+    }
+    let facing = (0..3).fold(0, |b, a| if normal[a] > normal[b] { a } else { b });
+    let axes = [(facing + 1) % 3, (facing + 2) % 3];
+    let series: Vec<Series> = (topo.fronts().iter())
+        .filter(|f| growing(f.crack as usize))
+        .map(|f| {
+            // A closed front's two ends share a triangle.
+            let (first, last) = (f.vertices[0], f.vertices[f.vertices.len() - 1]);
+            let closed = (topo.elems().iter())
+                .any(|e| e.vertices().contains(&first) && e.vertices().contains(&last));
+            let ring = f.vertices.first().filter(|_| closed);
+            Series {
+                label: &topo.cracks()[f.crack as usize].name,
+                points: (f.vertices.iter().chain(ring))
+                    .map(|&v| {
+                        let p = D::to_xyz(x[v as usize]);
+                        (p[axes[0]], p[axes[1]])
+                    })
+                    .collect(),
+            }
         })
         .collect();
-    plot::plane(path, &format!("{name}: crack paths"), &series)
+    let label = |a: usize| ["x (m)", "y (m)", "z (m)"][a];
+    plot::plane(
+        path,
+        &format!("{name}: crack fronts at the end"),
+        [label(axes[0]), label(axes[1])],
+        &series,
+    )
 }
 
 /// energy.png: the energies and works on top; below, the energy balance's drift

@@ -129,10 +129,18 @@ pub(super) fn growth<D: Dim>(world: &World<D>) -> Vec<GrowthReport> {
         .filter_map(|(f, st)| {
             let crack = &topo.cracks()[f.crack as usize];
             let g = crack.growth?;
-            let x = D::to_xyz(cracks.geometry.x[f.vertices[0] as usize]);
+            let at = |v: &u32| D::to_xyz(cracks.geometry.x[*v as usize]);
+            let n = f.vertices.len() as f64;
+            let x = (f.vertices.iter().map(at))
+                .fold([0.0; 3], |s, x| [0, 1, 2].map(|a| s[a] + x[a] / n));
+            let tip = if D::D == 3 {
+                "front"
+            } else {
+                ["start", "end"][f.end as usize]
+            };
             Some(GrowthReport {
                 crack: crack.name.clone(),
-                tip: ["start", "end"][f.end as usize].into(),
+                tip: tip.into(),
                 x: [x[0], x[1]],
                 grown: st.grown,
                 started: (!st.started.is_nan()).then_some(st.started),

@@ -217,9 +217,19 @@ impl Writers {
     /// Appends the growing tips' new segments to growth.csv: the length grown and tip
     /// before the segment (m), K read there (Pa sqrt(m)), the segment's turn and direction
     /// (degrees), and under fatigue Delta K_eq (Pa sqrt(m)) and the cycles to that length.
+    /// A 3D front's row (tip `front`) holds its mean advance, the mean of its vertices (x,
+    /// y), and the means of K and Delta K_eq along it.
     pub fn growth(&mut self, rows: &[GrowthRow]) -> anyhow::Result<()> {
         let Some((f, names)) = &mut self.growth else {
             return Ok(());
+        };
+        let front = self.front_vertices;
+        let tip = |t: u32| {
+            if front {
+                "front"
+            } else {
+                ["start", "end"][t as usize]
+            }
         };
         for g in rows {
             writeln!(
@@ -228,7 +238,7 @@ impl Writers {
                 g.step,
                 g.time,
                 names[g.crack as usize],
-                ["start", "end"][g.tip as usize],
+                tip(g.tip),
                 g.grown,
                 g.x[0],
                 g.x[1],

@@ -610,13 +610,13 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             }
             _ if e.quantity == "K_drift" => Some(super::cracks::drift_measure(src, i, e)?),
             _ if ["kink", "path_angle", "turn", "cycles"].contains(&e.quantity.as_str()) => {
-                if D::D == 3 {
+                if D::D == 3 && e.quantity != "cycles" {
                     return Err(src.error(
                         &key("quantity"),
                         format!("`{}` follows a growing 2D tip", e.quantity),
                     ));
                 }
-                Some(super::growth::growth_measure(src, i, e)?)
+                Some(super::growth::growth_measure(src, i, e, D::D == 3)?)
             }
             _ => None,
         };

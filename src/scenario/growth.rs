@@ -34,12 +34,6 @@ pub(super) fn growth<D: Dim>(
         return Ok(None);
     };
     let key = |k: &str| format!("crack[{c}].growth.{k}");
-    if D::D != 2 {
-        return Err(src.error(
-            &format!("crack[{c}].growth"),
-            "crack growth is 2D for now: a 3D front does not grow",
-        ));
-    }
     if !tips {
         return Err(src.error(
             &format!("crack[{c}].growth"),
@@ -47,16 +41,32 @@ pub(super) fn growth<D: Dim>(
         ));
     }
     let initiation = initiation(src, c, g)?;
-    let direction = match g.direction.as_deref().unwrap_or("hoop") {
-        "hoop" => Direction::Hoop,
-        "straight" => Direction::Straight,
-        other => {
+    // A 3D front grows in its own plane; a 2D tip turns by the hoop stress unless told.
+    let planar = D::D == 3;
+    let direction = match g.direction.as_deref() {
+        Some("hoop") if planar => {
+            return Err(src.error(
+                &key("direction"),
+                "a 3D front grows in its own plane: direction = \"straight\" (the default in 3D)",
+            ));
+        }
+        Some("hoop") => Direction::Hoop,
+        Some("straight") => Direction::Straight,
+        None if planar => Direction::Straight,
+        None => Direction::Hoop,
+        Some(other) => {
             return Err(src.error(
                 &key("direction"),
                 format!("unknown direction `{other}` (hoop, straight)"),
             ));
         }
     };
+    if planar && g.speed.is_some() {
+        return Err(src.error(
+            &key("speed"),
+            "a 3D front does not run at a set speed: it grows by its criterion or a Paris law",
+        ));
+    }
     let paris = match &g.paris {
         Some(p) => Some(paris(src, c, p, &initiation, g.speed.is_some())?),
         None => None,
@@ -210,9 +220,9 @@ fn rayleigh_speed(m: &Material) -> f64 {
 }
 
 /// The measure of a growth expect (`kink`, `path_angle`, `turn`, `cycles`) on expect `i`: a named
-/// crack with a growth table, one of its tips, and for `cycles` a Paris law and the
-/// `length` grown (m).
-pub(super) fn growth_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure> {
+/// crack with a growth table, one of its tips (in 3D, with a `front`, its one front), and
+/// for `cycles` a Paris law and the `length` grown (m; in 3D the front's mean advance).
+pub(super) fn growth_measure(src: &Source, i: usize, e: &ExpectSpec, front: bool) -> R<Measure> {
     let key = |k: &str| format!("expect[{i}].{k}");
     let sc = &src.scenario;
     let name = e
@@ -228,13 +238,22 @@ pub(super) fn growth_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measur
             format!("crack `{name}` does not grow (it has no [crack.growth] table)"),
         ));
     };
-    let tip = match e.tip.as_deref().unwrap_or("end") {
-        "start" => 0,
-        "end" => 1,
-        other => return Err(src.error(&key("tip"), format!("unknown tip `{other}` (start, end)"))),
+    let tip = match e.tip.as_deref() {
+        Some(_) if front => {
+            return Err(src.error(
+                &key("tip"),
+                "a 3D crack grows along its front, not at a tip",
+            ));
+        }
+        None if front => 0,
+        Some("start") => 0,
+        Some("end") | None => 1,
+        Some(other) => {
+            return Err(src.error(&key("tip"), format!("unknown tip `{other}` (start, end)")));
+        }
     };
     let tips = spec.tips.clone().unwrap_or_else(|| vec!["end".into()]);
-    if !tips.iter().any(|t| t == ["start", "end"][tip]) {
+    if !front && !tips.iter().any(|t| t == ["start", "end"][tip]) {
         return Err(src.error(
             &key("tip"),
             format!("the {} of `{name}` is not a tip", ["start", "end"][tip]),

@@ -305,7 +305,8 @@ pub struct GrowthSpec {
     pub g_c: Option<f64>,
     /// Start time (s), for "time".
     pub at: Option<f64>,
-    /// "hoop" (the direction of the largest hoop stress; default) or "straight".
+    /// "hoop" (the direction of the largest hoop stress; the default in 2D) or "straight"
+    /// (on along the last segment; in 3D in the crack plane, the only choice there).
     pub direction: Option<String>,
     /// Once started, run at this speed (m/s) whatever K does, on the heading taken at the
     /// start (default: extend by `extension` at every check at which the criterion

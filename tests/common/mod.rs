@@ -349,6 +349,65 @@ history_interval = 1.0e-6
     )
 }
 
+/// A 12 mm steel cube with a penny crack of radius 3 mm at its centre, normal to y, under
+/// a ramped tension `force` (N) on its top and bottom particle layers; `growth` is the
+/// body of the crack's `[crack.growth]` table and `duration` the run's length (s). J and
+/// K are measured on tubes of two cells when `force` is not zero.
+pub fn penny_block(growth: &str, force: f64, duration: f64) -> String {
+    let fracture = if force != 0.0 {
+        "[fracture]\ndomain = 2\n"
+    } else {
+        ""
+    };
+    format!(
+        r#"name = "penny_growth"
+[simulation]
+dimension = 3
+shape = "ugimp"
+update = "usavg"
+duration = {duration:e}
+cfl = 0.5
+damping = 6.0e5
+[grid]
+min = [-0.002, -0.002, -0.002]
+max = [0.014, 0.014, 0.014]
+cell = [0.001, 0.001, 0.001]
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 8000.0
+[[body]]
+material = "steel"
+box = {{ min = [0.0, 0.0, 0.0], max = [0.012, 0.012, 0.012] }}
+[[crack]]
+name = "penny"
+penny = {{ center = [0.006, 0.006, 0.006], normal = [0.0, 1.0, 0.0], radius = 0.003 }}
+[crack.growth]
+{growth}
+[[load]]
+region = {{ min = [0.0, 0.0115, 0.0], max = [0.012, 0.012, 0.012] }}
+force = [0.0, {force:e}, 0.0]
+time = {{ kind = "ramp", rise = 2.0e-6 }}
+[[load]]
+region = {{ min = [0.0, 0.0, 0.0], max = [0.012, 0.0005, 0.012] }}
+force = [0.0, {neg:e}, 0.0]
+time = {{ kind = "ramp", rise = 2.0e-6 }}
+{fracture}[output]
+history_interval = 1.0e-6
+"#,
+        neg = -force
+    )
+}
+
+/// A fatigue law for [`penny_block`]: Paris growth by a quarter cell every
+/// microsecond (12 steps) from the check at 4.1 us on.
+pub const PENNY_FATIGUE: &str = r#"initiation = "time"
+at = 3.5e-6
+extension = 2.5e-4
+interval = 1.0e-6
+paris = { C = 1.0e-29, m = 3.0 }"#;
+
 /// A fatigue law for [`edge_plate`]: Paris growth by a cell every 4 us from 10 us on.
 pub const PARIS_GROWTH: &str = r#"initiation = "time"
 at = 1.0e-5
