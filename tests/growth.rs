@@ -209,7 +209,13 @@ fn growth_out_of_the_grid_stops_the_run() {
 /// 3 threads.
 #[test]
 fn growth_is_identical_on_one_two_and_three_threads() {
-    let text = edge_plate(PARIS_GROWTH, 2.0e-5);
+    let one = same_on_one_two_and_three_threads(&edge_plate(PARIS_GROWTH, 2.0e-5));
+    assert!(!one.history.growth.is_empty());
+}
+
+/// Runs `text` on 1, 2 and 3 threads, asserts that the growth and fracture rows are
+/// bitwise the same, and returns the one-thread run.
+fn same_on_one_two_and_three_threads(text: &str) -> Outcome {
     let bits = |o: &Outcome| -> Vec<u64> {
         (o.history.growth.iter())
             .flat_map(|g| g.values())
@@ -217,14 +223,14 @@ fn growth_is_identical_on_one_two_and_three_threads() {
             .map(f64::to_bits)
             .collect()
     };
-    let one = run_with(&text, 1);
-    assert!(!one.history.growth.is_empty());
+    let one = run_with(text, 1);
     for threads in [2, 3] {
         assert!(
-            bits(&one) == bits(&run_with(&text, threads)),
+            bits(&one) == bits(&run_with(text, threads)),
             "{threads} threads"
         );
     }
+    one
 }
 
 /// growth.csv holds one row per new segment, as the history does, with the cycles in its
@@ -298,25 +304,8 @@ fn a_3d_front_grows_in_its_plane_and_stays_round() {
 #[test]
 fn front_growth_is_identical_on_one_two_and_three_threads() {
     let text = common::penny_block(PENNY_FATIGUE, 7.2e3, 6.3e-6);
-    let bits = |o: &Outcome| -> Vec<u64> {
-        (o.history.growth.iter())
-            .flat_map(|g| g.values())
-            .chain(o.history.fracture.iter().flat_map(|t| t.values()))
-            .map(f64::to_bits)
-            .collect()
-    };
-    let one = run_with(&text, 1);
-    assert_eq!(one.history.growth.len(), 3, "checks at 4.1, 5.2 and 6.2 us");
-    assert!(
-        one.history
-            .growth
-            .windows(2)
-            .all(|w| w[1].fatigue[1] > w[0].fatigue[1])
-    );
-    for threads in [2, 3] {
-        assert!(
-            bits(&one) == bits(&run_with(&text, threads)),
-            "{threads} threads"
-        );
-    }
+    let one = same_on_one_two_and_three_threads(&text);
+    let rows = &one.history.growth;
+    assert_eq!(rows.len(), 3, "checks at 4.1, 5.2 and 6.2 us");
+    assert!(rows.windows(2).all(|w| w[1].fatigue[1] > w[0].fatigue[1]));
 }

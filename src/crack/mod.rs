@@ -34,6 +34,19 @@ pub struct Geometry<D: Dim> {
     pub bottom: Vec<D::Vec>,
 }
 
+impl<D: Dim> Geometry<D> {
+    /// A new vertex (the next index) where vertex `v` is, with its surfaces, and `v` moved
+    /// to `to` with both surfaces closed on it: how a tip or front vertex advances.
+    fn leave_behind(&mut self, v: usize, to: D::Vec) {
+        self.x.push(self.x[v]);
+        self.top.push(self.top[v]);
+        self.bottom.push(self.bottom[v]);
+        self.x[v] = to;
+        self.top[v] = to;
+        self.bottom[v] = to;
+    }
+}
+
 impl<D: Dim> Default for Geometry<D> {
     fn default() -> Self {
         Geometry {
@@ -65,14 +78,7 @@ impl<D: Dim<Elem = Segment>> Cracks<D> {
         let f = &self.topology.fronts()[front];
         let (c, end, tip) = (f.crack as usize, f.end, f.vertices[0]);
         let new = self.topology.insert_behind_tip(c, end, tip);
-        let g = &mut self.geometry;
-        let t = tip as usize;
-        g.x.push(g.x[t]);
-        g.top.push(g.top[t]);
-        g.bottom.push(g.bottom[t]);
-        g.x[t] = to;
-        g.top[t] = to;
-        g.bottom[t] = to;
+        self.geometry.leave_behind(tip as usize, to);
         new
     }
 }
@@ -91,18 +97,11 @@ impl<D: Dim<Elem = Triangle>> Cracks<D> {
         let moves: Vec<bool> = to.iter().map(Option::is_some).collect();
         let behind = self.topology.insert_behind_front(front, &moves, closed)?;
         let fv = &self.topology.fronts()[front].vertices;
-        let g = &mut self.geometry;
         for ((&v, &b), t) in fv.iter().zip(&behind).zip(to) {
-            let (v, Some(t)) = (v as usize, *t) else {
-                continue;
-            };
-            debug_assert_eq!(b as usize, g.x.len());
-            g.x.push(g.x[v]);
-            g.top.push(g.top[v]);
-            g.bottom.push(g.bottom[v]);
-            g.x[v] = t;
-            g.top[v] = t;
-            g.bottom[v] = t;
+            if let Some(t) = *t {
+                debug_assert_eq!(b as usize, self.geometry.x.len());
+                self.geometry.leave_behind(v as usize, t);
+            }
         }
         Ok(())
     }
