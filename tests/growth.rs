@@ -234,7 +234,8 @@ fn same_on_one_two_and_three_threads(text: &str) -> Outcome {
 }
 
 /// growth.csv holds one row per new segment, as the history does, with the cycles in its
-/// last column; growth.png draws the path.
+/// last column, and cycles.csv the length grown against cycles; growth.png draws the
+/// path.
 #[test]
 fn growth_outputs_are_written() {
     let dir = std::env::temp_dir().join(format!("fissure-grow-{}-out", std::process::id()));
@@ -251,6 +252,20 @@ fn growth_outputs_are_written() {
     for (line, row) in lines[1..].iter().zip(&out.history.growth) {
         let cycles: f64 = line.rsplit(',').next().unwrap().parse().unwrap();
         assert!((cycles - row.fatigue[1]).abs() <= 1e-8 * row.fatigue[1].max(1.0));
+    }
+    // cycles.csv: the fatigue rows alone, length grown against cycles.
+    let cycles = std::fs::read_to_string(dir.join("cycles.csv")).unwrap();
+    let lines: Vec<&str> = cycles.lines().collect();
+    assert_eq!(lines[0], "step,time,crack,tip,grown,dKeq,cycles");
+    assert_eq!(lines.len() - 1, out.history.growth.len());
+    for (line, row) in lines[1..].iter().zip(&out.history.growth) {
+        let v: Vec<f64> = line
+            .split(',')
+            .skip(4)
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert!((v[0] - row.grown).abs() <= 1e-8 * row.grown.max(1e-3));
+        assert!((v[2] - row.fatigue[1]).abs() <= 1e-8 * row.fatigue[1].max(1.0));
     }
     let png = std::fs::read(dir.join("growth.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"), "growth.png is a PNG");

@@ -92,7 +92,7 @@ fn restart_is_bit_exact(text: &str, k: u64, threads: usize, name: &str) {
 
     let last_frame = newest_frame(&dir.join("full"));
     let final_snap = format!("snapshots/step_{steps:012}.fsnap");
-    let measured = ["fracture.csv", "paths.csv", "growth.csv"]
+    let measured = ["fracture.csv", "paths.csv", "growth.csv", "cycles.csv"]
         .into_iter()
         .filter(|f| dir.join("full").join(f).exists());
     for f in ["energy.csv", "probes.csv", &last_frame, &final_snap]

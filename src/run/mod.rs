@@ -209,11 +209,17 @@ fn drive<D: Dim>(
         .as_ref()
         .and(world.cracks.as_ref())
         .map(|c| c.topology.cracks().iter().map(|c| c.name.clone()).collect());
-    let growing: Option<Vec<String>> = world
+    let growing: Option<(Vec<String>, bool)> = world
         .cracks
         .as_ref()
         .filter(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()))
-        .map(|c| c.topology.cracks().iter().map(|c| c.name.clone()).collect());
+        .map(|c| {
+            let cracks = c.topology.cracks();
+            let fatigue = cracks
+                .iter()
+                .any(|c| c.growth.is_some_and(|g| g.paris.is_some()));
+            (cracks.iter().map(|c| c.name.clone()).collect(), fatigue)
+        });
     let mut writers = match &opts.out {
         Some(dir) => Some(Writers::open(
             dir,
@@ -221,7 +227,7 @@ fn drive<D: Dim>(
             crack_names.as_deref(),
             fracture.as_ref().is_some_and(|f| !f.compare.is_empty()),
             D::D == 3,
-            growing.as_deref(),
+            growing.as_ref().map(|(n, f)| (n.as_slice(), *f)),
             &state.history,
         )?),
         None => None,

@@ -48,6 +48,8 @@ pub struct Writers {
     fracture: Option<(Named, Vec<String>)>,
     paths: Option<Named>,
     growth: Option<(Named, Vec<String>)>,
+    /// cycles.csv, when some crack grows under fatigue.
+    cycles: Option<Named>,
     /// Whether a tip is a 3D front vertex (named by its ordinal along the crack's front)
     /// rather than a 2D crack end (named start or end).
     front_vertices: bool,
@@ -62,14 +64,14 @@ impl Writers {
     /// `cracks` names the cracks when J and K are measured (then fracture.csv is written);
     /// `paths` asks for paths.csv (J on compared contours); `front_vertices` says the tips
     /// are 3D front vertices; `growing` names the cracks when some crack grows (then
-    /// growth.csv is written).
+    /// growth.csv is written) and says whether one grows under fatigue (then cycles.csv).
     pub fn open(
         dir: &Path,
         probe_names: &[String],
         cracks: Option<&[String]>,
         paths: bool,
         front_vertices: bool,
-        growing: Option<&[String]>,
+        growing: Option<(&[String], bool)>,
         history: &History,
     ) -> anyhow::Result<Self> {
         std::fs::create_dir_all(dir)
@@ -113,8 +115,16 @@ impl Writers {
             }
             _ => None,
         };
+        let cycles = match growing {
+            Some((_, true)) => {
+                let mut f = create("cycles.csv")?;
+                writeln!(f, "step,time,crack,tip,grown,dKeq,cycles")?;
+                Some(f)
+            }
+            _ => None,
+        };
         let growth = match growing {
-            Some(names) => {
+            Some((names, _)) => {
                 let mut f = create("growth.csv")?;
                 writeln!(
                     f,
@@ -131,6 +141,7 @@ impl Writers {
             fracture,
             paths,
             growth,
+            cycles,
             front_vertices,
             earlier: None,
         };
@@ -249,6 +260,19 @@ impl Writers {
                 g.fatigue[0],
                 g.fatigue[1]
             )?;
+            if let Some(c) = self.cycles.as_mut().filter(|_| g.fatigue[1].is_finite()) {
+                writeln!(
+                    c,
+                    "{},{:.9e},{},{},{:.9e},{:.9e},{:.9e}",
+                    g.step,
+                    g.time,
+                    names[g.crack as usize],
+                    tip(g.tip),
+                    g.grown,
+                    g.fatigue[0],
+                    g.fatigue[1]
+                )?;
+            }
         }
         Ok(())
     }
@@ -318,6 +342,9 @@ impl Writers {
             f.flush()?;
         }
         if let Some((f, _)) = &mut self.growth {
+            f.flush()?;
+        }
+        if let Some(f) = &mut self.cycles {
             f.flush()?;
         }
         Ok(())
