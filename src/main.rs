@@ -178,6 +178,9 @@ fn cmd_sweep(
                      tolerance",
                     s.status, s.particles, s.wall_seconds
                 );
+                for note in node_line_notes(s) {
+                    println!("  warning: {note}");
+                }
             }
             (None, Some(e)) => println!("[{k}/{n}] {what}: {e}"),
             (None, None) => {}
@@ -269,6 +272,9 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
              energy in (uGIMP does not)",
             s.particles
         );
+    }
+    for note in node_line_notes(s) {
+        println!("  note: {note}");
     }
     for t in &s.tubes {
         let part = |what: &str, v: &str| (!v.is_empty()).then(|| format!("{what} at vertices {v}"));
@@ -557,4 +563,22 @@ fn cmd_validate(
     } else {
         ExitCode::FAILURE
     }
+}
+
+/// What the launcher says of each crack that lay on a line or plane of grid nodes.
+fn node_line_notes(s: &fissure::output::summary::Summary) -> Vec<String> {
+    let what = if s.dimension == 2 { "line" } else { "plane" };
+    (s.node_lines.iter())
+        .map(|n| {
+            format!(
+                "crack `{}` lies on the node {what} {} = {:.4e} m ({:.0} % of its elements): J \
+                 and K read less accurately there and its classification is redone every \
+                 step; set it half a cell off (e.g. with `[grid] anchor`)",
+                n.crack,
+                n.axis,
+                n.at,
+                100.0 * n.share
+            )
+        })
+        .collect()
 }

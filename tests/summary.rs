@@ -54,3 +54,23 @@ velocity = [{speed:e}, 0.0]
         None
     );
 }
+
+/// The edge plate's crack at y = 0 lies half a cell from the node rows, and nothing is
+/// reported; with the grid moved half a cell, y = 0 is a node row and summary.json names
+/// the crack, the axis and the row.
+#[test]
+fn a_crack_on_a_node_row_is_reported() {
+    let growth = "initiation = \"time\"\nat = 1.0";
+    let text = common::edge_plate(growth, 1.0e-7);
+    assert!(run_text(&text).summary.node_lines.is_empty());
+    let moved = (text.replace("min = [-0.0015, -0.00875]", "min = [-0.0015, -0.009]"))
+        .replace("max = [0.0095, 0.00875]", "max = [0.0095, 0.009]");
+    let lines = run_text(&moved).summary.node_lines;
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    let n = &lines[0];
+    assert_eq!(
+        (n.crack.as_str(), n.axis.as_str(), n.share),
+        ("edge", "y", 1.0)
+    );
+    assert!(n.at.abs() < 1e-12, "{}", n.at);
+}

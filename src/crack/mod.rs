@@ -10,11 +10,13 @@
 mod element;
 mod fields;
 mod law;
+mod node_lines;
 mod topology;
 
 pub use element::{Element, Segment, Triangle};
 pub use fields::{Classified, Fields, Links, Scratch, side_bit};
 pub use law::{Contact, Law};
+pub use node_lines::{NodeLine, on_node_lines};
 pub use topology::{Crack, Front, Topology, TopologyError};
 
 use crate::dim::Dim;

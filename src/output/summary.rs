@@ -51,6 +51,8 @@ pub struct Summary {
     /// With linear shape functions, the particles that ended in another cell than they
     /// started in (each crossing jumps their internal force); None with the other shapes.
     pub cell_crossings: Option<usize>,
+    /// Cracks that lay on a line (2D) or plane (3D) of grid nodes when the run began.
+    pub node_lines: Vec<NodeLineReport>,
     /// Energies at the end (J).
     pub energies: Energies,
     /// Results of the scenario's `[[expect]]` blocks (only for a completed run).
@@ -106,6 +108,19 @@ pub struct TubeReport {
     pub shrunk: String,
     /// Vertices where no tube of 2 cells or more fits.
     pub unfitted: String,
+}
+
+/// A crack lying on a line or plane of grid nodes, which costs J and K accuracy.
+#[derive(Clone, Debug, Serialize)]
+pub struct NodeLineReport {
+    /// Crack name.
+    pub crack: String,
+    /// "x", "y" or "z": the axis the line or plane is normal to.
+    pub axis: String,
+    /// Its coordinate on that axis (m).
+    pub at: f64,
+    /// The share of the crack's elements on it.
+    pub share: f64,
 }
 
 /// A growing crack tip at the end of the run.

@@ -209,6 +209,7 @@ fn drive<D: Dim>(
         .as_ref()
         .and(world.cracks.as_ref())
         .map(|c| c.topology.cracks().iter().map(|c| c.name.clone()).collect());
+    let node_lines = reports::node_lines(&world);
     let growing: Option<(Vec<String>, bool)> = world
         .cracks
         .as_ref()
@@ -460,6 +461,7 @@ fn drive<D: Dim>(
         bytes_per_node: crate::grid::Grid::<D>::bytes_per_node(),
         peak_resident_bytes: crate::output::summary::peak_resident_bytes(),
         cell_crossings: world.cell_crossings(),
+        node_lines,
         energies: world.energies(),
         expects: results,
         paths: reports::paths(&world, fracture.as_ref(), &state.history),

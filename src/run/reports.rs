@@ -1,11 +1,12 @@
 //! The fracture reports of summary.json: path dependence of J, the tubes around a 3D front
 //! that did not fit inside the body, and how far the growing tips got.
 
+use crate::crack::on_node_lines;
 use crate::dim::Dim;
 use crate::fracture::FracturePlan;
 use crate::growth::Stopped;
 use crate::measure::{History, last_rows, path_difference, path_tips};
-use crate::output::summary::{GrowthReport, PathReport, TubeReport};
+use crate::output::summary::{GrowthReport, NodeLineReport, PathReport, TubeReport};
 use crate::world::World;
 
 /// The path-dependence report of summary.json: every crack tip against every compared
@@ -147,6 +148,21 @@ pub(super) fn growth<D: Dim>(world: &World<D>) -> Vec<GrowthReport> {
                 cycles: g.paris.map(|_| st.cycles),
                 stopped: Stopped::from_code(st.stopped).map(|s| s.describe().into()),
             })
+        })
+        .collect()
+}
+
+/// The cracks that lie on a line or plane of grid nodes as the world stands.
+pub(super) fn node_lines<D: Dim>(world: &World<D>) -> Vec<NodeLineReport> {
+    let Some(cracks) = &world.cracks else {
+        return Vec::new();
+    };
+    (on_node_lines(cracks, &world.grid.geom).into_iter())
+        .map(|n| NodeLineReport {
+            crack: cracks.topology.cracks()[n.crack].name.clone(),
+            axis: ["x", "y", "z"][n.axis].into(),
+            at: n.at,
+            share: n.share,
         })
         .collect()
 }
