@@ -141,7 +141,12 @@ fn advance(
             st.stopped = Stopped::Surface as u8;
         }
     }
-    let grown = mean(&ds);
+    // The front's mean advance, counting a vertex held for a share under a hundredth of a
+    // cell as not moving.
+    let moved: Vec<f64> = (to.iter().zip(&ds))
+        .map(|(t, &d)| if t.is_some() { d } else { 0.0 })
+        .collect();
+    let grown = mean(&moved);
     let moves = st.stopped == 0 && to.iter().any(Option::is_some);
     if moves {
         let k = rows.map_or([f64::NAN; 2], |r| {
