@@ -324,3 +324,19 @@ fn front_growth_is_identical_on_one_two_and_three_threads() {
     assert_eq!(rows.len(), 3, "checks at 4.1, 5.2 and 6.2 us");
     assert!(rows.windows(2).all(|w| w[1].fatigue[1] > w[0].fatigue[1]));
 }
+
+/// A 3D front set growing by the clock a cell per check reaches the cube's faces (3 mm
+/// from the penny's rim along the axes): it stops as a whole at the check whose move would
+/// carry a vertex out of the body, that move not taken, and the summary says so.
+#[test]
+fn a_3d_front_stops_at_the_free_surface() {
+    let growth = "initiation = \"time\"\nat = 1.0e-6\nextension = 1.0e-3\ninterval = 1.0e-6";
+    let out = run_with(&common::penny_block(growth, 0.0, 6.05e-6), 2);
+    let g = &out.summary.growth[0];
+    assert_eq!((g.crack.as_str(), g.tip.as_str()), ("penny", "front"));
+    assert_eq!(g.stopped.as_deref(), Some("reached the free surface"));
+    // Three whole cells grown, to a radius of 6 mm (the vertices on the axes on the
+    // faces, a quarter cell from the outer particles); the fourth would carry them a cell
+    // past.
+    assert!((g.grown - 3.0e-3).abs() < 1e-12, "{}", g.grown);
+}
