@@ -178,7 +178,7 @@ fn cmd_sweep(
                      tolerance",
                     s.status, s.particles, s.wall_seconds
                 );
-                for note in node_line_notes(s) {
+                for note in node_line_notes(&s.node_lines, s.dimension) {
                     println!("  warning: {note}");
                 }
             }
@@ -273,7 +273,7 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
             s.particles
         );
     }
-    for note in node_line_notes(s) {
+    for note in node_line_notes(&s.node_lines, s.dimension) {
         println!("  note: {note}");
     }
     for t in &s.tubes {
@@ -467,6 +467,10 @@ fn cmd_check(path: &Path, overrides: &[String]) -> ExitCode {
                         fissure::run::step_count(scene.duration, w.settings.dt),
                         names.join(" -> ")
                     );
+                    let dim = usize::from(src.scenario.simulation.dimension);
+                    for note in node_line_notes(&fissure::run::node_lines(w), dim) {
+                        println!("  note: {note}");
+                    }
                     ExitCode::SUCCESS
                 }
                 Err(e) => bad_input(&e),
@@ -565,10 +569,14 @@ fn cmd_validate(
     }
 }
 
-/// What the launcher says of each crack that lay on a line or plane of grid nodes.
-fn node_line_notes(s: &fissure::output::summary::Summary) -> Vec<String> {
-    let what = if s.dimension == 2 { "line" } else { "plane" };
-    (s.node_lines.iter())
+/// What the launcher says of each crack that lies on a line or plane of grid nodes.
+fn node_line_notes(
+    lines: &[fissure::output::summary::NodeLineReport],
+    dimension: usize,
+) -> Vec<String> {
+    let what = if dimension == 2 { "line" } else { "plane" };
+    lines
+        .iter()
         .map(|n| {
             format!(
                 "crack `{}` lies on the node {what} {} = {:.4e} m ({:.0} % of its elements): J \

@@ -3,6 +3,7 @@
 
 pub mod checkpoint;
 mod reports;
+pub use reports::node_lines;
 pub mod state;
 pub mod stop;
 pub mod writers;

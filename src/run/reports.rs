@@ -153,7 +153,7 @@ pub(super) fn growth<D: Dim>(world: &World<D>) -> Vec<GrowthReport> {
 }
 
 /// The cracks that lie on a line or plane of grid nodes as the world stands.
-pub(super) fn node_lines<D: Dim>(world: &World<D>) -> Vec<NodeLineReport> {
+pub fn node_lines<D: Dim>(world: &World<D>) -> Vec<NodeLineReport> {
     let Some(cracks) = &world.cracks else {
         return Vec::new();
     };
