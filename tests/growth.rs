@@ -340,3 +340,22 @@ fn a_3d_front_stops_at_the_free_surface() {
     // past.
     assert!((g.grown - 3.0e-3).abs() < 1e-12, "{}", g.grown);
 }
+
+/// A 3D front under the energy criterion: with G_c far below the J it reads every vertex
+/// holds, so the front advances a whole extension at each check from the first; with G_c
+/// far above, it never starts.
+#[test]
+fn a_3d_front_grows_where_j_reaches_gc() {
+    let law = |g_c: f64| {
+        format!("initiation = \"energy\"\nGc = {g_c:e}\nextension = 2.5e-4\ninterval = 1.0e-6")
+    };
+    let out = run_with(&common::penny_block(&law(1.0e-3), 7.2e3, 6.3e-6), 2);
+    let rows = &out.history.growth;
+    assert!(rows.len() >= 3, "{} checks grew", rows.len());
+    for (k, g) in rows.iter().enumerate() {
+        assert!((g.grown - 2.5e-4 * k as f64).abs() < 1e-15, "{}", g.grown);
+    }
+    let out = run_with(&common::penny_block(&law(1.0e9), 7.2e3, 6.3e-6), 2);
+    assert!(out.history.growth.is_empty());
+    assert_eq!(out.summary.growth[0].started, None);
+}
