@@ -65,8 +65,6 @@ pub fn front_line(cracks: &Cracks<D3>, front: &Front) -> FrontLine {
     // Per front vertex: the summed area normals and the summed centroids of its triangles.
     let mut normal = vec![DVec3::ZERO; fv.len()];
     let mut centroid = vec![(DVec3::ZERO, 0.0); fv.len()];
-    let mut closed = false;
-    let (first, last) = (fv[0], fv[fv.len() - 1]);
     for (e, &c) in topo.elems().iter().zip(topo.elem_crack()) {
         if c != front.crack {
             continue;
@@ -80,8 +78,8 @@ pub fn front_line(cracks: &Cracks<D3>, front: &Front) -> FrontLine {
                 centroid[o].1 += 1.0;
             }
         }
-        closed |= fv.len() > 2 && e.contains(&first) && e.contains(&last);
     }
+    let closed = topo.is_closed(front);
     let n = fv.len();
     let frames = (0..n)
         .map(|k| {

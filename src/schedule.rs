@@ -207,7 +207,7 @@ impl Schedule {
         keep_stencils: bool,
         measure: bool,
     ) -> Result<(), Unstable> {
-        let growth = Some(D::GROWTH).filter(|_| self.grows);
+        let growth = self.grows.then_some(D::GROWTH);
         // A step whose end a growing tip reads K at keeps its stencils, as a measured one.
         let reads = growth
             .as_ref()

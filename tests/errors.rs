@@ -816,6 +816,11 @@ fn bad_growth_tables_name_the_key() {
          reference = 1.0\nsource = \"x\"\ntolerance = 0.1\n"
     ));
     assert_error(&e, "expect[0].quantity", None, "2D tip");
+    let e = error_3d(
+        "[[crack]]\nrectangle = { center = [0.01, 0.01, 0.01], axes = [[0.003, 0.0, 0.0], \
+         [0.0, 0.0, 0.003]] }\n[crack.growth]\ninitiation = \"time\"\nat = 0.0\n",
+    );
+    assert_error(&e, "crack[0].growth", None, "no front to grow");
 }
 
 /// GOOD with `keys` added to its material (from line 15 on).

@@ -45,24 +45,22 @@ pub fn on_node_lines<D: Dim>(cracks: &Cracks<D>, geom: &GridGeom<D>) -> Vec<Node
             }
         }
     }
-    let mut found: Vec<NodeLine> = Vec::new();
+    // Per crack, the line holding most of its elements (the first such in axis order).
+    let mut best: BTreeMap<u16, (usize, usize, i64)> = BTreeMap::new();
     for ((c, a, k), n) in on {
-        let share = n as f64 / elements[c as usize] as f64;
-        let best = found.last().is_some_and(|f| f.crack == c as usize);
-        if share < REPORTED_SHARE || best && found.last().is_some_and(|f| f.share >= share) {
-            continue;
+        if best.get(&c).is_none_or(|b| n > b.0) {
+            best.insert(c, (n, a, k));
         }
-        if best {
-            found.pop();
-        }
-        found.push(NodeLine {
+    }
+    (best.into_iter())
+        .map(|(c, (n, a, k))| NodeLine {
             crack: c as usize,
             axis: a,
             at: geom.origin[a] + k as f64 * geom.h[a],
-            share,
-        });
-    }
-    found
+            share: n as f64 / elements[c as usize] as f64,
+        })
+        .filter(|l| l.share >= REPORTED_SHARE)
+        .collect()
 }
 
 /// The node line or plane normal to axis `a` that `p` lies on (within a millionth of a

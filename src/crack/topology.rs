@@ -6,7 +6,7 @@ use super::element::Element;
 use super::law::Contact;
 use crate::dim::Dim;
 use crate::growth::Growth;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// One crack of the store.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,6 +92,17 @@ impl<D: Dim> Topology<D> {
     /// Changes whenever elements, vertices or fronts do.
     pub fn version(&self) -> u64 {
         self.version
+    }
+
+    /// Whether `front` is a loop: its two ends lie on one element of its crack (in 3D, a
+    /// triangle edge joins them).
+    pub fn is_closed(&self, front: &Front) -> bool {
+        let fv = &front.vertices;
+        let (first, last) = (fv[0], fv[fv.len() - 1]);
+        fv.len() > 2
+            && (self.elems.iter().zip(&self.elem_crack)).any(|(e, &k)| {
+                k == front.crack && e.vertices().contains(&first) && e.vertices().contains(&last)
+            })
     }
 
     /// Adds a crack of `vertices` new vertices (numbered after the existing ones), with
@@ -180,6 +191,26 @@ impl<D: Dim> Topology<D> {
     {
         let c = self.fronts[front].crack;
         let fv = self.fronts[front].vertices.clone();
+        // The crack's triangle edges, each in the direction its triangle runs it: how each
+        // front edge is oriented, found before anything changes.
+        let runs: HashSet<(u32, u32)> = (self.elems.iter().zip(&self.elem_crack))
+            .filter(|(_, k)| **k == c)
+            .flat_map(|(e, _)| (0..3).map(move |k| (e[k], e[(k + 1) % 3])))
+            .collect();
+        let edges = if closed { fv.len() } else { fv.len() - 1 };
+        let forward = (0..edges)
+            .map(|i| {
+                let (a, b) = (fv[i], fv[(i + 1) % fv.len()]);
+                match (runs.contains(&(a, b)), runs.contains(&(b, a))) {
+                    (true, _) => Ok(true),
+                    (_, true) => Ok(false),
+                    _ => Err(TopologyError(format!(
+                        "front edge {i} of crack `{}` lies on none of its triangles",
+                        self.cracks[c as usize].name
+                    ))),
+                }
+            })
+            .collect::<Result<Vec<bool>, _>>()?;
         let mut next = self.vertex_count as u32;
         let behind: Vec<u32> = (fv.iter().zip(moves))
             .map(|(&v, &m)| {
@@ -201,29 +232,13 @@ impl<D: Dim> Topology<D> {
                 }
             }
         }
-        let edges = if closed { fv.len() } else { fv.len() - 1 };
         let mut strip = Vec::with_capacity(2 * edges);
-        for i in 0..edges {
+        for (i, &forward) in forward.iter().enumerate() {
             let j = (i + 1) % fv.len();
-            if behind[i] == fv[i] && behind[j] == fv[j] {
-                continue;
-            }
             let (p, q) = (behind[i], behind[j]);
-            let forward = (self.elems.iter().zip(&self.elem_crack))
-                .filter(|(_, k)| **k == c)
-                .find_map(|(e, _)| {
-                    let at = |v: u32| e.iter().position(|&w| w == v);
-                    let (a, b) = (at(p)?, at(q)?);
-                    Some((a + 1) % 3 == b)
-                })
-                .ok_or_else(|| {
-                    TopologyError(format!(
-                        "front edge {i} of crack `{}` lies on none of its triangles",
-                        self.cracks[c as usize].name
-                    ))
-                })?;
             // The quadrilateral behind the edge, run against the edge's own triangle,
-            // fanned from its first corner (a corner that did not move closes it to one).
+            // fanned from its first corner (a corner that did not move closes it to one;
+            // an edge neither of whose ends moved has none).
             let quad = if forward {
                 [q, p, fv[i], fv[j]]
             } else {

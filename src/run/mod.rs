@@ -8,7 +8,7 @@ pub mod state;
 pub mod stop;
 pub mod writers;
 
-use crate::crack::{Cracks, Element};
+use crate::crack::Cracks;
 use crate::dim::{D2, D3, Dim};
 use crate::error::{Unstable, UsageError};
 use crate::fracture::TipResult;
@@ -699,9 +699,9 @@ fn plot_paths<D: Dim>(path: &Path, name: &str, cracks: &Cracks<D>) -> Result<(),
     let x = &cracks.geometry.x;
     let growing = |c: usize| topo.cracks()[c].growth.is_some();
     if D::D == 2 {
-        let series: Vec<Series> = (topo.cracks().iter().enumerate())
-            .filter(|&(c, _)| growing(c))
-            .map(|(_, c)| Series {
+        let series: Vec<Series> = (topo.cracks().iter())
+            .filter(|c| c.growth.is_some())
+            .map(|c| Series {
                 label: &c.name,
                 points: (c.vertices.iter())
                     .map(|&v| {
@@ -731,11 +731,7 @@ fn plot_paths<D: Dim>(path: &Path, name: &str, cracks: &Cracks<D>) -> Result<(),
     let series: Vec<Series> = (topo.fronts().iter())
         .filter(|f| growing(f.crack as usize))
         .map(|f| {
-            // A closed front's two ends share a triangle.
-            let (first, last) = (f.vertices[0], f.vertices[f.vertices.len() - 1]);
-            let closed = (topo.elems().iter())
-                .any(|e| e.vertices().contains(&first) && e.vertices().contains(&last));
-            let ring = f.vertices.first().filter(|_| closed);
+            let ring = f.vertices.first().filter(|_| topo.is_closed(f));
             Series {
                 label: &topo.cracks()[f.crack as usize].name,
                 points: (f.vertices.iter().chain(ring))

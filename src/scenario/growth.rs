@@ -35,10 +35,12 @@ pub(super) fn growth<D: Dim>(
     };
     let key = |k: &str| format!("crack[{c}].growth.{k}");
     if !tips {
-        return Err(src.error(
-            &format!("crack[{c}].growth"),
-            "the crack has no tip to grow (see `tips`)",
-        ));
+        let why = if D::D == 2 {
+            "the crack has no tip to grow (see `tips`)"
+        } else {
+            "the crack has no front to grow (a rectangle cuts through the body and has none)"
+        };
+        return Err(src.error(&format!("crack[{c}].growth"), why));
     }
     let initiation = initiation(src, c, g)?;
     // A 3D front grows in its own plane; a 2D tip turns by the hoop stress unless told.
