@@ -113,44 +113,75 @@ impl Material {
 
     /// The stress update of a plastic material (`j2` set) by the strain increment `de`, with
     /// the particle's plastic strain and hardening state: an elastic predictor and a radial
-    /// return. In plane stress the zz strain is found by the secant method so that the
-    /// returned sigma_zz vanishes (it is monotone in that strain).
+    /// return.
     pub fn update_plastic(
         &self,
         plane: Plane,
+        de: Sym3,
+        stress: &mut Sym3,
+        plastic: &mut Sym3,
+        h: &mut Hardened,
+    ) {
+        let start = *stress;
+        self.update(plane, de, stress);
+        self.correct_plastic(plane, de, &start, stress, plastic, h);
+    }
+
+    /// Corrects the elastic trial `stress` (the update of `start` by `de`) of a plastic
+    /// material to the yield surface. In plane stress the zz strain is then found by the
+    /// secant method so that the returned sigma_zz vanishes (it is monotone in that
+    /// strain).
+    fn correct_plastic(
+        &self,
+        plane: Plane,
         mut de: Sym3,
+        start: &Sym3,
         stress: &mut Sym3,
         plastic: &mut Sym3,
         h: &mut Hardened,
     ) {
         let Some(j2) = &self.j2 else {
-            return self.update(plane, de, stress);
+            return;
         };
-        let trial = |de: &Sym3| {
-            let (mut s, mut p, mut hh) = (*stress, *plastic, *h);
-            self.add_elastic(de, &mut s);
+        let returned = |trial: Sym3| {
+            let (mut s, mut p, mut hh) = (trial, *plastic, *h);
             j2.radial_return(&mut s, &mut p, &mut hh);
             (s, p, hh)
         };
         if plane != Plane::Stress {
-            (*stress, *plastic, *h) = trial(&de);
+            (*stress, *plastic, *h) = returned(*stress);
             return;
         }
-        de.zz = self.plane_stress_zz(&de);
-        let mut now = trial(&de);
+        let trial = |de: &Sym3| {
+            let mut s = *start;
+            self.add_elastic(de, &mut s);
+            returned(s)
+        };
+        // The first zz strain: the elastic one, or, from a start on the yield surface, the
+        // one the elastic-plastic tangent predicts (one return fewer in steady flow).
+        let mut now = match self.plastic_zz(j2, &de, start, h) {
+            Some(zz) => {
+                de.zz = zz;
+                trial(&de)
+            }
+            None => {
+                de.zz = self.plane_stress_zz(&de);
+                returned(*stress)
+            }
+        };
         let tol = 1e-12 * j2.flow_stress(&now.2);
         if now.0.zz.abs() > tol {
-            // The first correction follows the continuum elastic-plastic tangent's zz entry,
-            // (lambda + 2 mu) - 6 mu^2/(3 mu + H) N_zz^2 with N = sqrt(3/2) S / sigma_y
-            // (Mashayekhi et al. 2011, Eq. 60); the secant method takes it from there.
+            // The first correction is Newton's, with the zz-zz entry of the radial return's
+            // consistent tangent (Simo & Hughes 1998, Box 3.2): K + 4/3 mu theta - 2 mu
+            // theta_bar u_zz^2, theta = y / q_trial = y / (y + 3 mu dl), theta_bar =
+            // 3 mu / (3 mu + H) - (1 - theta); the secant method takes it from there.
             let (mut z0, mut f0) = (de.zz, now.0.zz);
             let y = j2.flow_stress(&now.2);
-            let n_zz = now.0.deviator().zz / y;
-            let slope = self.lambda + 2.0 * self.mu
-                - 6.0 * self.mu * self.mu / (3.0 * self.mu + j2.hardening_slope(y))
-                    * 1.5
-                    * n_zz
-                    * n_zz;
+            let theta = y / (y + 3.0 * self.mu * (now.2.equivalent - h.equivalent));
+            let (beta, u, _) = self.tangent(j2, &now.0.deviator(), y);
+            let theta_bar = beta / (2.0 * self.mu) - (1.0 - theta);
+            let slope = self.lambda + 2.0 * self.mu * (1.0 / 3.0 + 2.0 / 3.0 * theta)
+                - 2.0 * self.mu * theta_bar * u.zz * u.zz;
             de.zz -= f0 / slope;
             now = trial(&de);
             for _ in 0..crate::plastic::MAX_ITERATIONS {
@@ -165,6 +196,31 @@ impl Material {
             }
         }
         (*stress, *plastic, *h) = now;
+    }
+
+    /// The continuum elastic-plastic tangent at a stress with deviator `dev` on the yield
+    /// surface `y`: C_ep = C - beta u (x) u with beta = 6 mu^2/(3 mu + H) and the unit
+    /// normal u = sqrt(3/2) S / y (Mashayekhi et al. 2011, Eq. 60). Returns beta, u and
+    /// the zz-zz entry.
+    fn tangent(&self, j2: &J2, dev: &Sym3, y: f64) -> (f64, Sym3, f64) {
+        let beta = 6.0 * self.mu * self.mu / (3.0 * self.mu + j2.hardening_slope(y));
+        let u = *dev * (1.5f64.sqrt() / y);
+        (beta, u, self.lambda + 2.0 * self.mu - beta * u.zz * u.zz)
+    }
+
+    /// The zz strain increment that keeps sigma_zz = 0 under the elastic-plastic tangent at
+    /// `start`, when `start` lies on the yield surface of state `h` (None otherwise): the
+    /// zz row of C_ep : de = 0, lambda tr(de) + 2 mu de_zz - beta u_zz (u : de) = 0,
+    /// solved for de_zz.
+    fn plastic_zz(&self, j2: &J2, de: &Sym3, start: &Sym3, h: &Hardened) -> Option<f64> {
+        let y = j2.flow_stress(h);
+        let dev = start.deviator();
+        if h.equivalent == 0.0 || 1.5 * dev.ddot(&dev) < (y * (1.0 - 1e-6)).powi(2) {
+            return None;
+        }
+        let (beta, u, czz) = self.tangent(j2, &dev, y);
+        let u_de = Sym3 { zz: 0.0, ..*de }.ddot(&u);
+        Some((beta * u.zz * u_de - self.lambda * (de.xx + de.yy)) / czz)
     }
 
     /// Elastic strain from stress through the 3D compliance, eps = ((1 + nu) sigma - nu

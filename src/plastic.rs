@@ -56,12 +56,24 @@ pub(crate) const MAX_ITERATIONS: usize = 60;
 /// Relative tolerance of the scalar solves.
 const TOLERANCE: f64 = 1e-13;
 
-/// r^e, by repeated multiplication when e is a whole number (the usual Ramberg-Osgood
-/// exponents), several times faster than `powf` in the return map's Newton iterations.
+/// r^e, by squaring when e is a small whole number (the usual Ramberg-Osgood exponents):
+/// a few multiplications inline, where `powf` (or `powi`'s library call) costs several
+/// times more in the return map's Newton iterations.
 #[inline(always)]
 fn power(r: f64, e: f64) -> f64 {
-    if e.fract() == 0.0 && e.abs() <= 128.0 {
-        r.powi(e as i32)
+    // `e as u32` saturates, so the round trip holds only for whole e in 0..=64 (and,
+    // unlike `fract`, it needs no library call).
+    let k = e as u32;
+    if k <= 64 && k as f64 == e {
+        let (mut k, mut base, mut acc) = (k, r, 1.0);
+        while k > 0 {
+            if k & 1 == 1 {
+                acc *= base;
+            }
+            base *= base;
+            k >>= 1;
+        }
+        acc
     } else {
         r.powf(e)
     }
@@ -76,12 +88,6 @@ impl J2 {
         } else {
             self.yield_stress
         }
-    }
-
-    /// The equivalent plastic strain at yield stress `y` on the Ramberg-Osgood curve.
-    fn ramberg_osgood_strain(&self, n: f64, y: f64) -> f64 {
-        let r = y / self.yield_stress;
-        self.yield_stress / self.youngs * (power(r, n) - r)
     }
 
     /// The hardening slope H = d(sigma_y)/d(eps_p) at yield stress `y` (Pa).
@@ -109,22 +115,35 @@ impl J2 {
                 // In the new yield stress y: f(y) = q - y - 3G (eps_p(y) - eps_p) is concave
                 // and decreasing on [y0, q]. Newton's first step from y0 (the linearised
                 // return) lands just past the root, and from there Newton falls monotonically
-                // onto it: a step or two for the small increments of an explicit step.
+                // onto it. It stops once the next step's bound, |f''| / (2 |f'(y0)|) times
+                // this step squared (|f'| is least at y0, |f''| largest at the iterate), is
+                // below the tolerance in the plastic strain it gives: for the small
+                // increments of an explicit step, two evaluations of the law. The new eps_p(y) is the last evaluation's,
+                // extended to y along its slope (the error is of the bound's order).
                 let (s0, eps0) = (self.yield_stress, self.yield_stress / self.youngs);
-                let mut y = y0;
+                // Reciprocals off the chain of dependent operations a return is.
+                let inv_s0 = 1.0 / s0;
+                let c = g3 * eps0 * inv_s0;
+                let df0 = 1.0 + c * (n * power(y0 * inv_s0, n - 1.0) - 1.0);
+                let mut y = (y0 + (q - y0) / df0).min(q);
+                let mut strain = h.equivalent;
                 for _ in 0..MAX_ITERATIONS {
-                    let r = y / s0;
-                    let rn1 = power(r, n - 1.0);
-                    let f = q - y - g3 * (eps0 * (rn1 * r - r) - h.equivalent);
-                    let df = -1.0 - g3 * eps0 / s0 * (n * rn1 - 1.0);
-                    let step = f / df;
-                    y = (y - step).clamp(y0, q);
-                    if step.abs() <= TOLERANCE * q {
+                    let r = y * inv_s0;
+                    let p = power(r, n - 1.0);
+                    let e = eps0 * (p * r - r);
+                    let df = 1.0 + c * (n * p - 1.0);
+                    let step = (q - y - g3 * (e - h.equivalent)) / df;
+                    let next = (y + step).clamp(y0, q);
+                    strain = e + (next - y) * eps0 * inv_s0 * (n * p - 1.0);
+                    y = next;
+                    // 2 |f'(y0)| r times the bound on y's error (|f''(y)| r = c n (n - 1)
+                    // r^(n-1) / s0), and the strain's error it makes, against the strain.
+                    let bound = c * n * (n - 1.0) * p * inv_s0 * step * step;
+                    if bound * eps0 * inv_s0 * (n * p - 1.0) <= 2.0 * df0 * TOLERANCE * strain * r {
                         break;
                     }
                 }
-                let dl = (self.ramberg_osgood_strain(n, y) - h.equivalent).max(0.0);
-                (dl, y)
+                ((strain - h.equivalent).max(0.0), y)
             }
         }
     }
@@ -141,18 +160,20 @@ impl J2 {
     /// updating the plastic strain and hardening state; a trial inside is kept.
     #[inline]
     pub fn radial_return(&self, trial: &mut Sym3, plastic: &mut Sym3, h: &mut Hardened) {
-        if !self.yields(trial, h) {
+        let s = trial.deviator();
+        let q2 = 1.5 * s.ddot(&s);
+        let y0 = self.flow_stress(h);
+        if q2 <= y0 * y0 {
             return;
         }
         let p = trial.trace() / 3.0;
-        let s = trial.deviator();
-        let q = (1.5 * s.ddot(&s)).sqrt();
-        let y0 = self.flow_stress(h);
+        let q = q2.sqrt();
         let (dl, y) = self.consistency(q, y0, h);
-        // Eq. 56: S = (1 - 3 G dl / q) S_trial; the flow direction is S_trial / q.
-        let shrink = 1.0 - 3.0 * self.mu * dl / q;
-        *trial = s * shrink + Sym3::identity() * p;
-        *plastic += s * (1.5 * dl / q);
+        // Eq. 56: S = (1 - 3 G dl / q) S_trial = (y / q) S_trial; the flow direction is
+        // S_trial / q.
+        let inv_q = 1.0 / q;
+        *trial = s * (y * inv_q) + Sym3::identity() * p;
+        *plastic += s * (1.5 * dl * inv_q);
         // The dissipation sigma_y d(eps_p) by the trapezoidal rule (exact for linear hardening).
         h.work += 0.5 * (y0 + y) * dl;
         h.equivalent += dl;
@@ -172,6 +193,12 @@ mod tests {
     /// A stress update of `m` by `de` with plastic state, returning the new stress.
     fn step(m: &Material, plane: Plane, de: Sym3, st: &mut (Sym3, Sym3, Hardened)) {
         m.update_plastic(plane, de, &mut st.0, &mut st.1, &mut st.2);
+    }
+
+    /// The equivalent plastic strain at yield stress `y` on the Ramberg-Osgood curve.
+    fn ramberg_osgood_strain(j2: &J2, n: f64, y: f64) -> f64 {
+        let r = y / j2.yield_stress;
+        j2.yield_stress / j2.youngs * (r.powf(n) - r)
     }
 
     fn effective(s: &Sym3) -> f64 {
@@ -210,8 +237,12 @@ mod tests {
                     assert!(q <= y, "{hardening:?}: elastic above yield");
                 }
                 if let Hardening::RambergOsgood { exponent } = hardening {
-                    let e = j2.ramberg_osgood_strain(exponent, y);
-                    assert!((e - st.2.equivalent).abs() <= 1e-12 * e, "{hardening:?}");
+                    let e = ramberg_osgood_strain(&j2, exponent, y);
+                    assert!(
+                        (e - st.2.equivalent).abs() <= 1e-12 * e,
+                        "{hardening:?} {}",
+                        (e - st.2.equivalent) / e
+                    );
                 }
                 // Plastic flow is deviatoric.
                 assert!(st.1.trace().abs() <= 1e-15 * st.2.equivalent.max(1e-30));
