@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 use fissure::dim::{D2, D3};
 use fissure::error::{ScenarioError, UsageError};
+use fissure::measure::ExpectResult;
 use fissure::run::checkpoint::resolve;
 use fissure::run::stop::StopRequests;
 use fissure::run::{Outcome, RunOptions, resume, run};
@@ -275,6 +276,14 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
     }
     for note in node_line_notes(&s.node_lines, s.dimension) {
         println!("  note: {note}");
+    }
+    let k_missing = |e: &ExpectResult| e.quantity.starts_with('K') && e.value.is_none();
+    if s.energies.plastic_work > 0.0 && s.expects.iter().any(k_missing) {
+        println!(
+            "  note: the body yielded and a K expect has no value: K is NaN wherever yielded \
+             material lies near the J contour or tube (K comes from J only where the \
+             response is elastic); J is reported there"
+        );
     }
     for t in &s.tubes {
         let part = |what: &str, v: &str| (!v.is_empty()).then(|| format!("{what} at vertices {v}"));

@@ -114,6 +114,22 @@ fn k_is_reported_only_while_the_contour_is_elastic() {
         yielded.j
     );
     assert!(yielded.k[0].is_nan() && yielded.k_interaction[0].is_nan());
+    // The launcher says why a K expect then has no value.
+    let dir = std::env::temp_dir().join(format!("fissure-k-plastic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("yielded.toml");
+    let expect = "[[expect]]\nquantity = \"KI\"\ncrack = \"edge\"\nreference = 1e6\n\
+                  tolerance = 0.1\nsource = \"any\"\n";
+    std::fs::write(&file, plastic(&edge_plate(), 5e7, "H = 0") + expect).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+        .args(["run", file.to_str().unwrap(), "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains("a K expect has no value"), "{stdout}");
+    std::fs::remove_dir_all(dir).ok();
 }
 
 /// A 14 mm cube (E = 1 GPa) with a centred penny crack of radius 3 mm normal to y, pulled

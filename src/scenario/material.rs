@@ -90,7 +90,7 @@ fn material(src: &Source, i: usize, m: &MaterialSpec) -> R<Material> {
         return Err(src.error(
             &key("sigma_y"),
             format!(
-                "the yield strain sigma_y/E = {:.3} is above {MAX_YIELD_STRAIN}: small-strain \
+                "the yield strain sigma_y/E = {:.3e} is above {MAX_YIELD_STRAIN}: small-strain \
                  plasticity does not hold there",
                 sigma_y / m.youngs
             ),
