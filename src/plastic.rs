@@ -115,11 +115,12 @@ impl J2 {
                 // In the new yield stress y: f(y) = q - y - 3G (eps_p(y) - eps_p) is concave
                 // and decreasing on [y0, q]. Newton's first step from y0 (the linearised
                 // return) lands just past the root, and from there Newton falls monotonically
-                // onto it. It stops once the next step's bound, |f''| / (2 |f'(y0)|) times
-                // this step squared (|f'| is least at y0, |f''| largest at the iterate), is
-                // below the tolerance in the plastic strain it gives: for the small
-                // increments of an explicit step, two evaluations of the law. The new eps_p(y) is the last evaluation's,
-                // extended to y along its slope (the error is of the bound's order).
+                // onto it. After a step s the error left is at most K s^2 with K = |f''| /
+                // (2 |f'(y0)|) (|f'| is least at y0, |f''| largest at the iterate); the
+                // iteration stops once the plastic strain that error makes is below the
+                // tolerance: two evaluations of the law for an explicit step's increment.
+                // The new eps_p(y) is the last evaluation's, carried to y along its slope
+                // (an error of the same order).
                 let (s0, eps0) = (self.yield_stress, self.yield_stress / self.youngs);
                 // Reciprocals off the chain of dependent operations a return is.
                 let inv_s0 = 1.0 / s0;
@@ -136,8 +137,8 @@ impl J2 {
                     let next = (y + step).clamp(y0, q);
                     strain = e + (next - y) * eps0 * inv_s0 * (n * p - 1.0);
                     y = next;
-                    // 2 |f'(y0)| r times the bound on y's error (|f''(y)| r = c n (n - 1)
-                    // r^(n-1) / s0), and the strain's error it makes, against the strain.
+                    // K s^2 times 2 |f'(y0)| r, with |f''(y)| r = c n (n - 1) r^(n-1) / s0; the
+                    // strain error is that over the hardening slope, eps0/s0 (n r^(n-1) - 1).
                     let bound = c * n * (n - 1.0) * p * inv_s0 * step * step;
                     if bound * eps0 * inv_s0 * (n * p - 1.0) <= 2.0 * df0 * TOLERANCE * strain * r {
                         break;
