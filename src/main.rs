@@ -4,6 +4,7 @@ use clap::{Parser, Subcommand};
 use fissure::dim::{D2, D3};
 use fissure::error::{ScenarioError, UsageError};
 use fissure::measure::ExpectResult;
+use fissure::output::summary::Summary;
 use fissure::run::checkpoint::resolve;
 use fissure::run::stop::StopRequests;
 use fissure::run::{Outcome, RunOptions, resume, run};
@@ -277,13 +278,8 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
     for note in node_line_notes(&s.node_lines, s.dimension) {
         println!("  note: {note}");
     }
-    let k_missing = |e: &ExpectResult| e.quantity.starts_with('K') && e.value.is_none();
-    if s.energies.plastic_work > 0.0 && s.expects.iter().any(k_missing) {
-        println!(
-            "  note: the body yielded and a K expect has no value: K is NaN wherever yielded \
-             material lies near the J contour or tube (K comes from J only where the \
-             response is elastic); J is reported there"
-        );
+    if let Some(note) = k_withheld_note(s) {
+        println!("  note: {note}");
     }
     for t in &s.tubes {
         let part = |what: &str, v: &str| (!v.is_empty()).then(|| format!("{what} at vertices {v}"));
@@ -563,6 +559,9 @@ fn cmd_validate(
                         wall
                     );
                 }
+                if let Some(note) = k_withheld_note(&o.summary) {
+                    println!("{:<28} note: {note}", o.summary.scenario);
+                }
             }
             Err(e) => {
                 println!("{:<28} error: {e:#}", src.name());
@@ -576,6 +575,16 @@ fn cmd_validate(
     } else {
         ExitCode::FAILURE
     }
+}
+
+/// Why a K expect has no value in a body that yielded (None when that is not the case).
+fn k_withheld_note(s: &Summary) -> Option<&'static str> {
+    let k_missing = |e: &ExpectResult| e.quantity.starts_with('K') && e.value.is_none();
+    (s.energies.plastic_work > 0.0 && s.expects.iter().any(k_missing)).then_some(
+        "the body yielded and a K expect has no value: K is NaN wherever yielded material \
+         lies near the J contour or tube (K comes from J only where the response is \
+         elastic); J is reported there",
+    )
 }
 
 /// What the launcher says of each crack that lies on a line or plane of grid nodes.
