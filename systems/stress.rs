@@ -8,7 +8,7 @@ use crate::material::{Material, Plane};
 use crate::particles::Particles;
 use crate::plastic::Hardened;
 use crate::shape::{Rows, Stencil};
-use crate::sym::SymTensor;
+use crate::sym::{Sym3, SymTensor};
 use crate::with_shape;
 use crate::world::{CHUNK, World};
 use rayon::prelude::*;
@@ -146,18 +146,46 @@ impl<'a, D: Dim> StressColumns<'a, D> {
             // A plastic particle whose elastic trial stays inside the yield surface keeps
             // its plastic state untouched (the common case, and no extra traffic).
             if let Some(j2) = m.j2.as_ref().filter(|_| self.plastic) {
-                let mut h = self.hardened.get(i);
+                let h = self.hardened.get(i);
                 if j2.yields(&sigma, &h) {
-                    let mut ep = self.plastic_strain.get(i).to_sym3();
-                    sigma = start;
-                    m.update_plastic(plane, de, &mut sigma, &mut ep, &mut h);
-                    self.plastic_strain.set(i, D::Sym::from_sym3(ep));
-                    self.hardened.set(i, h);
+                    self.return_plastic(i, de, plane, m, &mut sigma, h);
                 }
             }
             let s = D::Sym::from_sym3(sigma);
             self.stress.set(i, s);
             s
+        }
+    }
+
+    /// The plastic correction of particle `i`'s elastic trial `sigma` (outside the yield
+    /// surface of its state `h`): the radial return, and in plane stress the update redone
+    /// from the start stress with the iterated zz strain. Kept out of line so that the
+    /// elastic loop around it compiles as it would without plasticity.
+    ///
+    /// # Safety
+    /// As [`Self::update`]; particle `i`'s stress entry still holds the start stress.
+    #[inline(never)]
+    unsafe fn return_plastic(
+        &self,
+        i: usize,
+        de: Sym3,
+        plane: Plane,
+        m: &Material,
+        sigma: &mut Sym3,
+        mut h: Hardened,
+    ) {
+        // SAFETY: the caller's guarantee, passed on.
+        unsafe {
+            let mut ep = self.plastic_strain.get(i).to_sym3();
+            match (plane, m.j2.as_ref()) {
+                (Plane::Stress, _) | (_, None) => {
+                    *sigma = self.stress.get(i).to_sym3();
+                    m.update_plastic(plane, de, sigma, &mut ep, &mut h);
+                }
+                (_, Some(j2)) => j2.radial_return(sigma, &mut ep, &mut h),
+            }
+            self.plastic_strain.set(i, D::Sym::from_sym3(ep));
+            self.hardened.set(i, h);
         }
     }
 }
