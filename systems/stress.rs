@@ -174,15 +174,17 @@ impl<'a, D: Dim> StressColumns<'a, D> {
         sigma: &mut Sym3,
         mut h: Hardened,
     ) {
+        let Some(j2) = &m.j2 else {
+            return;
+        };
         // SAFETY: the caller's guarantee, passed on.
         unsafe {
             let mut ep = self.plastic_strain.get(i).to_sym3();
-            match (plane, m.j2.as_ref()) {
-                (Plane::Stress, _) | (_, None) => {
-                    *sigma = self.stress.get(i).to_sym3();
-                    m.update_plastic(plane, de, sigma, &mut ep, &mut h);
-                }
-                (_, Some(j2)) => j2.radial_return(sigma, &mut ep, &mut h),
+            if plane == Plane::Stress {
+                *sigma = self.stress.get(i).to_sym3();
+                m.update_plastic(plane, de, sigma, &mut ep, &mut h);
+            } else {
+                j2.radial_return(sigma, &mut ep, &mut h);
             }
             self.plastic_strain.set(i, D::Sym::from_sym3(ep));
             self.hardened.set(i, h);
