@@ -11,7 +11,8 @@ use serde::Serialize;
 use std::collections::HashMap;
 
 /// What a probe averages.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ProbeQty {
     /// Displacement component (m).
     Displacement,

@@ -1,6 +1,6 @@
 //! summary.json: what ran, how fast, how much memory, and every expect's result.
 
-use crate::measure::ExpectResult;
+use crate::measure::{ExpectResult, ProbeQty};
 use crate::world::Energies;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -55,6 +55,8 @@ pub struct Summary {
     pub node_lines: Vec<NodeLineReport>,
     /// Energies at the end (J).
     pub energies: Energies,
+    /// Every probe's last sample (e.g. the crack-mouth opening of an `opening` probe).
+    pub probes: Vec<ProbeReport>,
     /// Results of the scenario's `[[expect]]` blocks (only for a completed run).
     pub expects: Vec<ExpectResult>,
     /// Path dependence of J per crack tip and compared contour (`[fracture] compare`).
@@ -121,6 +123,17 @@ pub struct NodeLineReport {
     pub at: f64,
     /// The share of the crack's elements on it.
     pub share: f64,
+}
+
+/// A probe's last sample.
+#[derive(Clone, Debug, Serialize)]
+pub struct ProbeReport {
+    /// Probe name.
+    pub name: String,
+    /// What it averages, as in the scenario.
+    pub quantity: ProbeQty,
+    /// Its last sample (SI units of the quantity); None before any.
+    pub last: Option<f64>,
 }
 
 /// A growing crack tip at the end of the run.

@@ -464,6 +464,7 @@ fn drive<D: Dim>(
         cell_crossings: world.cell_crossings(),
         node_lines,
         energies: world.energies(),
+        probes: reports::probes(&probes, &state.history),
         expects: results,
         paths: reports::paths(&world, fracture.as_ref(), &state.history),
         tubes: reports::tubes(&world, fracture.as_ref(), &state.history),

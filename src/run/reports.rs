@@ -5,8 +5,8 @@ use crate::crack::on_node_lines;
 use crate::dim::Dim;
 use crate::fracture::FracturePlan;
 use crate::growth::Stopped;
-use crate::measure::{History, last_rows, path_difference, path_tips};
-use crate::output::summary::{GrowthReport, NodeLineReport, PathReport, TubeReport};
+use crate::measure::{History, Probe, last_rows, path_difference, path_tips};
+use crate::output::summary::{GrowthReport, NodeLineReport, PathReport, ProbeReport, TubeReport};
 use crate::world::World;
 
 /// The path-dependence report of summary.json: every crack tip against every compared
@@ -118,6 +118,17 @@ fn ranges(v: &[u32]) -> String {
         k = e + 1;
     }
     out.join(", ")
+}
+
+/// Every probe's last sample.
+pub(super) fn probes(probes: &[Probe], h: &History) -> Vec<ProbeReport> {
+    (probes.iter().zip(&h.probes))
+        .map(|(p, samples)| ProbeReport {
+            name: p.name.clone(),
+            quantity: p.qty,
+            last: samples.last().copied(),
+        })
+        .collect()
 }
 
 /// Every growing 2D tip: where it is, how far it grew, and why it stopped, if it did.
