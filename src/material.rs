@@ -128,9 +128,9 @@ impl Material {
     }
 
     /// Corrects the elastic trial `stress` (the update of `start` by `de`) of a plastic
-    /// material to the yield surface. In plane stress the zz strain is then found by the
-    /// secant method so that the returned sigma_zz vanishes (it is monotone in that
-    /// strain).
+    /// material to the yield surface. In plane stress the zz strain is then found so that
+    /// the returned sigma_zz vanishes (it is monotone in that strain): a tangent's
+    /// prediction, a Newton step, then the secant method.
     fn correct_plastic(
         &self,
         plane: Plane,
