@@ -131,7 +131,7 @@ impl Material {
     /// material to the yield surface. In plane stress the zz strain is then found so that
     /// the returned sigma_zz vanishes (it is monotone in that strain): a tangent's
     /// prediction, a Newton step, then the secant method.
-    fn correct_plastic(
+    pub(crate) fn correct_plastic(
         &self,
         plane: Plane,
         mut de: Sym3,
@@ -143,15 +143,15 @@ impl Material {
         let Some(j2) = &self.j2 else {
             return;
         };
+        if plane != Plane::Stress {
+            j2.radial_return(stress, plastic, h);
+            return;
+        }
         let returned = |trial: Sym3| {
             let (mut s, mut p, mut hh) = (trial, *plastic, *h);
             j2.radial_return(&mut s, &mut p, &mut hh);
             (s, p, hh)
         };
-        if plane != Plane::Stress {
-            (*stress, *plastic, *h) = returned(*stress);
-            return;
-        }
         let trial = |de: &Sym3| {
             let mut s = *start;
             self.add_elastic(de, &mut s);

@@ -158,9 +158,8 @@ impl<'a, D: Dim> StressColumns<'a, D> {
     }
 
     /// The plastic correction of particle `i`'s elastic trial `sigma` (outside the yield
-    /// surface of its state `h`): the radial return, and in plane stress the update redone
-    /// from the start stress with the iterated zz strain. Kept out of line so that the
-    /// elastic loop around it compiles as it would without plasticity.
+    /// surface of its state `h`; see [`Material::correct_plastic`]). Kept out of line so
+    /// that the elastic loop around it compiles as it would without plasticity.
     ///
     /// # Safety
     /// As [`Self::update`]; particle `i`'s stress entry still holds the start stress.
@@ -174,18 +173,11 @@ impl<'a, D: Dim> StressColumns<'a, D> {
         sigma: &mut Sym3,
         mut h: Hardened,
     ) {
-        let Some(j2) = &m.j2 else {
-            return;
-        };
         // SAFETY: the caller's guarantee, passed on.
         unsafe {
+            let start = self.stress.get(i).to_sym3();
             let mut ep = self.plastic_strain.get(i).to_sym3();
-            if plane == Plane::Stress {
-                *sigma = self.stress.get(i).to_sym3();
-                m.update_plastic(plane, de, sigma, &mut ep, &mut h);
-            } else {
-                j2.radial_return(sigma, &mut ep, &mut h);
-            }
+            m.correct_plastic(plane, de, &start, sigma, &mut ep, &mut h);
             self.plastic_strain.set(i, D::Sym::from_sym3(ep));
             self.hardened.set(i, h);
         }

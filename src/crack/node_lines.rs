@@ -37,10 +37,10 @@ pub fn on_node_lines<D: Dim>(cracks: &Cracks<D>, geom: &GridGeom<D>) -> Vec<Node
     for (e, &c) in topo.elems().iter().zip(topo.elem_crack()) {
         elements[c as usize] += 1;
         for a in 0..D::D {
-            let nodes: Vec<Option<i64>> = (e.vertices().iter())
-                .map(|&v| node_line(geom, x[v as usize], a))
-                .collect();
-            if let Some(k) = nodes[0].filter(|_| nodes.windows(2).all(|w| w[0] == w[1])) {
+            let mut lines = (e.vertices().iter()).map(|&v| node_line(geom, x[v as usize], a));
+            if let Some(Some(k)) = lines.next()
+                && lines.all(|l| l == Some(k))
+            {
                 *on.entry((c, a, k)).or_default() += 1;
             }
         }
