@@ -4,55 +4,52 @@
 //! approach (Eq. 70); the law's momentum change goes to the field above and its negative to
 //! the field below, so momentum is conserved exactly.
 
-use crate::crack::Law;
+use crate::crack::{ElementBins, Law, Topology};
 use crate::dim::Dim;
 use crate::shape::Stencil;
 use crate::with_shape;
 use crate::world::World;
-use std::collections::HashMap;
 
-/// Unit normal (pointing above) of the element of crack `c` nearest to `x`.
+/// Unit normal (pointing above) of the element of crack `c` nearest to `x`, from that
+/// crack's bins (built on first use: scenes without contact rows pay nothing).
 fn normal<D: Dim>(
+    bins: &mut [Option<ElementBins>],
     verts: &[D::Vec],
-    elems: &[D::Elem],
-    elem_crack: &[u16],
+    topology: &Topology<D>,
+    cell: [f64; 3],
     c: usize,
     x: D::Vec,
 ) -> D::Vec {
-    let mut best = (f64::INFINITY, D::zero());
-    for (e, &el) in elems.iter().enumerate() {
-        if elem_crack[e] as usize != c {
-            continue;
-        }
-        let d = D::elem_distance_sq(x, verts, el);
-        if d < best.0 {
-            best = (d, D::elem_normal(verts, el));
-        }
-    }
-    best.1
+    let (elems, elem_crack) = (topology.elems(), topology.elem_crack());
+    let bins = bins[c].get_or_insert_with(|| {
+        ElementBins::new::<D>(verts, elems, |e| elem_crack[e] as usize == c, cell, 3)
+    });
+    bins.nearest::<D>(x, verts, elems)
+        .map_or(D::zero(), |e| D::elem_normal(verts, elems[e as usize]))
 }
 
 /// Mass-weighted displacement sums m u at every entry of the nodes with crack fields, from
 /// the particles of the tiles around them (Eq. 68), in a fixed order.
-fn nodal_displacements<D: Dim>(world: &World<D>) -> HashMap<usize, D::Vec> {
-    let cracks = world.cracks.as_ref().expect("contact runs with cracks");
+fn nodal_displacements<D: Dim>(world: &mut World<D>) {
+    let Some(cracks) = world.cracks.as_mut() else {
+        return;
+    };
     let f = &cracks.scratch.fields;
+    let disp = &mut cracks.scratch.disp;
+    disp.reset(f);
+    if f.node.is_empty() {
+        return;
+    }
     let geom = &world.grid.geom;
     let tiles = &world.tiles;
     let p = &world.particles;
-    let mut disp: HashMap<usize, D::Vec> = HashMap::new();
     let (mut lo, mut hi) = ([usize::MAX; 3], [0usize; 3]);
-    for (r, &n) in f.node.iter().enumerate() {
-        disp.insert(n as usize, D::zero());
-        disp.insert(f.nodes + r, D::zero());
+    for &n in &f.node {
         let ijk = geom.node_ijk(n as usize);
         for a in 0..D::D {
             lo[a] = lo[a].min(ijk[a]);
             hi[a] = hi[a].max(ijk[a]);
         }
-    }
-    if disp.is_empty() {
-        return disp;
     }
     let mut t_lo = [0; 3];
     let mut t_hi = [0; 3];
@@ -69,8 +66,8 @@ fn nodal_displacements<D: Dim>(world: &World<D>) -> HashMap<usize, D::Vec> {
                     let i = i as usize;
                     let mu = p.displacement(i) * p.mass[i];
                     let mut add = |entry: usize, w: f64| {
-                        if let Some(d) = disp.get_mut(&entry) {
-                            *d += mu * w;
+                        if let Some(s) = disp.entry(entry) {
+                            disp.sums[s] += mu * w;
                         }
                     };
                     with_shape!(shape, S, N => {
@@ -84,7 +81,6 @@ fn nodal_displacements<D: Dim>(world: &World<D>) -> HashMap<usize, D::Vec> {
             }
         }
     }
-    disp
 }
 
 /// Applies each crack's contact law: to the nodal momenta after the scatter (`update`
@@ -102,9 +98,8 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
             }
         }
     } else {
-        let disp = nodal_displacements(world);
+        nodal_displacements(world);
         if let Some(c) = world.cracks.as_mut() {
-            c.scratch.disp = disp;
             c.scratch.contact_dp.clear();
         }
     }
@@ -114,7 +109,18 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
     let f = &cracks.scratch.fields;
     let g = &mut world.grid;
     let mut changes = Vec::new();
-    for r in 0..f.node.len() {
+    // The first pass of a step finds the normals, the second reuses them.
+    let normals = &mut cracks.scratch.contact_normals;
+    let fresh = !update || normals.len() != f.node.len();
+    if fresh {
+        normals.clear();
+        normals.resize(f.node.len(), D::zero());
+    }
+    let mut bins: Vec<Option<ElementBins>> = Vec::new();
+    bins.resize_with(cracks.topology.cracks().len(), || None);
+    let h = D::to_xyz(g.geom.h);
+    let cell = std::array::from_fn(|k| if k < D::D { h[k] } else { 1.0 });
+    for (r, normal_r) in normals.iter_mut().enumerate() {
         let mask = f.mask[r];
         if mask.count_ones() != 1 {
             // A row behind two cracks at once: no single crack normal to act along.
@@ -132,16 +138,18 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
         if ma <= tol || mb <= tol {
             continue;
         }
-        let nrm = normal::<D>(
-            &cracks.geometry.x,
-            cracks.topology.elems(),
-            cracks.topology.elem_crack(),
-            c,
-            g.geom.node_position(n),
-        );
-        let d = |e: usize, m: f64| {
-            cracks.scratch.disp.get(&e).copied().unwrap_or(D::zero()) * (1.0 / m)
-        };
+        if fresh {
+            *normal_r = normal::<D>(
+                &mut bins,
+                &cracks.geometry.x,
+                &cracks.topology,
+                cell,
+                c,
+                g.geom.node_position(n),
+            );
+        }
+        let nrm = *normal_r;
+        let d = |e: usize, m: f64| cracks.scratch.disp.at(e) * (1.0 / m);
         if D::dot(d(a, ma) - d(b, mb), nrm) >= 0.0 {
             continue;
         }

@@ -4,7 +4,6 @@
 
 use crate::dim::Dim;
 use crate::fracture::Measured;
-use std::collections::HashMap;
 use std::ops::Range;
 
 /// Which grid entry each particle-node pair of a particle near a crack uses, and the extra
@@ -88,10 +87,13 @@ pub struct Scratch<D: Dim> {
     pub links: Links,
     /// Mass-weighted nodal displacements m u of the crack fields' entries this step (for
     /// contact detection).
-    pub disp: HashMap<usize, D::Vec>,
+    pub disp: Displacements<D>,
     /// Momentum changes made by contact on the scattered momenta this step (entry, change),
     /// which the particles' velocity update must also see.
     pub contact_dp: Vec<(usize, D::Vec)>,
+    /// The crack normal at each field row this step, found by the first contact pass and
+    /// reused by the second (the cracks do not move between them); zero where not needed.
+    pub contact_normals: Vec<D::Vec>,
     /// What the fracture system last measured, until the run loop takes it.
     pub measured: Measured,
 }
@@ -102,8 +104,9 @@ impl<D: Dim> Default for Scratch<D> {
             fields: Fields::default(),
             classified: Classified::default(),
             links: Links::default(),
-            disp: HashMap::new(),
+            disp: Displacements::default(),
             contact_dp: Vec::new(),
+            contact_normals: Vec::new(),
             measured: Measured::default(),
         }
     }
@@ -121,6 +124,74 @@ impl<D: Dim> Default for Classified<D> {
             crosses: Vec::new(),
             masks: Vec::new(),
         }
+    }
+}
+
+/// Sums over the grid entries of the crack fields (a node with extra rows, and each row),
+/// in a dense column: one array read finds an entry's sum, where the scatter into them asks
+/// for every stencil node of every particle near a crack.
+#[derive(Clone, Debug)]
+pub struct Displacements<D: Dim> {
+    /// Per grid node, the slot of its own field's sum, `u32::MAX` for a node without rows
+    /// (sized on first use: scenes without contact keep it empty).
+    slot: Vec<u32>,
+    /// The nodes whose slots are set, to clear them for the next step's rows.
+    marked: Vec<u32>,
+    /// The sums: the marked nodes', then one per extra row.
+    pub sums: Vec<D::Vec>,
+    /// Grid nodes (extra rows start here).
+    nodes: usize,
+}
+
+impl<D: Dim> Default for Displacements<D> {
+    fn default() -> Self {
+        Displacements {
+            slot: Vec::new(),
+            marked: Vec::new(),
+            sums: Vec::new(),
+            nodes: 0,
+        }
+    }
+}
+
+impl<D: Dim> Displacements<D> {
+    /// Zero sums for the entries of this step's `fields`.
+    pub fn reset(&mut self, fields: &Fields) {
+        for &n in &self.marked {
+            self.slot[n as usize] = u32::MAX;
+        }
+        self.marked.clear();
+        self.nodes = fields.nodes;
+        if self.slot.len() != fields.nodes {
+            self.slot = vec![u32::MAX; fields.nodes];
+        }
+        for &n in &fields.node {
+            if self.slot[n as usize] == u32::MAX {
+                self.slot[n as usize] = self.marked.len() as u32;
+                self.marked.push(n);
+            }
+        }
+        self.sums.clear();
+        self.sums
+            .resize(self.marked.len() + fields.node.len(), D::zero());
+    }
+
+    /// The slot of grid entry `e` (a node or an extra row), if it is a crack field's.
+    #[inline(always)]
+    pub fn entry(&self, e: usize) -> Option<usize> {
+        if e >= self.nodes {
+            Some(self.marked.len() + e - self.nodes)
+        } else {
+            match self.slot.get(e) {
+                Some(&s) if s != u32::MAX => Some(s as usize),
+                _ => None,
+            }
+        }
+    }
+
+    /// The sum at grid entry `e` (zero for an entry that is not a crack field's).
+    pub fn at(&self, e: usize) -> D::Vec {
+        self.entry(e).map_or(D::zero(), |s| self.sums[s])
     }
 }
 

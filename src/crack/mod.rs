@@ -7,14 +7,16 @@
 //! [`Geometry`] of the vertices, and the systems' [`Scratch`] (the extra velocity fields
 //! and what classification and contact keep between steps).
 
+mod bins;
 mod element;
 mod fields;
 mod law;
 mod node_lines;
 mod topology;
 
+pub use bins::ElementBins;
 pub use element::{Element, Segment, Triangle};
-pub use fields::{Classified, Fields, Links, Scratch, side_bit};
+pub use fields::{Classified, Displacements, Fields, Links, Scratch, side_bit};
 pub use law::{Contact, Law};
 pub use node_lines::{NodeLine, on_node_lines};
 pub use topology::{Crack, Front, Topology, TopologyError};
