@@ -35,6 +35,14 @@ fn span<D: Dim>(a: D::Vec, b: D::Vec) -> Aabb<D> {
     (lo, hi)
 }
 
+/// Squared distance between two boxes (zero where they meet): at most that between any
+/// point or segment in one and any element in the other.
+fn gap_sq<D: Dim>(a: &Aabb<D>, b: &Aabb<D>) -> f64 {
+    (0..D::D)
+        .map(|k| (a.0[k] - b.1[k]).max(b.0[k] - a.1[k]).max(0.0).powi(2))
+        .sum()
+}
+
 fn grow<D: Dim>(b: &Aabb<D>, by: f64) -> Aabb<D> {
     let (mut lo, mut hi) = *b;
     for k in 0..D::D {
@@ -322,7 +330,19 @@ impl<D: Dim> Pass<'_, D> {
                     *o = true;
                 }
             }
+            // A node (or its line from the particle, when a feature is open) whose box
+            // lies farther from the element's box than the clearance cannot lower it.
+            let any_open = open.iter().any(|&o| o);
+            let bx = &elements.boxes[e as usize];
             for &xn in &s.nodes {
+                let from = if any_open {
+                    span::<D>(xp, xn)
+                } else {
+                    (xn, xn)
+                };
+                if gap_sq::<D>(&from, bx) > clearance * clearance * (1.0 + 1e-9) {
+                    continue;
+                }
                 let mut c = D::elem_distance(xn, x, el);
                 for k in (0..<D::Elem as Element>::FEATURES).filter(|&k| open[k]) {
                     c = c.min(D::feature_distance(xp, xn, x, el, k));
