@@ -252,12 +252,13 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
         format!("{} steps (to step {})", s.steps_run, s.steps)
     };
     println!(
-        "{}: {} particles, {steps} in {:.2} s ({:.3e} particle-steps/s, {} threads); outputs in {}",
+        "{}: {} particles, {steps} in {:.2} s ({:.3e} particle-steps/s, {} thread{}); outputs in {}",
         s.scenario,
         s.particles,
         s.wall_seconds,
         s.particle_steps_per_second,
         s.threads,
+        if s.threads == 1 { "" } else { "s" },
         out.display()
     );
     if let Some(p) = &s.snapshot {
