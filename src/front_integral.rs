@@ -184,6 +184,8 @@ struct Sample {
     c: [[f64; 3]; 4],
     /// Whether the particle has yielded.
     yielded: bool,
+    /// The particle's material index.
+    material: u16,
 }
 
 /// The actual fields at a particle, in the frame of its nearest front point.
@@ -205,6 +207,8 @@ struct Fields {
     plastic: f64,
     /// Whether the particle has yielded.
     yielded: bool,
+    /// Material index.
+    material: u16,
 }
 
 fn mv(m: &M3, v: [f64; 3]) -> [f64; 3] {
@@ -265,6 +269,7 @@ impl Sample {
             vol: f.vol,
             c,
             yielded: f.yielded,
+            material: f.material,
         }
     }
 }
@@ -305,7 +310,7 @@ fn curved(place: &Place, s: &M3, gu: &M3, sa: &M3, ga: &M3, ua: [f64; 3]) -> (M3
 }
 
 /// J and K at vertex `k` of `line` from the particles in the tube, shrunk by `tube.step`
-/// while particles do not fill it. `facets` are the crack triangles within reach of the
+/// while particles do not fill it or it holds a material other than the vertex's. `facets` are the crack triangles within reach of the
 /// tube; `elastic` gives the material of each material index.
 pub fn front_integrals(
     world: &World<D3>,
@@ -321,7 +326,16 @@ pub fn front_integrals(
         return none;
     };
     let el = elastic(material);
-    let mut r = tube.radius;
+    // The auxiliary fields are those of a homogeneous body: the tube stays in the material
+    // at the vertex, inside the nearest particle of other elastic constants.
+    let foreign = (samples.iter())
+        .filter(|q| {
+            let e = elastic(q.material);
+            e.mu != el.mu || e.nu != el.nu
+        })
+        .map(|q| q.r)
+        .fold(f64::INFINITY, f64::min);
+    let mut r = tube.radius.min(foreign - tube.step);
     while r >= tube.min_radius {
         if let Some((i, [j, j_volume])) = integrate(&samples, r, tube.length) {
             let (band, len) = (tube.step, tube.length);
@@ -498,6 +512,7 @@ fn gather(
             plastic: (p.plastic_strain.get(i))
                 .map_or(0.0, |ep| p.plastic_work(i) - 0.5 * st.ddot(&ep.to_sym3())),
             yielded: p.hardened.get(i).is_some_and(|h| h.equivalent > 0.0),
+            material: p.material[i],
         };
         out.push(Sample::new(&at, &fields, &elastic(p.material[i])));
     }
@@ -601,6 +616,7 @@ mod tests {
                         mass: 0.0,
                         plastic: 0.0,
                         yielded: false,
+                        material: 0,
                     };
                     out.push(Sample::new(&place, &fields, &el));
                 }

@@ -51,7 +51,8 @@ pub struct InteractionK {
     /// K_I and K_II (Pa sqrt(m)); NaN when no domain fits.
     pub k: [f64; 2],
     /// Domain radius used (m); smaller than asked when the asked one reached another
-    /// crack or past the body's edge, 0 when none fitted.
+    /// crack, a material of other elastic constants or past the body's edge, 0 when none
+    /// fitted.
     pub radius: f64,
 }
 
@@ -105,8 +106,8 @@ impl Sample {
 }
 
 /// K_I and K_II at `tip` from the interaction integral over a disc of radius `radius` (m),
-/// shrunk by `step` (m) at a time while it reaches another crack or past the body's edge,
-/// down to `min_radius`.
+/// shrunk by `step` (m) at a time while it reaches another crack, another material or past
+/// the body's edge, down to `min_radius`.
 pub fn interaction_k(
     world: &World<D2>,
     cracks: &Cracks<D2>,
@@ -118,7 +119,9 @@ pub fn interaction_k(
 ) -> InteractionK {
     let plane = world.settings.plane;
     let kap = kappa(mat, plane);
-    let mut r_max = radius.min(other_crack_distance(cracks, tip) - step);
+    let mut r_max = radius
+        .min(other_crack_distance(cracks, tip) - step)
+        .min(other_material_distance(world, tip, radius, mat) - step);
     let samples = gather(world, cracks, tip, r_max.max(0.0), kap, mat.mu);
     let e_prime = e_prime(mat, plane);
     while r_max >= min_radius {
@@ -148,6 +151,25 @@ fn other_crack_distance(cracks: &Cracks<D2>, tip: Tip) -> f64 {
         .filter(|(c, _)| *c != tip.crack)
         .flat_map(|(_, cr)| cr.vertices.windows(2))
         .map(|w| point_segment::<D2>(x, at(w[0]), at(w[1])))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Distance from the tip to the nearest particle within `reach` whose elastic constants
+/// differ from the tip's material `mat` (m; infinite when none): the auxiliary field is
+/// that of a homogeneous body, so the domain stays in the tip's material.
+fn other_material_distance(world: &World<D2>, tip: Tip, reach: f64, mat: &Material) -> f64 {
+    let p = &world.particles;
+    let x = DVec2::from(tip.x);
+    let foreign: Vec<bool> = (world.materials.iter())
+        .map(|m| m.youngs != mat.youngs || m.poisson != mat.poisson)
+        .collect();
+    if !foreign.contains(&true) {
+        return f64::INFINITY;
+    }
+    near(world, x, reach)
+        .into_iter()
+        .filter(|&i| foreign[p.material[i] as usize])
+        .map(|i| p.x[i].distance(x))
         .fold(f64::INFINITY, f64::min)
 }
 

@@ -61,8 +61,8 @@ pub struct Summary {
     pub expects: Vec<ExpectResult>,
     /// Path dependence of J per crack tip and compared contour (`[fracture] compare`).
     pub paths: Vec<PathReport>,
-    /// Along 3D fronts: where the tube around a vertex was shrunk to stay inside the body,
-    /// or none fitted (last measurement).
+    /// Along 3D fronts: where the tube around a vertex was shrunk to stay inside the body
+    /// and the vertex's material, or none fitted (last measurement).
     pub tubes: Vec<TubeReport>,
     /// Every growing crack tip: how far it grew and whether it stopped for good.
     pub growth: Vec<GrowthReport>,
@@ -97,7 +97,7 @@ pub struct PathReport {
 }
 
 /// The front vertices of one crack whose tube, at the last measurement, was shrunk to stay
-/// inside the body, or did not fit at all (J and K NaN there).
+/// inside the body and the vertex's material, or did not fit at all (J and K NaN there).
 #[derive(Clone, Debug, Serialize)]
 pub struct TubeReport {
     /// Crack name.
