@@ -41,9 +41,13 @@ fn cracks(c: &mut Criterion) {
             .every_step = on;
     };
     every_step(&mut world, true);
-    g.bench_function("classify_full", |b| b.iter(|| classify::run(&mut world)));
+    g.bench_function("classify_full", |b| {
+        b.iter(|| classify::run(&mut world).expect("room for every crack"))
+    });
     every_step(&mut world, false);
-    g.bench_function("classify_reuse", |b| b.iter(|| classify::run(&mut world)));
+    g.bench_function("classify_reuse", |b| {
+        b.iter(|| classify::run(&mut world).expect("room for every crack"))
+    });
     g.throughput(Throughput::Elements(1));
     g.bench_function("j_integral", |b| {
         b.iter(|| fracture::measure(&world, &plan))
@@ -122,9 +126,13 @@ fn cracks_3d(c: &mut Criterion) {
         c.scratch.classified.every_step = on;
     };
     every_step(&mut world, true);
-    g.bench_function("classify_full", |b| b.iter(|| classify::run(&mut world)));
+    g.bench_function("classify_full", |b| {
+        b.iter(|| classify::run(&mut world).expect("room for every crack"))
+    });
     every_step(&mut world, false);
-    g.bench_function("classify_reuse", |b| b.iter(|| classify::run(&mut world)));
+    g.bench_function("classify_reuse", |b| {
+        b.iter(|| classify::run(&mut world).expect("room for every crack"))
+    });
     let vertices = world
         .cracks
         .as_ref()

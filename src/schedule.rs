@@ -238,7 +238,7 @@ impl Schedule {
             return Ok(());
         }
         bin::run(world)?;
-        classify::run(world);
+        classify::run(world)?;
         self.fracture_system(world);
         Ok(())
     }
@@ -264,7 +264,7 @@ impl Schedule {
             let t0 = Instant::now();
             match self.systems[k] {
                 System::Bin => bin::run(world)?,
-                System::Classify => classify::run(world),
+                System::Classify => classify::run(world)?,
                 System::CrackAdvect => crack_advect::run(world),
                 System::Contact { update } => contact::run(world, update),
                 System::P2g { internal } => p2g::run(world, internal),

@@ -9,8 +9,9 @@
 //! longer holds (clearance used up, or a new stencil) until the skin itself is used up; the
 //! result is exactly that of a full pass.
 
-use crate::crack::{Classified, Cracks, Element, Fields, side_bit};
+use crate::crack::{self, Classified, Cracks, Element, Fields, side_bit};
 use crate::dim::Dim;
+use crate::error::Unstable;
 use crate::grid::GridGeom;
 use crate::shape::{ShapeKind, Stencil, StencilCache};
 use crate::tiles::Tiles;
@@ -58,6 +59,8 @@ struct Elements<'a, D: Dim> {
     x: &'a [D::Vec],
     elems: &'a [D::Elem],
     elem_crack: &'a [u16],
+    /// Each crack's colour: the pair of mask bits its crossings set.
+    color: &'a [u8],
     boxes: Vec<Aabb<D>>,
     order: Vec<u32>,
     axis: usize,
@@ -77,6 +80,7 @@ impl<'a, D: Dim> Elements<'a, D> {
         x: &'a [D::Vec],
         elems: &'a [D::Elem],
         elem_crack: &'a [u16],
+        color: &'a [u8],
         neighbour: &'a [[u32; 3]],
     ) -> Self {
         let boxes: Vec<Aabb<D>> = elems
@@ -106,6 +110,7 @@ impl<'a, D: Dim> Elements<'a, D> {
             x,
             elems,
             elem_crack,
+            color,
             boxes,
             order,
             axis,
@@ -152,7 +157,7 @@ impl<'a, D: Dim> Elements<'a, D> {
             }
             let s = D::crossing_from(xp, sp, xn, self.x, self.elems[e]);
             if s != 0 {
-                let bit = 1u32 << self.elem_crack[e];
+                let bit = 1u32 << self.color[self.elem_crack[e] as usize];
                 odd ^= bit;
                 if s > 0 {
                     above |= bit;
@@ -549,7 +554,11 @@ impl<D: Dim> Pass<'_, D> {
 
 /// Classifies the particles near cracks (afresh, or reusing the last record where it still
 /// holds) and sizes the grid's extra field rows. Nothing to do in a scene without cracks.
-pub fn run<D: Dim>(world: &mut World<D>) {
+///
+/// Fails when more than [`crate::crack::COLORS`] cracks have come within reach of one
+/// another (their masks would have no bits left).
+pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
+    let (step, time) = (world.step, world.time);
     let Some(Cracks {
         topology,
         geometry,
@@ -558,12 +567,13 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 fields,
                 classified: rec,
                 links,
+                colors,
                 ..
             },
         ..
     }) = world.cracks.as_mut()
     else {
-        return;
+        return Ok(());
     };
     let x = &geometry.x;
     if links.version != Some(topology.version()) {
@@ -575,11 +585,38 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let geom = &world.grid.geom;
     let tiles = &world.tiles;
     let h_min = (0..D::D).map(|k| geom.h[k]).fold(f64::INFINITY, f64::min);
+    let h_max = (0..D::D).map(|k| geom.h[k]).fold(0.0, f64::max);
+    let now = crack::colors::<D>(topology, x, h_max).map_err(|c| {
+        let name = |k: usize| &topology.cracks()[k].name;
+        Unstable {
+            step,
+            time,
+            what: format!(
+                "crack `{}` came within reach of {} other cracks (`{}` among them): a field \
+                 mask has room for {} cracks near one place",
+                name(c.crack),
+                crack::COLORS,
+                name(c.near),
+                crack::COLORS
+            ),
+        }
+    })?;
+    if *colors != now {
+        // Crossings were recorded under the old colours.
+        *colors = now;
+        rec.x0.clear();
+    }
     let pass = Pass {
         geom,
         shape: world.settings.shape,
         stencils: &tiles.stencils,
-        elements: Elements::<D>::new(x, topology.elems(), topology.elem_crack(), &links.neighbour),
+        elements: Elements::<D>::new(
+            x,
+            topology.elems(),
+            topology.elem_crack(),
+            colors,
+            &links.neighbour,
+        ),
         skin: 0.25 * h_min,
         slack: 1e-6 * h_min,
     };
@@ -602,4 +639,5 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     }
     let extra = pass.fields(rec, world.particles.len(), fields);
     world.grid.set_extra_fields(extra);
+    Ok(())
 }

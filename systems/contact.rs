@@ -4,28 +4,32 @@
 //! approach (Eq. 70); the law's momentum change goes to the field above and its negative to
 //! the field below, so momentum is conserved exactly.
 
-use crate::crack::{ElementBins, Law, Topology};
+use crate::crack::{COLORS, Cracks, ElementBins, Law};
 use crate::dim::Dim;
 use crate::shape::Stencil;
 use crate::with_shape;
 use crate::world::World;
 
-/// Unit normal (pointing above) of the element of crack `c` nearest to `x`, from that
-/// crack's bins (built on first use: scenes without contact rows pay nothing).
-fn normal<D: Dim>(
+/// The crack of colour `color` nearest to `x` and the unit normal (pointing above) of its
+/// element nearest to `x`, from that colour's bins (built on first use: scenes without
+/// contact rows pay nothing). Cracks sharing a colour are never within a stencil's reach of
+/// one another, so the nearest is the one the row's particles crossed.
+fn nearest<D: Dim>(
     bins: &mut [Option<ElementBins>],
-    verts: &[D::Vec],
-    topology: &Topology<D>,
+    cracks: &Cracks<D>,
     cell: [f64; 3],
-    c: usize,
+    color: u8,
     x: D::Vec,
-) -> D::Vec {
+) -> Option<(usize, D::Vec)> {
+    let (verts, topology) = (&cracks.geometry.x, &cracks.topology);
     let (elems, elem_crack) = (topology.elems(), topology.elem_crack());
-    let bins = bins[c].get_or_insert_with(|| {
-        ElementBins::new::<D>(verts, elems, |e| elem_crack[e] as usize == c, cell, 3)
+    let colors = &cracks.scratch.colors;
+    let bins = bins[color as usize].get_or_insert_with(|| {
+        let keep = |e: usize| colors[elem_crack[e] as usize] == color;
+        ElementBins::new::<D>(verts, elems, keep, cell, 3)
     });
-    bins.nearest::<D>(x, verts, elems)
-        .map_or(D::zero(), |e| D::elem_normal(verts, elems[e as usize]))
+    let e = bins.nearest::<D>(x, verts, elems)? as usize;
+    Some((elem_crack[e] as usize, D::elem_normal(verts, elems[e])))
 }
 
 /// Mass-weighted displacement sums m u at every entry of the nodes with crack fields, from
@@ -109,15 +113,20 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
     let f = &cracks.scratch.fields;
     let g = &mut world.grid;
     let mut changes = Vec::new();
-    // The first pass of a step finds the normals, the second reuses them.
-    let normals = &mut cracks.scratch.contact_normals;
+    // The first pass of a step finds each row's crack and normal, the second reuses them.
+    let mut normals = std::mem::take(&mut cracks.scratch.contact_normals);
     let fresh = !update || normals.len() != f.node.len();
     if fresh {
         normals.clear();
-        normals.resize(f.node.len(), D::zero());
+        normals.resize(f.node.len(), None);
     }
     let mut bins: Vec<Option<ElementBins>> = Vec::new();
-    bins.resize_with(cracks.topology.cracks().len(), || None);
+    bins.resize_with(COLORS, || None);
+    // Whether some crack of each colour has a contact law.
+    let mut acts = [false; COLORS];
+    for (c, crack) in cracks.topology.cracks().iter().enumerate() {
+        acts[cracks.scratch.color(c) as usize] |= crack.contact.law != Law::None;
+    }
     let h = D::to_xyz(g.geom.h);
     let cell = std::array::from_fn(|k| if k < D::D { h[k] } else { 1.0 });
     for (r, normal_r) in normals.iter_mut().enumerate() {
@@ -127,9 +136,8 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
             continue;
         }
         let bit = mask.trailing_zeros() as usize;
-        let (c, above) = (bit / 2, bit.is_multiple_of(2));
-        let contact = cracks.topology.cracks()[c].contact;
-        if contact.law == Law::None {
+        let (color, above) = (bit / 2, bit.is_multiple_of(2));
+        if !acts[color] {
             continue;
         }
         let (n, row) = (f.node[r] as usize, f.nodes + r);
@@ -139,16 +147,21 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
             continue;
         }
         if fresh {
-            *normal_r = normal::<D>(
+            *normal_r = nearest::<D>(
                 &mut bins,
-                &cracks.geometry.x,
-                &cracks.topology,
+                cracks,
                 cell,
-                c,
+                color as u8,
                 g.geom.node_position(n),
             );
         }
-        let nrm = *normal_r;
+        let Some((c, nrm)) = *normal_r else {
+            continue;
+        };
+        let contact = cracks.topology.cracks()[c].contact;
+        if contact.law == Law::None {
+            continue;
+        }
         let d = |e: usize, m: f64| cracks.scratch.disp.at(e) * (1.0 / m);
         if D::dot(d(a, ma) - d(b, mb), nrm) >= 0.0 {
             continue;
@@ -174,6 +187,7 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
             changes.push((b, -dp));
         }
     }
+    cracks.scratch.contact_normals = normals;
     if !update {
         cracks.scratch.contact_dp = changes;
     }

@@ -2,17 +2,17 @@
 //! and the top and bottom crack surfaces with the fields above and below the crack (Guo &
 //! Nairn 3D (2006) Eqs. 21-23; 2D (2004) section 2.2), which gives the crack opening.
 
-use crate::crack::{Cracks, Fields, Geometry, Scratch};
+use crate::crack::{Cracks, Fields, Geometry};
 use crate::dim::Dim;
 use crate::shape::{ShapeKind, Stencil};
 use crate::world::{Update, World};
 
 /// Momentum and mass at node `n`, all fields together (Eq. 23's centre of mass), and of its
-/// fields above and below crack `c`; zero for fields lighter than `sliver`. `momentum`
-/// gives each entry's momentum.
+/// fields above and below the crack of colour `color`; zero for fields lighter than
+/// `sliver`. `momentum` gives each entry's momentum.
 fn node_fields<D: Dim>(
     n: usize,
-    c: usize,
+    color: u8,
     mass: &[f64],
     momentum: &impl Fn(usize) -> D::Vec,
     fields: &Fields,
@@ -28,7 +28,7 @@ fn node_fields<D: Dim>(
         return [(D::zero(), 0.0); 3];
     }
     let side = |s: i8| {
-        let e = fields.side_entry_in(rows.clone(), n, c, s);
+        let e = fields.side_entry_in(rows.clone(), n, color, s);
         if mass[e] > sliver {
             (momentum(e), mass[e])
         } else {
@@ -45,7 +45,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let Some(Cracks {
         topology,
         geometry: Geometry { x: xs, top, bottom },
-        scratch: Scratch { fields, .. },
+        scratch,
         ..
     }) = world.cracks.as_mut()
     else {
@@ -69,7 +69,9 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         }
     };
     let geom = &g.geom;
+    let fields = &scratch.fields;
     for (c, crack) in topology.cracks().iter().enumerate() {
+        let color = scratch.color(c);
         for k in crack.vertices.iter().map(|&k| k as usize) {
             let x = xs[k];
             if !geom.fits(ShapeKind::Linear, x, D::zero()) {
@@ -89,7 +91,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             }
             let mut sums = [(D::zero(), 0.0); 3];
             st.for_each::<D>(&geom.stride, |n, w, _| {
-                let f = node_fields::<D>(n, c, &g.mass, &momentum, fields, sliver);
+                let f = node_fields::<D>(n, color, &g.mass, &momentum, fields, sliver);
                 for (s, (p, m)) in sums.iter_mut().zip(f) {
                     s.0 += p * w;
                     s.1 += m * w;

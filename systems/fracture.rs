@@ -430,7 +430,8 @@ fn contour_j(
     // The split path: crossing point, ring[e + 1], ..., ring[e], crossing point (Eq. 12).
     let m = ring.len() - 1;
     let order: Vec<usize> = (1..=m).map(|q| (e + q) % m).collect();
-    let at = |q: usize, side: i8| value(fields.side_entry(index(ring[q]), c, side));
+    let color = cracks.scratch.color(c);
+    let at = |q: usize, side: i8| value(fields.side_entry(index(ring[q]), color, side));
     let cross = {
         let (a, b) = (pos(ring[e]), pos(ring[e + 1]));
         [a[0] + (b[0] - a[0]) * s, a[1] + (b[1] - a[1]) * s]

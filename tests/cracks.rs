@@ -457,3 +457,55 @@ fn interaction_domain_stays_in_the_tips_material() {
         tip.k_interaction[1]
     );
 }
+
+/// More cracks than a field's mask has colours: a 92 mm bar cut by 91 cracks into 92
+/// pieces 1 mm wide (uGIMP), each moving along the bar faster than the one to its left.
+/// The cracks take 8 colours (those within 3.5 cells of one another differ), and every
+/// piece flies off on its own: no strain energy and every velocity unchanged, as with two
+/// cracks; one thread and two give the same positions to the bit.
+#[test]
+fn ninety_one_cracks_cut_ninety_two_free_pieces() {
+    let mut text = String::from(
+        "[simulation]\ndimension = 2\nshape = \"ugimp\"\nduration = 2e-5\n[grid]\n\
+         min = [0.0, 0.0]\nmax = [0.1, 0.012]\ncell = [0.001, 0.001]\n[[material]]\n\
+         name = \"m\"\nE = 70e9\nnu = 0.3\nrho = 2700.0\n",
+    );
+    let edge = |k: usize| 0.0045 + 0.001 * k as f64;
+    for k in 0..92 {
+        text += &format!(
+            "[[body]]\nmaterial = \"m\"\nbox = {{ min = [{:.4}, 0.004], max = [{:.4}, 0.008] }}\n\
+             velocity = [{:.3}, 0.0]\n",
+            edge(k),
+            edge(k + 1),
+            0.05 * k as f64
+        );
+    }
+    for k in 1..92 {
+        text += &format!(
+            "[[crack]]\npoints = [[{x:.4}, 0.0025], [{x:.4}, 0.0095]]\ntips = []\n",
+            x = edge(k)
+        );
+    }
+    let w = final_world::<D2>(&text, 2);
+    let e = w.energies();
+    assert!(
+        e.strain < 1e-20 * e.kinetic,
+        "strain energy {:e} J",
+        e.strain
+    );
+    let one = final_world::<D2>(&text, 1);
+    assert!(
+        (w.particles.x.iter().zip(&one.particles.x)).all(|(a, b)| a.to_array() == b.to_array()),
+        "one thread and two differ"
+    );
+    let colors = &w.cracks.as_ref().unwrap().scratch.colors;
+    assert_eq!(colors.len(), 91);
+    assert!(colors.iter().all(|&c| c < 8), "{colors:?}");
+    for (x, v) in w.particles.x.iter().zip(&w.particles.v) {
+        let want = 0.05 * ((x.x - 0.0045) / 0.001).floor();
+        assert!(
+            (v.x - want).abs() < 1e-12 && v.y.abs() < 1e-12,
+            "at {x}: {v}, want {want}"
+        );
+    }
+}

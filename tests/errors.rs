@@ -933,3 +933,26 @@ fn plastic_radius_probes_are_checked() {
     ));
     assert_error(&e, "probe[0].component", None, "give the probed component");
 }
+
+/// A scene may hold more than 32 cracks, but no more than 32 within reach of one another:
+/// the 33rd of a row 0.1 mm apart is refused, naming it.
+#[test]
+fn too_many_cracks_in_one_place_are_refused() {
+    let mut text = GOOD.to_string();
+    for k in 0..40 {
+        let x = 0.006 + 1e-4 * k as f64;
+        text += &format!(
+            "[[crack]]\nname = \"c{k}\"\npoints = [[{x:.4}, 0.0071], [{x:.4}, 0.0089]]\ntips = []\n"
+        );
+    }
+    let e = refused(&text);
+    assert_error(&e, "crack[32]", None, "crack `c32` lies within reach");
+    let spread: String = (0..40)
+        .map(|k| {
+            let x = 0.0041 + 3e-4 * k as f64;
+            format!("[[crack]]\npoints = [[{x:.4}, 0.0045], [{x:.4}, 0.0047]]\ntips = []\n")
+        })
+        .collect();
+    let wide = GOOD.replace("cell = [0.002, 0.002]", "cell = [0.00005, 0.00005]");
+    assert!(build::<D2>(&Source::parse("ok.toml", &(wide + &spread), &[]).unwrap()).is_ok());
+}

@@ -84,7 +84,7 @@ fn the_crack_systems_follow_a_grown_crack_at_once() {
 
     let grown = final_world_with::<D2>(&text, 1, |w| {
         bin::run(w).unwrap();
-        classify::run(w);
+        classify::run(w).expect("room for every crack");
         w.cracks.as_mut().unwrap().extend_tip(0, THROUGH);
     });
     let e = grown.energies();

@@ -85,17 +85,27 @@ pub struct Scratch<D: Dim> {
     pub classified: Classified<D>,
     /// The elements' neighbours, rebuilt when the topology changes.
     pub links: Links,
+    /// Each crack's colour (the pair of mask bits its side takes), from `classify`.
+    pub colors: Vec<u8>,
     /// Mass-weighted nodal displacements m u of the crack fields' entries this step (for
     /// contact detection).
     pub disp: Displacements<D>,
     /// Momentum changes made by contact on the scattered momenta this step (entry, change),
     /// which the particles' velocity update must also see.
     pub contact_dp: Vec<(usize, D::Vec)>,
-    /// The crack normal at each field row this step, found by the first contact pass and
-    /// reused by the second (the cracks do not move between them); zero where not needed.
-    pub contact_normals: Vec<D::Vec>,
+    /// The crack and its normal at each field row this step, found by the first contact
+    /// pass and reused by the second (the cracks do not move between them); None where
+    /// not needed.
+    pub contact_normals: Vec<Option<(usize, D::Vec)>>,
     /// What the fracture system last measured, until the run loop takes it.
     pub measured: Measured,
+}
+
+impl<D: Dim> Scratch<D> {
+    /// Crack `c`'s colour (its own index before the first classification).
+    pub fn color(&self, c: usize) -> u8 {
+        self.colors.get(c).copied().unwrap_or(c as u8)
+    }
 }
 
 impl<D: Dim> Default for Scratch<D> {
@@ -104,6 +114,7 @@ impl<D: Dim> Default for Scratch<D> {
             fields: Fields::default(),
             classified: Classified::default(),
             links: Links::default(),
+            colors: Vec::new(),
             disp: Displacements::default(),
             contact_dp: Vec::new(),
             contact_normals: Vec::new(),
@@ -214,15 +225,16 @@ impl Fields {
         }
     }
 
-    /// Grid entry of node `n`'s field on `side` (+1 above, -1 below) of crack `c`: the row
-    /// whose particles crossed the crack from that side, or else the node's own field.
-    pub fn side_entry(&self, n: usize, c: usize, side: i8) -> usize {
-        self.side_entry_in(self.rows_of(n as u32), n, c, side)
+    /// Grid entry of node `n`'s field on `side` (+1 above, -1 below) of the crack of colour
+    /// `color` (`Scratch::colors`) near it: the row whose particles crossed the crack from
+    /// that side, or else the node's own field.
+    pub fn side_entry(&self, n: usize, color: u8, side: i8) -> usize {
+        self.side_entry_in(self.rows_of(n as u32), n, color, side)
     }
 
     /// [`Fields::side_entry`] given `rows`, node `n`'s [`Fields::rows_of`].
-    pub fn side_entry_in(&self, mut rows: Range<usize>, n: usize, c: usize, side: i8) -> usize {
-        let bit = side_bit(c, side);
+    pub fn side_entry_in(&self, mut rows: Range<usize>, n: usize, color: u8, side: i8) -> usize {
+        let bit = side_bit(color as usize, side);
         rows.find(|&r| self.mask[r - self.nodes] & bit != 0)
             .unwrap_or(n)
     }
@@ -235,7 +247,8 @@ impl Fields {
     }
 }
 
-/// Mask bit for crack `c` crossed with the particle on `side` (+1 above, -1 below).
+/// Mask bit for a crack of colour `c` crossed with the particle on `side` (+1 above, -1
+/// below).
 #[inline(always)]
 pub fn side_bit(c: usize, side: i8) -> u64 {
     1u64 << (2 * c + usize::from(side < 0))

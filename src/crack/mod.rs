@@ -8,6 +8,7 @@
 //! and what classification and contact keep between steps).
 
 mod bins;
+mod colors;
 mod element;
 mod fields;
 mod law;
@@ -15,6 +16,7 @@ mod node_lines;
 mod topology;
 
 pub use bins::ElementBins;
+pub use colors::{COLORS, Crowded, colors};
 pub use element::{Element, Segment, Triangle};
 pub use fields::{Classified, Displacements, Fields, Links, Scratch, side_bit};
 pub use law::{Contact, Law};
@@ -24,8 +26,9 @@ pub use topology::{Crack, Front, Topology, TopologyError};
 use crate::dim::Dim;
 use crate::growth::TipState;
 
-/// Most cracks a scene may hold (each takes two bits of a node field's side mask).
-pub const MAX_CRACKS: usize = 32;
+/// Most cracks a scene may hold (element-to-crack indices are `u16`); at most
+/// [`COLORS`] of them may lie within reach of one another.
+pub const MAX_CRACKS: usize = u16::MAX as usize;
 
 /// Where each crack vertex is (struct of arrays, one entry per vertex).
 #[derive(Clone, Debug)]

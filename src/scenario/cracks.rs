@@ -4,7 +4,7 @@ use super::build::{positive, to_vec, vec3};
 use super::schema::{AlongSpec, CrackSpec, ExpectSpec, FractureSpec};
 use super::source::Source;
 use super::surface;
-use crate::crack::{Contact, Cracks, Element, Law, MAX_CRACKS};
+use crate::crack::{COLORS, Contact, Cracks, Element, Law, MAX_CRACKS, colors};
 use crate::dim::{D3, Dim};
 use crate::error::ScenarioError;
 use crate::fracture::{FracturePlan, KMethod};
@@ -40,7 +40,7 @@ pub(super) fn build<D: Dim>(
     if specs.len() > MAX_CRACKS {
         return Err(src.error(
             &format!("crack[{MAX_CRACKS}]"),
-            format!("at most {MAX_CRACKS} cracks per scene"),
+            format!("at most {MAX_CRACKS} cracks per scene (crack indices are 16-bit)"),
         ));
     }
     let occupied = Occupied::new(particles, geom);
@@ -148,6 +148,19 @@ pub(super) fn build<D: Dim>(
             &piece.fronts,
         );
         store.geometry.x.extend(&piece.points);
+    }
+    let h_max = (0..D::D).map(|k| geom.h[k]).fold(0.0, f64::max);
+    if let Err(c) = colors::<D>(&store.topology, &store.geometry.x, h_max) {
+        let name = |k: usize| &store.topology.cracks()[k].name;
+        return Err(src.error(
+            &format!("crack[{}]", c.crack),
+            format!(
+                "crack `{}` lies within reach (3.5 cells) of {COLORS} other cracks (`{}` among \
+                 them): a field's mask has room for {COLORS} cracks near one place",
+                name(c.crack),
+                name(c.near)
+            ),
+        ));
     }
     let g = &mut store.geometry;
     g.top = g.x.clone();
