@@ -122,20 +122,17 @@ impl Material {
         plastic: &mut Sym3,
         h: &mut Hardened,
     ) {
-        let start = *stress;
         self.update(plane, de, stress);
-        self.correct_plastic(plane, de, &start, stress, plastic, h);
+        self.correct_plastic(plane, stress, plastic, h);
     }
 
-    /// Corrects the elastic trial `stress` (the update of `start` by `de`) of a plastic
-    /// material to the yield surface. In plane stress the zz strain is then found so that
-    /// the returned sigma_zz vanishes (it is monotone in that strain): a tangent's
-    /// prediction, a Newton step, then the secant method.
+    /// Corrects the elastic trial `stress` of a plastic material to the yield surface: the
+    /// radial return in 3D and plane strain, the projected return in plane stress (which
+    /// keeps sigma_zz = 0).
+    #[inline]
     pub(crate) fn correct_plastic(
         &self,
         plane: Plane,
-        mut de: Sym3,
-        start: &Sym3,
         stress: &mut Sym3,
         plastic: &mut Sym3,
         h: &mut Hardened,
@@ -143,84 +140,11 @@ impl Material {
         let Some(j2) = &self.j2 else {
             return;
         };
-        if plane != Plane::Stress {
+        if plane == Plane::Stress {
+            j2.plane_stress_return(stress, plastic, h);
+        } else {
             j2.radial_return(stress, plastic, h);
-            return;
         }
-        let returned = |trial: Sym3| {
-            let (mut s, mut p, mut hh) = (trial, *plastic, *h);
-            j2.radial_return(&mut s, &mut p, &mut hh);
-            (s, p, hh)
-        };
-        let trial = |de: &Sym3| {
-            let mut s = *start;
-            self.add_elastic(de, &mut s);
-            returned(s)
-        };
-        // The first zz strain: the elastic one, or, from a start on the yield surface, the
-        // one the elastic-plastic tangent predicts (one return fewer in steady flow).
-        let mut now = match self.plastic_zz(j2, &de, start, h) {
-            Some(zz) => {
-                de.zz = zz;
-                trial(&de)
-            }
-            None => {
-                de.zz = self.plane_stress_zz(&de);
-                returned(*stress)
-            }
-        };
-        let tol = 1e-12 * j2.flow_stress(&now.2);
-        if now.0.zz.abs() > tol {
-            // The first correction is Newton's, with the zz-zz entry of the radial return's
-            // consistent tangent (Simo & Hughes 1998, Box 3.2): K + 4/3 mu theta - 2 mu
-            // theta_bar u_zz^2, theta = y / q_trial = y / (y + 3 mu dl), theta_bar =
-            // 3 mu / (3 mu + H) - (1 - theta); the secant method takes it from there.
-            let (mut z0, mut f0) = (de.zz, now.0.zz);
-            let y = j2.flow_stress(&now.2);
-            let theta = y / (y + 3.0 * self.mu * (now.2.equivalent - h.equivalent));
-            let (beta, u, _) = self.tangent(j2, &now.0.deviator(), y);
-            let theta_bar = beta / (2.0 * self.mu) - (1.0 - theta);
-            let slope = self.lambda + 2.0 * self.mu * (1.0 / 3.0 + 2.0 / 3.0 * theta)
-                - 2.0 * self.mu * theta_bar * u.zz * u.zz;
-            de.zz -= f0 / slope;
-            now = trial(&de);
-            for _ in 0..crate::plastic::MAX_ITERATIONS {
-                let f1 = now.0.zz;
-                if f1.abs() <= tol || f1 == f0 {
-                    break;
-                }
-                let z1 = de.zz;
-                de.zz = z1 - f1 * (z1 - z0) / (f1 - f0);
-                (z0, f0) = (z1, f1);
-                now = trial(&de);
-            }
-        }
-        (*stress, *plastic, *h) = now;
-    }
-
-    /// The continuum elastic-plastic tangent at a stress with deviator `dev` on the yield
-    /// surface `y`: C_ep = C - beta u (x) u with beta = 6 mu^2/(3 mu + H) and the unit
-    /// normal u = sqrt(3/2) S / y (Mashayekhi et al. 2011, Eq. 60). Returns beta, u and
-    /// the zz-zz entry.
-    fn tangent(&self, j2: &J2, dev: &Sym3, y: f64) -> (f64, Sym3, f64) {
-        let beta = 6.0 * self.mu * self.mu / (3.0 * self.mu + j2.hardening_slope(y));
-        let u = *dev * (1.5f64.sqrt() / y);
-        (beta, u, self.lambda + 2.0 * self.mu - beta * u.zz * u.zz)
-    }
-
-    /// The zz strain increment that keeps sigma_zz = 0 under the elastic-plastic tangent at
-    /// `start`, when `start` lies on the yield surface of state `h` (None otherwise): the
-    /// zz row of C_ep : de = 0, lambda tr(de) + 2 mu de_zz - beta u_zz (u : de) = 0,
-    /// solved for de_zz.
-    fn plastic_zz(&self, j2: &J2, de: &Sym3, start: &Sym3, h: &Hardened) -> Option<f64> {
-        let y = j2.flow_stress(h);
-        let dev = start.deviator();
-        if h.equivalent == 0.0 || 1.5 * dev.ddot(&dev) < (y * (1.0 - 1e-6)).powi(2) {
-            return None;
-        }
-        let (beta, u, czz) = self.tangent(j2, &dev, y);
-        let u_de = Sym3 { zz: 0.0, ..*de }.ddot(&u);
-        Some((beta * u.zz * u_de - self.lambda * (de.xx + de.yy)) / czz)
     }
 
     /// Elastic strain from stress through the 3D compliance, eps = ((1 + nu) sigma - nu

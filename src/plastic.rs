@@ -1,7 +1,8 @@
 //! J2 (von Mises) plasticity at small strain: an elastic predictor and a radial return
 //! (Simo & Hughes 1998, Box 3.2; Mashayekhi, Shodja & Namakian 2011, Eqs. 46-56), with
 //! linear isotropic hardening or the modified Ramberg-Osgood law (Mashayekhi et al. 2011,
-//! Eqs. 62-63). Plane stress iterates the out-of-plane strain until sigma_zz = 0.
+//! Eqs. 62-63); in plane stress the projected return of Simo & Taylor (Simo & Hughes 1998,
+//! Section 3.4.3).
 
 use crate::sym::Sym3;
 use bytemuck::{Pod, Zeroable};
@@ -49,9 +50,9 @@ pub struct Hardened {
     pub work: f64,
 }
 
-/// Most iterations of a scalar solve (the Ramberg-Osgood return, the plane-stress zz
-/// strain); both converge in a handful.
-pub(crate) const MAX_ITERATIONS: usize = 60;
+/// Most iterations of a scalar solve (the Ramberg-Osgood return, the plane-stress return);
+/// both converge in a handful.
+const MAX_ITERATIONS: usize = 60;
 
 /// Relative tolerance of the scalar solves.
 const TOLERANCE: f64 = 1e-13;
@@ -182,6 +183,109 @@ impl J2 {
     }
 }
 
+impl J2 {
+    /// Returns the plane-stress elastic trial `trial` (sigma_zz = 0) to the yield surface in
+    /// plane stress, keeping sigma_zz = 0: Simo & Taylor's projected return (Simo & Hughes
+    /// 1998, Section 3.4.3). In the eigenbasis of the J2 projection P the returned stress
+    /// is the trial's scaled by 1 / (1 + E dg / (3 (1 - nu))) along (1, 1, 0) and by
+    /// 1 / (1 + 2 mu dg) along (-1, 1, 0) and the shear, dg the plastic multiplier; one
+    /// scalar equation gives the new yield stress y, q(dg(y)) = y, with dg(y) = 3 dl /
+    /// (2 y) from the hardening law's plastic strain dl (for no hardening, q(dg) = y in
+    /// dg). Safeguarded Newton: each iterate stays inside the bracket the signs give.
+    pub fn plane_stress_return(&self, trial: &mut Sym3, plastic: &mut Sym3, h: &mut Hardened) {
+        let dev = trial.deviator();
+        let y0 = self.flow_stress(h);
+        let q_trial = (1.5 * dev.ddot(&dev)).sqrt();
+        if q_trial <= y0 {
+            return;
+        }
+        let nu = self.youngs / (2.0 * self.mu) - 1.0;
+        let (k1, k2) = (self.youngs / (3.0 * (1.0 - nu)), 2.0 * self.mu);
+        let a1 = (trial.xx + trial.yy) * std::f64::consts::FRAC_1_SQRT_2;
+        let a2 = (trial.yy - trial.xx) * std::f64::consts::FRAC_1_SQRT_2;
+        let (p1, p2) = (a1 * a1 / 3.0, a2 * a2 + 2.0 * trial.xy * trial.xy);
+        // q after a return of multiplier dg, and dq/d(dg).
+        let q_of = |dg: f64| {
+            let (f1, f2) = (1.0 / (1.0 + k1 * dg), 1.0 / (1.0 + k2 * dg));
+            let q = (1.5 * (p1 * f1 * f1 + p2 * f2 * f2)).sqrt();
+            let dxi = -2.0 * (k1 * p1 * f1 * f1 * f1 + k2 * p2 * f2 * f2 * f2);
+            (q, 0.75 * dxi / q)
+        };
+        let tol = TOLERANCE * y0;
+        let (dg, y, dl) = match self.hardening {
+            Hardening::Linear { modulus: 0.0 } => {
+                // q(dg) is convex and decreasing: Newton from dg = 0 rises onto the root.
+                let mut dg = 0.0;
+                for _ in 0..MAX_ITERATIONS {
+                    let (q, dq) = q_of(dg);
+                    let step = (q - y0) / dq;
+                    dg -= step;
+                    if step.abs() * k2 <= TOLERANCE {
+                        break;
+                    }
+                }
+                (dg, y0, 2.0 / 3.0 * dg * y0)
+            }
+            _ => {
+                // dg(y) and d(dg)/dy from the plastic strain the hardening law gives at y.
+                let (s0, eps0) = (self.yield_stress, self.yield_stress / self.youngs);
+                let strain = |y: f64| -> (f64, f64) {
+                    match self.hardening {
+                        Hardening::Linear { modulus } => ((y - y0) / modulus, 1.0 / modulus),
+                        Hardening::RambergOsgood { exponent: n } => {
+                            let r = y / s0;
+                            let p = power(r, n - 1.0);
+                            (eps0 * (p * r - r) - h.equivalent, eps0 / s0 * (n * p - 1.0))
+                        }
+                    }
+                };
+                let (mut lo, mut hi, mut y) = (y0, q_trial, y0);
+                for _ in 0..MAX_ITERATIONS {
+                    let (e, de) = strain(y);
+                    let dg = 1.5 * e.max(0.0) / y;
+                    let (q, dq) = q_of(dg);
+                    let g = q - y;
+                    if g > 0.0 {
+                        lo = y;
+                    } else {
+                        hi = y;
+                    }
+                    let slope = dq * (1.5 * de / y - dg / y) - 1.0;
+                    let step = g / slope;
+                    if step.abs() <= tol {
+                        y -= step;
+                        break;
+                    }
+                    // Newton, or the bracket's midpoint where Newton would leave it.
+                    y = if y - step > lo && y - step < hi {
+                        y - step
+                    } else {
+                        0.5 * (lo + hi)
+                    };
+                }
+                let dl = strain(y).0.max(0.0);
+                (1.5 * dl / y, y, dl)
+            }
+        };
+        let (f1, f2) = (1.0 / (1.0 + k1 * dg), 1.0 / (1.0 + k2 * dg));
+        let (b1, b2) = (
+            a1 * f1 * std::f64::consts::FRAC_1_SQRT_2,
+            a2 * f2 * std::f64::consts::FRAC_1_SQRT_2,
+        );
+        *trial = Sym3 {
+            xx: b1 - b2,
+            yy: b1 + b2,
+            xy: trial.xy * f2,
+            ..Sym3::default()
+        };
+        // Plastic flow along the returned deviator: d(eps_p) = dg S.
+        *plastic += trial.deviator() * dg;
+        h.work += 0.5 * (y0 + y) * dl;
+        h.equivalent += dl;
+        h.flow_stress = y;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -208,7 +312,8 @@ mod tests {
     }
 
     /// After a return, the effective stress equals the yield stress to round-off and the
-    /// Ramberg-Osgood state lies on its hardening curve (the consistency condition).
+    /// Ramberg-Osgood state lies on its hardening curve (the consistency condition), in 3D
+    /// and in plane stress (whose return also keeps sigma_zz = 0).
     #[test]
     fn return_satisfies_consistency() {
         for hardening in [
@@ -217,36 +322,42 @@ mod tests {
             Hardening::RambergOsgood { exponent: 10.0 },
             Hardening::RambergOsgood { exponent: 3.0 },
         ] {
-            let m = steel(hardening);
-            let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
-            let de = Sym3 {
-                xx: 4e-4,
-                yy: -1e-4,
-                zz: 0.5e-4,
-                yz: 2e-4,
-                xz: -1e-4,
-                xy: 3e-4,
-            };
-            for _ in 0..20 {
-                step(&m, Plane::None, de, &mut st);
-                let j2 = m.j2.expect("plastic");
-                let y = j2.flow_stress(&st.2);
-                let q = effective(&st.0);
-                if st.2.equivalent > 0.0 {
-                    assert!((q - y).abs() <= 1e-12 * y, "{hardening:?}: {q} vs {y}");
-                } else {
-                    assert!(q <= y, "{hardening:?}: elastic above yield");
+            // In plane stress the increment is in-plane (its zz is the update's to choose).
+            for (plane, out) in [(Plane::None, 1.0), (Plane::Stress, 0.0)] {
+                let m = steel(hardening);
+                let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
+                let de = Sym3 {
+                    xx: 4e-4,
+                    yy: -1e-4,
+                    zz: 0.5e-4 * out,
+                    yz: 2e-4 * out,
+                    xz: -1e-4 * out,
+                    xy: 3e-4,
+                };
+                for _ in 0..20 {
+                    step(&m, plane, de, &mut st);
+                    // The elastic update leaves round-off in sigma_zz, a return none.
+                    let zz = if plane == Plane::Stress { st.0.zz } else { 0.0 };
+                    assert!(zz.abs() <= 1e-12 * 250e6, "{hardening:?}: sigma_zz {zz}");
+                    let j2 = m.j2.expect("plastic");
+                    let y = j2.flow_stress(&st.2);
+                    let q = effective(&st.0);
+                    if st.2.equivalent > 0.0 {
+                        assert!((q - y).abs() <= 1e-12 * y, "{hardening:?}: {q} vs {y}");
+                    } else {
+                        assert!(q <= y, "{hardening:?}: elastic above yield");
+                    }
+                    if let Hardening::RambergOsgood { exponent } = hardening {
+                        let e = ramberg_osgood_strain(&j2, exponent, y);
+                        assert!(
+                            (e - st.2.equivalent).abs() <= 1e-12 * e,
+                            "{hardening:?} {}",
+                            (e - st.2.equivalent) / e
+                        );
+                    }
+                    // Plastic flow is deviatoric.
+                    assert!(st.1.trace().abs() <= 1e-15 * st.2.equivalent.max(1e-30));
                 }
-                if let Hardening::RambergOsgood { exponent } = hardening {
-                    let e = ramberg_osgood_strain(&j2, exponent, y);
-                    assert!(
-                        (e - st.2.equivalent).abs() <= 1e-12 * e,
-                        "{hardening:?} {}",
-                        (e - st.2.equivalent) / e
-                    );
-                }
-                // Plastic flow is deviatoric.
-                assert!(st.1.trace().abs() <= 1e-15 * st.2.equivalent.max(1e-30));
             }
         }
     }

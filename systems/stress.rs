@@ -148,7 +148,7 @@ impl<'a, D: Dim> StressColumns<'a, D> {
             if let Some(j2) = m.j2.as_ref().filter(|_| self.plastic) {
                 let h = self.hardened.get(i);
                 if j2.yields(&sigma, &h) {
-                    self.return_plastic(i, de, plane, m, &mut sigma, h);
+                    self.return_plastic(i, plane, m, &mut sigma, h);
                 }
             }
             let s = D::Sym::from_sym3(sigma);
@@ -162,12 +162,11 @@ impl<'a, D: Dim> StressColumns<'a, D> {
     /// that the elastic loop around it compiles as it would without plasticity.
     ///
     /// # Safety
-    /// As [`Self::update`]; particle `i`'s stress entry still holds the start stress.
+    /// As [`Self::update`].
     #[inline(never)]
     unsafe fn return_plastic(
         &self,
         i: usize,
-        de: Sym3,
         plane: Plane,
         m: &Material,
         sigma: &mut Sym3,
@@ -175,9 +174,8 @@ impl<'a, D: Dim> StressColumns<'a, D> {
     ) {
         // SAFETY: the caller's guarantee, passed on.
         unsafe {
-            let start = self.stress.get(i).to_sym3();
             let mut ep = self.plastic_strain.get(i).to_sym3();
-            m.correct_plastic(plane, de, &start, sigma, &mut ep, &mut h);
+            m.correct_plastic(plane, sigma, &mut ep, &mut h);
             self.plastic_strain.set(i, D::Sym::from_sym3(ep));
             self.hardened.set(i, h);
         }
