@@ -240,6 +240,7 @@ impl J2 {
                     }
                 };
                 let (mut lo, mut hi, mut y) = (y0, q_trial, y0);
+                let mut last = f64::NAN;
                 for _ in 0..MAX_ITERATIONS {
                     let (e, de) = strain(y);
                     let dg = 1.5 * e.max(0.0) / y;
@@ -252,15 +253,19 @@ impl J2 {
                     }
                     let slope = dq * (1.5 * de / y - dg / y) - 1.0;
                     let step = g / slope;
-                    if step.abs() <= tol {
+                    // Newton's error after this step is about M step^2, with M estimated
+                    // from the last two steps (step ~ M last^2): stop once that is below
+                    // the tolerance, sparing the step that would only confirm it.
+                    if step.abs() <= tol || step * step * step.abs() <= tol * last * last {
                         y -= step;
                         break;
                     }
-                    // Newton, or the bracket's midpoint where Newton would leave it.
-                    y = if y - step > lo && y - step < hi {
-                        y - step
+                    // Newton, or the bracket's midpoint where Newton would leave it (which
+                    // leaves no estimate of M).
+                    (y, last) = if y - step > lo && y - step < hi {
+                        (y - step, step)
                     } else {
-                        0.5 * (lo + hi)
+                        (0.5 * (lo + hi), f64::NAN)
                     };
                 }
                 let dl = strain(y).0.max(0.0);
@@ -323,7 +328,13 @@ mod tests {
             Hardening::RambergOsgood { exponent: 3.0 },
         ] {
             // In plane stress the increment is in-plane (its zz is the update's to choose).
-            for (plane, out) in [(Plane::None, 1.0), (Plane::Stress, 0.0)] {
+            // Increments of a third of the yield strain and of forty times it.
+            for (plane, out, big) in [
+                (Plane::None, 1.0, 1.0),
+                (Plane::Stress, 0.0, 1.0),
+                (Plane::None, 1.0, 125.0),
+                (Plane::Stress, 0.0, 125.0),
+            ] {
                 let m = steel(hardening);
                 let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
                 let de = Sym3 {
@@ -333,7 +344,7 @@ mod tests {
                     yz: 2e-4 * out,
                     xz: -1e-4 * out,
                     xy: 3e-4,
-                };
+                } * big;
                 for _ in 0..20 {
                     step(&m, plane, de, &mut st);
                     // The elastic update leaves round-off in sigma_zz, a return none.
