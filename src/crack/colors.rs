@@ -38,28 +38,35 @@ pub fn colors<D: Dim>(topology: &Topology<D>, x: &[D::Vec], cell: f64) -> Result
         let b = &mut boxes[c as usize];
         for &v in el.vertices() {
             let p = D::to_xyz(x[v as usize]);
-            for (k, &c) in p.iter().enumerate().take(D::D) {
-                b.0[k] = b.0[k].min(c - grow);
-                b.1[k] = b.1[k].max(c + grow);
+            for (k, &xk) in p.iter().enumerate().take(D::D) {
+                b.0[k] = b.0[k].min(xk - grow);
+                b.1[k] = b.1[k].max(xk + grow);
             }
         }
     }
-    let meet = |a: usize, b: usize| {
-        (0..D::D).all(|k| boxes[a].0[k] <= boxes[b].1[k] && boxes[b].0[k] <= boxes[a].1[k])
-    };
+    // The pairs of widened boxes that meet, by a sweep along x: each crack's earlier
+    // (lower-index) neighbours.
+    let mut by_x: Vec<usize> = (0..n).collect();
+    by_x.sort_by(|&a, &b| boxes[a].0[0].total_cmp(&boxes[b].0[0]).then(a.cmp(&b)));
+    let mut earlier: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (i, &a) in by_x.iter().enumerate() {
+        for &b in by_x[i + 1..]
+            .iter()
+            .take_while(|&&b| boxes[b].0[0] <= boxes[a].1[0])
+        {
+            if (1..D::D).all(|k| boxes[a].0[k] <= boxes[b].1[k] && boxes[b].0[k] <= boxes[a].1[k]) {
+                earlier[a.max(b)].push(a.min(b));
+            }
+        }
+    }
     let mut color = vec![0u8; n];
     for c in 0..n {
-        let mut taken = 0u64;
-        let mut last = c;
-        for d in (0..c).filter(|&d| meet(c, d)) {
-            taken |= 1 << color[d];
-            last = d;
-        }
+        let taken = (earlier[c].iter()).fold(0u64, |t, &d| t | 1 << color[d]);
         let free = (!taken).trailing_zeros() as usize;
         if free >= COLORS {
             return Err(Crowded {
                 crack: c,
-                near: last,
+                near: earlier[c].iter().copied().max().unwrap_or(c),
             });
         }
         color[c] = free as u8;
