@@ -282,6 +282,14 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
     if let Some(note) = k_withheld_note(s) {
         println!("  note: {note}");
     }
+    for t in &s.contours {
+        println!(
+            "  note: crack `{}`, tip `{}`: no J or K (the contour of {} cells around the tip's \
+             nearest node does not cross the crack: the crack is shorter than the contour, \
+             or the tip lies within the contour's size of the grid's edge)",
+            t.crack, t.tip, t.cells
+        );
+    }
     for t in &s.tubes {
         let part = |what: &str, v: &str| (!v.is_empty()).then(|| format!("{what} at vertices {v}"));
         let parts: Vec<String> = [

@@ -74,3 +74,32 @@ fn a_crack_on_a_node_row_is_reported() {
     );
     assert!(n.at.abs() < 1e-12, "{}", n.at);
 }
+
+/// A centre crack 0.4 mm long in 1 mm cells lies inside the 3-cell contour of each of its
+/// tips, so neither gets J: summary.json names both tips; a 20 mm crack gets J at both
+/// and nothing is reported.
+#[test]
+fn a_crack_inside_its_contour_is_reported() {
+    let scene = |half: f64| {
+        common::strip_2d(
+            "plane = \"stress\"",
+            2e-6,
+            &format!(
+                "[[body]]\nmaterial = \"m\"\nbox = {{ min = [0.004, 0.002], max = [0.036, 0.010] }}\n\
+                 velocity = [0.0, 0.0]\n[[crack]]\nname = \"c\"\n\
+                 line = {{ start = [{:.4}, 0.0065], end = [{:.4}, 0.0065], spacing = 5e-4 }}\n\
+                 tips = [\"start\", \"end\"]\n[[load]]\n\
+                 region = {{ min = [0.004, 0.0095], max = [0.036, 0.010] }}\nforce = [0.0, 1000.0]\n\
+                 [fracture]\ncontour = 3\n[output]\nhistory_interval = 1e-6\n",
+                0.02 - half,
+                0.02 + half
+            ),
+        )
+    };
+    let tiny = run_text(&scene(2e-4)).summary.contours;
+    let tips: Vec<(&str, &str, usize)> = (tiny.iter())
+        .map(|c| (c.crack.as_str(), c.tip.as_str(), c.cells))
+        .collect();
+    assert_eq!(tips, [("c", "start", 3), ("c", "end", 3)]);
+    assert!(run_text(&scene(0.01)).summary.contours.is_empty());
+}

@@ -64,6 +64,8 @@ pub struct Summary {
     /// Along 3D fronts: where the tube around a vertex was shrunk to stay inside the body
     /// and the vertex's material, or none fitted (last measurement).
     pub tubes: Vec<TubeReport>,
+    /// 2D tips where the last measurement found no J: the contour does not cross the crack.
+    pub contours: Vec<ContourReport>,
     /// Every growing crack tip: how far it grew and whether it stopped for good.
     pub growth: Vec<GrowthReport>,
     /// Snapshot this run continued from.
@@ -110,6 +112,19 @@ pub struct TubeReport {
     pub shrunk: String,
     /// Vertices where no tube of 2 cells or more fits.
     pub unfitted: String,
+}
+
+/// A 2D crack tip whose J contour, at the last measurement, did not cross the crack once
+/// (J and K NaN there): the crack is shorter than the contour, or the tip lies within the
+/// contour's size of the grid's edge.
+#[derive(Clone, Debug, Serialize)]
+pub struct ContourReport {
+    /// Crack name.
+    pub crack: String,
+    /// "start" or "end".
+    pub tip: String,
+    /// Contour size asked for (cells), `[fracture] contour`.
+    pub cells: usize,
 }
 
 /// A crack lying on a line or plane of grid nodes, which costs J and K accuracy.

@@ -468,6 +468,7 @@ fn drive<D: Dim>(
         expects: results,
         paths: reports::paths(&world, fracture.as_ref(), &state.history),
         tubes: reports::tubes(&world, fracture.as_ref(), &state.history),
+        contours: reports::contours(&world, fracture.as_ref(), &state.history),
         growth: reports::growth(&world),
         resumed_from: resumed_from.map(|p| p.display().to_string()),
         snapshot: snapshot.as_ref().map(|s| s.0.display().to_string()),

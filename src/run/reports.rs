@@ -6,7 +6,9 @@ use crate::dim::Dim;
 use crate::fracture::FracturePlan;
 use crate::growth::Stopped;
 use crate::measure::{History, Probe, last_rows, path_difference, path_tips};
-use crate::output::summary::{GrowthReport, NodeLineReport, PathReport, ProbeReport, TubeReport};
+use crate::output::summary::{
+    ContourReport, GrowthReport, NodeLineReport, PathReport, ProbeReport, TubeReport,
+};
 use crate::world::World;
 
 /// The path-dependence report of summary.json: every crack tip against every compared
@@ -97,6 +99,34 @@ pub(super) fn tubes<D: Dim>(
                 unfitted: ranges(&unfitted),
             });
         }
+    }
+    out
+}
+
+/// The 2D tips whose last measurement found no J (its contour did not cross the crack).
+pub(super) fn contours<D: Dim>(
+    world: &World<D>,
+    plan: Option<&FracturePlan>,
+    history: &History,
+) -> Vec<ContourReport> {
+    let (Some(plan), Some(cracks), true) = (plan, &world.cracks, D::D == 2) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (c, crack) in cracks.topology.cracks().iter().enumerate() {
+        let Some(mut mine) = last_rows(history, c as u32) else {
+            continue;
+        };
+        mine.sort_by_key(|t| t.tip);
+        out.extend(
+            mine.iter()
+                .filter(|t| t.j[0].is_nan())
+                .map(|t| ContourReport {
+                    crack: crack.name.clone(),
+                    tip: if t.tip == 0 { "start" } else { "end" }.to_string(),
+                    cells: plan.contour,
+                }),
+        );
     }
     out
 }
