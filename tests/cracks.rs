@@ -509,3 +509,37 @@ fn ninety_one_cracks_cut_ninety_two_free_pieces() {
         );
     }
 }
+
+/// Cracks that come within reach of too many others while a run goes on stop it with a
+/// message naming them: 40 cracks 1 mm apart build (each has at most 14 within reach),
+/// then, moved to a fifth of their spacing, classification refuses them.
+#[test]
+fn cracks_crowding_together_stop_the_run() {
+    let mut text = common::strip_2d(
+        "",
+        1e-6,
+        "[[body]]\nmaterial = \"m\"\nbox = { min = [0.0, 0.002], max = [0.04, 0.010] }\n",
+    )
+    .replace("max = [0.04, 0.012]", "max = [0.05, 0.012]");
+    for k in 0..40 {
+        let x = 0.0005 + 0.001 * k as f64;
+        text += &format!(
+            "[[crack]]\nname = \"c{k}\"\npoints = [[{x:.4}, 0.0051], [{x:.4}, 0.0069]]\ntips = []\n"
+        );
+    }
+    let mut world = build::<D2>(&source(&text))
+        .expect("40 cracks 1 mm apart")
+        .world;
+    fissure::systems::bin::run(&mut world).expect("binned");
+    fissure::systems::classify::run(&mut world).expect("room for 40 cracks 1 mm apart");
+    let cracks = world.cracks.as_mut().unwrap();
+    for x in cracks.geometry.x.iter_mut() {
+        x.x = 0.02 + 0.2 * (x.x - 0.02);
+    }
+    let e = fissure::systems::classify::run(&mut world).expect_err("no room any more");
+    assert!(
+        e.what.contains("came within reach of 32 other cracks"),
+        "{}",
+        e.what
+    );
+}
