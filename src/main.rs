@@ -568,6 +568,12 @@ fn cmd_validate(
                         wall
                     );
                 }
+                if o.summary.expects.is_empty() {
+                    println!(
+                        "{:<28} ran ({}) in {wall:.2} s; it has no [[expect]] to check",
+                        o.summary.scenario, o.summary.status
+                    );
+                }
                 if let Some(note) = k_withheld_note(&o.summary) {
                     println!("{:<28} note: {note}", o.summary.scenario);
                 }
