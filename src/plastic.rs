@@ -91,17 +91,6 @@ impl J2 {
         }
     }
 
-    /// The hardening slope H = d(sigma_y)/d(eps_p) at yield stress `y` (Pa).
-    pub fn hardening_slope(&self, y: f64) -> f64 {
-        match self.hardening {
-            Hardening::Linear { modulus } => modulus,
-            Hardening::RambergOsgood { exponent: n } => {
-                let r = y / self.yield_stress;
-                self.youngs / (n * power(r, n - 1.0) - 1.0)
-            }
-        }
-    }
-
     /// Solves the consistency condition q - 3 G dl - sigma_y(eps_p + dl) = 0 (Eq. 55) for
     /// the plastic multiplier dl and the new yield stress, given the trial effective stress
     /// `q` above the current yield stress `y0`.
@@ -181,9 +170,7 @@ impl J2 {
         h.equivalent += dl;
         h.flow_stress = y;
     }
-}
 
-impl J2 {
     /// Returns the plane-stress elastic trial `trial` (sigma_zz = 0) to the yield surface in
     /// plane stress, keeping sigma_zz = 0: Simo & Taylor's projected return (Simo & Hughes
     /// 1998, Section 3.4.3). In the eigenbasis of the J2 projection P the returned stress

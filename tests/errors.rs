@@ -639,7 +639,8 @@ fn accepted_but_wrong_inputs_are_refused() {
 
 /// Command-line values that cannot be used exit with code 2: an end time that is not after
 /// the start (0, NaN, infinite) or needs too many steps; a resume from a folder without
-/// snapshots; a validate over a folder without scenarios.
+/// snapshots; a validate over a folder without scenarios (one of a scenario without
+/// expects exits 0 and says it ran).
 #[test]
 fn unusable_command_line_values_exit_with_code_2() {
     let dir = std::env::temp_dir().join(format!("fissure-usage-{}", std::process::id()));
@@ -671,6 +672,17 @@ fn unusable_command_line_values_exit_with_code_2() {
     let (code, err) = fissure(&["validate", empty.to_str().unwrap()]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("no scenario"), "{err}");
+    // A scenario without expects is not an error, and `validate` says it ran.
+    let ran = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+        .args(["validate", f])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&ran.stdout);
+    assert_eq!(ran.status.code(), Some(0), "{stdout}");
+    assert!(
+        stdout.contains("good") && stdout.contains("no [[expect]] to check"),
+        "{stdout}"
+    );
     std::fs::remove_dir_all(dir).ok();
 }
 

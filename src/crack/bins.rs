@@ -2,7 +2,7 @@
 //! over rings of bins around it instead of a scan of every element (contact asks this of
 //! every node with a crack field, twice a step).
 
-use super::Element;
+use super::{Bounds, bounds};
 use crate::dim::Dim;
 
 /// One crack's elements on a lattice of bins (compressed rows: the elements of bin `b` are
@@ -15,7 +15,7 @@ pub struct ElementBins {
     items: Vec<u32>,
     /// Each element's box (indexed by element; meaningful for the binned ones), a cheap
     /// lower bound on its distance that spares most exact ones.
-    boxes: Vec<([f64; 3], [f64; 3])>,
+    boxes: Vec<Bounds>,
 }
 
 impl ElementBins {
@@ -32,14 +32,7 @@ impl ElementBins {
         let boxes: Vec<(usize, [f64; 3], [f64; 3])> = (elems.iter().enumerate())
             .filter(|&(e, _)| keep(e))
             .map(|(e, el)| {
-                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-                for &v in el.vertices() {
-                    let p = D::to_xyz(x[v as usize]);
-                    for k in 0..dims {
-                        lo[k] = lo[k].min(p[k]);
-                        hi[k] = hi[k].max(p[k]);
-                    }
-                }
+                let (lo, hi) = bounds::<D>(x, el);
                 (e, lo, hi)
             })
             .collect();

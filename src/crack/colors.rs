@@ -2,7 +2,7 @@
 //! scene may hold more cracks than a mask has bits for. Cracks that no particle's stencil
 //! can see at once may share a colour; with at most [`COLORS`] cracks each is its own.
 
-use super::{Element, Topology};
+use super::{Bounds, Topology, bounds, overlap};
 use crate::dim::Dim;
 
 /// Colours a mask has room for (two bits each in a `u64`).
@@ -33,15 +33,15 @@ pub fn colors<D: Dim>(topology: &Topology<D>, x: &[D::Vec], cell: f64) -> Result
         return Ok((0..n as u8).collect());
     }
     let grow = REACH_CELLS * cell;
-    let mut boxes = vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); n];
+    // Each crack's box, widened along the scene's axes.
+    let mut boxes: Vec<Bounds> = vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); n];
     for (el, &c) in topology.elems().iter().zip(topology.elem_crack()) {
+        let (lo, hi) = bounds::<D>(x, el);
         let b = &mut boxes[c as usize];
-        for &v in el.vertices() {
-            let p = D::to_xyz(x[v as usize]);
-            for (k, &xk) in p.iter().enumerate().take(D::D) {
-                b.0[k] = b.0[k].min(xk - grow);
-                b.1[k] = b.1[k].max(xk + grow);
-            }
+        for k in 0..3 {
+            let g = if k < D::D { grow } else { 0.0 };
+            b.0[k] = b.0[k].min(lo[k] - g);
+            b.1[k] = b.1[k].max(hi[k] + g);
         }
     }
     // The pairs of widened boxes that meet, by a sweep along x: each crack's earlier
@@ -54,7 +54,7 @@ pub fn colors<D: Dim>(topology: &Topology<D>, x: &[D::Vec], cell: f64) -> Result
             .iter()
             .take_while(|&&b| boxes[b].0[0] <= boxes[a].1[0])
         {
-            if (1..D::D).all(|k| boxes[a].0[k] <= boxes[b].1[k] && boxes[b].0[k] <= boxes[a].1[k]) {
+            if overlap(&boxes[a], &boxes[b]) {
                 earlier[a.max(b)].push(a.min(b));
             }
         }

@@ -2,7 +2,28 @@
 //! 3D. [`crate::dim::Dim::Elem`] picks one, so code written for one shape of element
 //! does not compile for the other.
 
+use crate::dim::Dim;
 use std::fmt::Debug;
+
+/// An axis-aligned box (min, max) in x, y, z (m); a 2D box has z = 0 at both ends.
+pub type Bounds = ([f64; 3], [f64; 3]);
+
+/// The box of element `e` of the vertices `v`.
+pub fn bounds<D: Dim>(v: &[D::Vec], e: &D::Elem) -> Bounds {
+    let mut b = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for &k in e.vertices() {
+        for (a, x) in D::to_xyz(v[k as usize]).into_iter().enumerate() {
+            b.0[a] = b.0[a].min(x);
+            b.1[a] = b.1[a].max(x);
+        }
+    }
+    b
+}
+
+/// Whether two boxes meet (touching counts).
+pub fn overlap(a: &Bounds, b: &Bounds) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
+}
 
 /// A crack element: a fixed number of vertex indices into the crack store.
 pub trait Element: Copy + Debug + PartialEq + Send + Sync + 'static {

@@ -2,26 +2,8 @@
 //! each crack splits the velocity field on its own, so where two meet a node's fields
 //! would be ambiguous.
 
-use crate::crack::{Cracks, Element};
+use crate::crack::{Bounds, Cracks, Element, bounds, overlap};
 use crate::dim::Dim;
-
-/// Bounding box of a crack element (m).
-type Bounds = ([f64; 3], [f64; 3]);
-
-fn bounds<D: Dim>(v: &[D::Vec], e: &D::Elem) -> Bounds {
-    let mut b = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for &k in e.vertices() {
-        for (a, x) in D::to_xyz(v[k as usize]).into_iter().enumerate() {
-            b.0[a] = b.0[a].min(x);
-            b.1[a] = b.1[a].max(x);
-        }
-    }
-    b
-}
-
-fn overlap(a: &Bounds, b: &Bounds) -> bool {
-    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
-}
 
 /// The edges of a crack element as vertex pairs: the segment itself in 2D, the three
 /// edges of a triangle in 3D.
