@@ -10,6 +10,7 @@ pub mod crack;
 pub mod dim;
 pub mod disjoint;
 pub mod error;
+pub mod eta;
 pub mod fracture;
 pub mod front;
 pub mod front_integral;

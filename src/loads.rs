@@ -27,6 +27,10 @@ pub struct VelocityBc<D: Dim> {
     pub velocity: D::Vec,
     /// Time multiplier on `velocity`.
     pub time: TimeFn,
+    /// The force each node's support exerted on the body over the last step (N; in 2D for
+    /// the scene's thickness), in the prescribed components: m (a_prescribed - a_free),
+    /// summed over the node's crack fields. Zero before the first step.
+    pub reaction: Vec<D::Vec>,
 }
 
 impl<D: Dim> VelocityBc<D> {

@@ -1,12 +1,12 @@
 //! Probes (particle averages recorded every step) and `[[expect]]` evaluation.
 
 use crate::dim::Dim;
+use crate::eta::EtaEstimate;
 use crate::fracture::{PathResult, TipResult};
 use crate::growth::GrowthRow;
-use crate::material::Material;
 use crate::particles::Particles;
 use crate::sym::SymTensor;
-use crate::world::Energies;
+use crate::world::{Energies, World};
 use serde::Serialize;
 use std::collections::HashMap;
 
@@ -31,6 +31,10 @@ pub enum ProbeQty {
     /// Largest initial distance (m) from the probe's centre of a particle that has yielded
     /// (0 while none has): the radius of a plastic zone spreading from a bore or a load.
     PlasticRadius,
+    /// Force component (N; in 2D for the scene's thickness) that the prescribed-velocity
+    /// nodes inside the probe's region exerted on the body over the last step: a support's
+    /// or a grip's reaction, the load of a load-displacement curve.
+    Reaction,
 }
 
 /// Average of one component over a fixed particle set.
@@ -38,8 +42,10 @@ pub enum ProbeQty {
 pub struct Probe {
     /// Name.
     pub name: String,
-    /// Particles averaged.
+    /// Particles averaged (none for a reaction).
     pub particles: Vec<u32>,
+    /// A reaction's nodes: (index of the boundary, the node's place in its node list).
+    pub supports: Vec<(u32, u32)>,
     /// Quantity.
     pub qty: ProbeQty,
     /// Component index (0..3 for vectors, 0..6 in xx, yy, zz, yz, xz, xy order for tensors).
@@ -50,11 +56,17 @@ pub struct Probe {
 }
 
 impl Probe {
-    /// Current average.
-    pub fn sample<D: Dim>(&self, p: &Particles<D>, materials: &[Material]) -> f64 {
+    /// Current value.
+    pub fn sample<D: Dim>(&self, world: &World<D>) -> f64 {
+        let (p, materials) = (&world.particles, &world.materials);
         match self.qty {
             ProbeQty::Opening => return self.opening(p),
             ProbeQty::PlasticRadius => return self.plastic_radius(p),
+            ProbeQty::Reaction => {
+                let bcs = &world.bcs;
+                let force = |&(b, k): &(u32, u32)| bcs[b as usize].reaction[k as usize];
+                return self.supports.iter().map(force).map(|f| f[self.comp]).sum();
+            }
             _ => {}
         }
         let mut sum = 0.0;
@@ -73,7 +85,7 @@ impl Probe {
                     };
                     strain.to_array()[self.comp]
                 }
-                ProbeQty::Opening | ProbeQty::PlasticRadius => {
+                ProbeQty::Opening | ProbeQty::PlasticRadius | ProbeQty::Reaction => {
                     unreachable!("sampled by their own methods")
                 }
             };
@@ -273,6 +285,20 @@ pub enum Measure {
         /// Start of the window (s).
         from: f64,
     },
+    /// |J| at a 2D crack tip (last row) against the eta estimate from a load and a
+    /// displacement probe: (|J| - J_eta) / J_eta.
+    JEta {
+        /// Crack index.
+        crack: u32,
+        /// 0 start, 1 end.
+        tip: u32,
+        /// The load probe (N).
+        load: usize,
+        /// The displacement probe (m), the load's work-conjugate.
+        displacement: usize,
+        /// The specimen's estimate.
+        estimate: EtaEstimate,
+    },
     /// A growing tip's path or fatigue life, from its growth rows.
     Growth {
         /// Crack index.
@@ -434,6 +460,18 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
                     Some(if d.abs() > worst.abs() { d } else { worst })
                 })
                 .map(|d| reference + d)
+        }
+        Measure::JEta {
+            crack,
+            tip,
+            load,
+            displacement,
+            estimate,
+        } => {
+            let last = (h.fracture.iter()).rfind(|r| r.crack == crack && r.tip == tip)?;
+            let j = last.j[0].hypot(last.j[1]);
+            let eta = estimate.j(&h.probes[load], &h.probes[displacement])?;
+            finite((j - eta) / eta)
         }
         Measure::KDrift { crack, tip, from } => {
             let rows: Vec<&TipResult> = h

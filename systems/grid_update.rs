@@ -30,7 +30,7 @@ pub fn momentum_bc<D: Dim>(world: &mut World<D>, end: bool) {
 
 /// Integrates nodal momenta over the step: a = (f - alpha p + m g)/m, v' = p/m + a dt; then
 /// prescribed components are set to their end-of-step values with the matching acceleration,
-/// and the work of the support's reaction is booked as external work.
+/// and the support's reaction is kept per node and its work booked as external work.
 pub fn run<D: Dim>(world: &mut World<D>) {
     let s = &world.settings;
     let (dt, alpha, gravity, tol) = (s.dt, s.damping, s.gravity, s.mass_tol);
@@ -85,8 +85,9 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let g = &mut world.grid;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     let mut work = 0.0;
-    for bc in &world.bcs {
-        for &node in &bc.nodes {
+    for bc in &mut world.bcs {
+        for k in 0..bc.nodes.len() {
+            let (node, mut reaction) = (bc.nodes[k], D::zero());
             for n in entries(node, fields) {
                 let m = g.mass[n];
                 if m <= tol {
@@ -99,12 +100,15 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                         // the mean of the start and prescribed end velocities.
                         let v1 = bc.value(a, t1);
                         let a_bc = (v1 - v0[a]) / dt;
-                        work += m * (a_bc - g.accel[n][a]) * 0.5 * (v0[a] + v1) * dt;
+                        let r = m * (a_bc - g.accel[n][a]);
+                        reaction[a] += r;
+                        work += r * 0.5 * (v0[a] + v1) * dt;
                         g.velocity[n][a] = v1;
                         g.accel[n][a] = a_bc;
                     }
                 }
             }
+            bc.reaction[k] = reaction;
         }
     }
     world.work.external += work;

@@ -968,3 +968,59 @@ fn too_many_cracks_in_one_place_are_refused() {
     let wide = GOOD.replace("cell = [0.002, 0.002]", "cell = [0.00005, 0.00005]");
     assert!(build::<D2>(&Source::parse("ok.toml", &(wide + &spread), &[]).unwrap()).is_ok());
 }
+
+#[test]
+fn bad_reactions_and_eta_estimates_name_the_key() {
+    let support =
+        "[[boundary]]\nregion = { min = [0.0, 0.0], max = [0.004, 0.02] }\nfix = [\"x\"]\n";
+    let probe = |region: &str, component: &str| {
+        format!(
+            "[[probe]]\nname = \"load\"\nregion = {region}\nquantity = \"reaction\"\ncomponent = \"{component}\"\n"
+        )
+    };
+    let left = "{ min = [0.0, 0.0], max = [0.004, 0.02] }";
+    let e = error_with_text(&format!("{support}{}", probe(left, "y")));
+    assert_error(&e, "probe[0].region", None, "prescribes its component");
+    let e = error_with_text(&format!(
+        "{support}{}",
+        probe("{ min = [0.01, 0.0], max = [0.02, 0.02] }", "x")
+    ));
+    assert_error(
+        &e,
+        "probe[0].region",
+        None,
+        "no grid node of a [[boundary]]",
+    );
+    let crack = "[[crack]]\npoints = [[0.003, 0.01], [0.01, 0.01]]\n[fracture]\n";
+    let displacement = "[[probe]]\nname = \"d\"\nregion = { min = [0.014, 0.004], max = [0.016, 0.016] }\nquantity = \"displacement\"\ncomponent = \"x\"\n";
+    let eta = "eta = { factor = 1.9, ligament = 0.006, K_per_load = 50.0, material = \"steel\" }\n";
+    let expect = |body: &str| {
+        error_with_text(&format!(
+            "{support}{}{displacement}{crack}[[expect]]\ncrack = \"crack0\"\nreference = 0.0\nsource = \"s\"\ntolerance = 0.05\n{body}",
+            probe(left, "x")
+        ))
+    };
+    let e = expect("quantity = \"J_eta\"\nprobes = [\"load\", \"d\"]\n");
+    assert_error(&e, "expect[0].eta", None, "give the specimen's estimate");
+    let e = expect(&format!("quantity = \"J_eta\"\nprobes = [\"load\"]\n{eta}"));
+    assert_error(&e, "expect[0].probes", None, "takes two probes");
+    let e = expect(&format!(
+        "quantity = \"J_eta\"\nprobes = [\"load\", \"d\"]\n{}",
+        eta.replace("1.9", "-1.9")
+    ));
+    assert_error(&e, "expect[0].eta.factor", None, "must be > 0");
+    let e = expect(&format!(
+        "quantity = \"J_eta\"\nprobes = [\"load\", \"d\"]\n{}",
+        eta.replace("\"steel\"", "\"iron\"")
+    ));
+    assert_error(
+        &e,
+        "expect[0].eta.material",
+        None,
+        "no [[material]] named `iron`",
+    );
+    let e = expect(&format!("quantity = \"KI\"\n{eta}"));
+    assert_error(&e, "expect[0].eta", None, "applies to J_eta");
+    let e = expect("quantity = \"KI\"\nprobes = [\"d\"]\n");
+    assert_error(&e, "expect[0].probes", None, "takes no probes");
+}

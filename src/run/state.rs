@@ -55,7 +55,7 @@ impl RunState {
     pub fn sample<D: Dim>(&mut self, world: &World<D>, probes: &[Probe]) {
         self.history.time.push(world.time);
         for (k, p) in probes.iter().enumerate() {
-            self.history.probes[k].push(p.sample(&world.particles, &world.materials));
+            self.history.probes[k].push(p.sample(world));
         }
     }
 

@@ -389,6 +389,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             return Err(src.error(&key("time"), msg));
         }
         bcs.push(VelocityBc {
+            reaction: vec![D::zero(); nodes.len()],
             nodes,
             axes,
             velocity: to_vec::<D>(velocity),
@@ -460,12 +461,13 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             "strain" => ProbeQty::Strain,
             "opening" => ProbeQty::Opening,
             "plastic_radius" => ProbeQty::PlasticRadius,
+            "reaction" => ProbeQty::Reaction,
             other => {
                 return Err(src.error(
                     &key("quantity"),
                     format!(
                         "unknown quantity `{other}` (displacement, velocity, position, stress, \
-                         strain, opening, plastic_radius)"
+                         strain, opening, plastic_radius, reaction)"
                     ),
                 ));
             }
@@ -493,6 +495,18 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 })?,
             (Some(c), _) => axis_index::<D>(src, &key("component"), c)?,
         };
+        if qty == ProbeQty::Reaction {
+            let supports = supports::<D>(src, &key, &p.region, &bcs, &geom, comp)?;
+            probes.push(Probe {
+                name: p.name.clone(),
+                particles: Vec::new(),
+                supports,
+                qty,
+                comp,
+                centre: [0.0; 3],
+            });
+            continue;
+        }
         let sel = select(&key("region"), &p.region)?;
         let mut centre = [0.0; 3];
         for &q in &sel {
@@ -537,6 +551,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         probes.push(Probe {
             name: p.name.clone(),
             particles: sel,
+            supports: Vec::new(),
             qty,
             comp,
             centre,
@@ -570,7 +585,10 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         let front_qty = ["KI_front", "KII_front", "KIII_front", "J1_front"]
             .iter()
             .position(|q| *q == e.quantity);
-        let tip_like = tip_qty.is_some() || e.quantity == "K_drift";
+        let tip_like = tip_qty.is_some() || ["K_drift", "J_eta"].contains(&e.quantity.as_str());
+        if e.eta.is_some() && e.quantity != "J_eta" {
+            return Err(src.error(&key("eta"), "`eta` applies to J_eta"));
+        }
         if D::D == 3 && tip_like {
             return Err(src.error(
                 &key("quantity"),
@@ -609,6 +627,9 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 Some(super::cracks::path_measure::<D>(src, i, e, &geom)?)
             }
             _ if e.quantity == "K_drift" => Some(super::cracks::drift_measure(src, i, e)?),
+            _ if e.quantity == "J_eta" => Some(super::eta::eta_measure(
+                src, i, e, &ids, &materials, plane, thickness,
+            )?),
             _ if ["kink", "path_angle", "turn", "cycles"].contains(&e.quantity.as_str()) => {
                 if D::D == 3 && e.quantity != "cycles" {
                     return Err(src.error(
@@ -622,6 +643,12 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         };
         if let Some(measure) = crack_measure {
             positive(src, &key("tolerance"), e.tolerance, "relative")?;
+            if !ids.is_empty() && e.quantity != "J_eta" {
+                return Err(src.error(
+                    &key("probes"),
+                    format!("`{}` is read at a crack: it takes no probes", e.quantity),
+                ));
+            }
             expects.push(Expect {
                 quantity: e.quantity.clone(),
                 probes: e
@@ -634,6 +661,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                         _ => "end".into(),
                     })])
                     .chain(e.at.map(|t| format!("t={t:.3e}")))
+                    .chain(e.probes.iter().cloned())
                     .collect(),
                 measure,
                 reference: e.reference,
@@ -667,8 +695,8 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                     format!(
                         "unknown quantity `{other}` (final, max, min, frequency, wave_speed, \
                          slope, momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2, \
-                         J_path, K_drift, kinetic_fraction, KI_front, KII_front, KIII_front, \
-                         J1_front, kink, path_angle, turn, cycles)"
+                         J_path, K_drift, J_eta, kinetic_fraction, KI_front, KII_front, \
+                         KIII_front, J1_front, kink, path_angle, turn, cycles)"
                     ),
                 ));
             }
@@ -895,6 +923,37 @@ fn hole(src: &Source, key: &str, round: &RoundSpec) -> R<f64> {
             ),
         ))
     }
+}
+
+/// A reaction probe's nodes: every prescribed-velocity node inside `region` (within a
+/// millionth of a cell, as boundaries select them), as (boundary, place in its node list),
+/// refused when none of them prescribes component `comp`.
+fn supports<D: Dim>(
+    src: &Source,
+    key: &dyn Fn(&str) -> String,
+    spec: &RegionSpec,
+    bcs: &[VelocityBc<D>],
+    geom: &GridGeom<D>,
+    comp: usize,
+) -> R<Vec<(u32, u32)>> {
+    let r = region::<D>(src, &key("region"), spec)?;
+    let tol = 1e-6 * (0..D::D).map(|a| geom.h[a]).fold(f64::INFINITY, f64::min);
+    let mut supports = Vec::new();
+    for (b, bc) in bcs.iter().enumerate().filter(|(_, bc)| bc.axes[comp]) {
+        for (k, &n) in bc.nodes.iter().enumerate() {
+            if r.contains(D::to_xyz(geom.node_position(n as usize)), D::D, tol) {
+                supports.push((b as u32, k as u32));
+            }
+        }
+    }
+    if supports.is_empty() {
+        return Err(src.error(
+            &key("region"),
+            "a reaction probe's region holds no grid node of a [[boundary]] that prescribes \
+             its component",
+        ));
+    }
+    Ok(supports)
 }
 
 /// The geometry of body `b`, from exactly one geometry key.

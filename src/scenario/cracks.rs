@@ -687,7 +687,7 @@ fn measured_crack<'a>(src: &Source, i: usize, e: &'a ExpectSpec) -> R<(usize, &'
 }
 
 /// The crack and tip (0 start, 1 end) an expect names, checked.
-fn expect_tip(src: &Source, i: usize, e: &ExpectSpec) -> R<(u32, u32)> {
+pub(super) fn expect_tip(src: &Source, i: usize, e: &ExpectSpec) -> R<(u32, u32)> {
     let key = |k: &str| format!("expect[{i}].{k}");
     let sc = &src.scenario;
     let (c, name) = measured_crack(src, i, e)?;

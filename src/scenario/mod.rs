@@ -4,6 +4,7 @@
 pub mod build;
 mod crack_meet;
 mod cracks;
+mod eta;
 mod growth;
 mod material;
 mod memory;

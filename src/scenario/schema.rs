@@ -500,18 +500,19 @@ pub struct WilliamsSpec {
     pub direction: f64,
 }
 
-/// `[[probe]]`: a particle average recorded at every step.
+/// `[[probe]]`: a particle average (or a support's reaction) recorded at every step.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ProbeSpec {
     /// Name used by `[[expect]]` and in probes.csv.
     pub name: String,
-    /// Particles initially inside this region are averaged.
+    /// Particles initially inside this region are averaged (for a reaction, its nodes summed).
     pub region: RegionSpec,
     /// "displacement", "velocity", "position", "stress", "strain", "opening" (the mean
-    /// displacement beyond the region's centroid minus that short of it, along `component`)
-    /// or "plastic_radius" (on a disc or ball region: the largest initial distance from its
-    /// centre of a particle that has yielded; no component).
+    /// displacement beyond the region's centroid minus that short of it, along `component`),
+    /// "plastic_radius" (on a disc or ball region: the largest initial distance from its
+    /// centre of a particle that has yielded; no component) or "reaction" (the force the
+    /// region's prescribed-velocity nodes exerted on the body, N).
     pub quantity: String,
     /// "x", "y", "z" for vectors; "xx", "yy", "zz", "yz", "xz", "xy" for tensors.
     pub component: Option<String>,
@@ -599,6 +600,24 @@ pub struct AlongSpec {
     pub ratio: Option<f64>,
 }
 
+/// The eta estimate J = K^2 / E' + eta A_pl / (B b) of a cracked specimen's J from its
+/// load-displacement record (Rice, Paris & Merkle 1973; ASTM E1820), with K = K_per_load P.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EtaSpec {
+    /// The plastic eta factor of the specimen and displacement measured (e.g. 1.9 for a
+    /// bend bar's load-line displacement).
+    pub factor: f64,
+    /// The uncracked ligament b (m).
+    pub ligament: f64,
+    /// The handbook's K_I per unit load (Pa sqrt(m) / N; in 2D per load on the scene's
+    /// thickness).
+    #[serde(rename = "K_per_load")]
+    pub k_per_load: f64,
+    /// The material at the tip, whose E' turns K into the elastic J.
+    pub material: String,
+}
+
 /// `[checkpoint]`: when to write snapshots into `<out>/snapshots/` (any combination; none
 /// set means snapshots only on a clean stop).
 #[derive(Debug, Clone, Deserialize, Default)]
@@ -629,7 +648,9 @@ pub struct ExpectSpec {
     /// vertex `near` a point, last row); for a growing 2D tip kink (its first turn,
     /// degrees), path_angle (its line over the last quarter of the length grown, to x, degrees in
     /// (-90, 90]), turn (the chord from the tip's start to its last new vertex, as a turn
-    /// from the crack, degrees) and cycles (fatigue: load cycles to grow by `length`).
+    /// from the crack, degrees) and cycles (fatigue: load cycles to grow by `length`);
+    /// J_eta (|J| at a 2D tip against the `eta` estimate from a load and a displacement
+    /// probe, relative).
     pub quantity: String,
     /// Probe(s) the quantity is measured on (wave_speed and slope take two).
     #[serde(default)]
@@ -651,6 +672,8 @@ pub struct ExpectSpec {
     /// For the front quantities: only the front vertex nearest this point (m), e.g. the
     /// deepest point of a surface crack (default: every front vertex).
     pub near: Option<Vec<f64>>,
+    /// For J_eta: the specimen's eta estimate of J from its load-displacement record.
+    pub eta: Option<EtaSpec>,
     /// Reference value (SI).
     pub reference: f64,
     /// Where the reference comes from.

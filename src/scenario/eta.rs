@@ -1,0 +1,72 @@
+//! The `J_eta` expect: a crack tip's J against the eta estimate from the scene's own
+//! load-displacement record (see [`crate::eta`]).
+
+use super::cracks::expect_tip;
+use super::schema::ExpectSpec;
+use super::source::Source;
+use crate::error::ScenarioError;
+use crate::eta::EtaEstimate;
+use crate::fracture::e_prime;
+use crate::material::{Material, Plane};
+use crate::measure::Measure;
+
+type R<T> = Result<T, ScenarioError>;
+
+/// The measure of a `J_eta` expect, whose probes `ids` are the load's and the
+/// displacement's; E' from the named material in the scene's `plane`, B its `thickness`.
+pub(super) fn eta_measure(
+    src: &Source,
+    i: usize,
+    e: &ExpectSpec,
+    ids: &[usize],
+    materials: &[Material],
+    plane: Plane,
+    thickness: f64,
+) -> R<Measure> {
+    let key = |k: &str| format!("expect[{i}].{k}");
+    let (crack, tip) = expect_tip(src, i, e)?;
+    let &[load, displacement] = ids else {
+        return Err(src.error(
+            &key("probes"),
+            "`J_eta` takes two probes: the load (e.g. a support's reaction) and the \
+             displacement it works through",
+        ));
+    };
+    if e.at.is_some() {
+        return Err(src.error(&key("at"), "`J_eta` is read at the end of the run"));
+    }
+    let Some(spec) = &e.eta else {
+        return Err(src.error(
+            &key("eta"),
+            "give the specimen's estimate: eta = { factor, ligament, K_per_load, material }",
+        ));
+    };
+    let positive = |k: &str, v: f64, unit: &str| {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(src.error(&key(&format!("eta.{k}")), format!("must be > 0 ({unit})")))
+        }
+    };
+    let material = (materials.iter())
+        .find(|m| m.name == spec.material)
+        .ok_or_else(|| {
+            src.error(
+                &key("eta.material"),
+                format!("no [[material]] named `{}`", spec.material),
+            )
+        })?;
+    Ok(Measure::JEta {
+        crack,
+        tip,
+        load,
+        displacement,
+        estimate: EtaEstimate {
+            factor: positive("factor", spec.factor, "dimensionless")?,
+            ligament: positive("ligament", spec.ligament, "m")?,
+            k_per_load: positive("K_per_load", spec.k_per_load, "Pa sqrt(m) / N")?,
+            modulus: e_prime(material, plane),
+            thickness,
+        },
+    })
+}
