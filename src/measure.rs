@@ -51,7 +51,7 @@ pub struct Probe {
     /// Component index (0..3 for vectors, 0..6 in xx, yy, zz, yz, xz, xy order for tensors).
     pub comp: usize,
     /// Initial centroid of the particles (m); for a plastic radius, the centre of its disc
-    /// or ball region.
+    /// or ball region; for a reaction, the centroid of its nodes.
     pub centre: [f64; 3],
 }
 

@@ -521,6 +521,18 @@ fn crossing_cracks_are_refused() {
         Some(22),
         "meets crack `a` (its segment",
     );
+    // On one line or plane the crossing predicates see no crossing; the overlap is refused.
+    let e = error_with_text(
+        "[[crack]]\nname = \"a\"\nline = { start = [0.006, 0.01], end = [0.012, 0.01] }\n\
+         [[crack]]\nline = { start = [0.009, 0.01], end = [0.014, 0.01] }\n",
+    );
+    assert_error(&e, "crack[1].line", Some(22), "meets crack `a` (its segment 0");
+    let e = error_3d(
+        "[[crack]]\nname = \"a\"\npenny = { center = [0.01, 0.01, 0.01], normal = [0.0, 0.0, 1.0], \
+         radius = 0.003 }\n[[crack]]\npenny = { center = [0.012, 0.01, 0.01], \
+         normal = [0.0, 0.0, 1.0], radius = 0.003 }\n",
+    );
+    assert_error(&e, "crack[1]", Some(21), "meets crack `a` (its triangle");
     let src = Source::parse("ok.toml", &text_3d(&pennies(0.0145)), &[]).unwrap();
     assert!(
         fissure::scenario::build::<fissure::dim::D3>(&src).is_ok(),

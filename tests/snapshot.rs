@@ -22,7 +22,8 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// The mixed scene with a probe, a history row every step, VTK frames and checkpoints.
+/// The mixed scene with two probes (a velocity and the clamp's reaction), a history row
+/// every step, VTK frames and checkpoints.
 fn scene(dim: usize, shape: &str, update: &str) -> String {
     let v = |a: f64, b: f64| common::v(dim, a, b);
     format!(
@@ -31,6 +32,11 @@ fn scene(dim: usize, shape: &str, update: &str) -> String {
 name = "box_vx"
 region = {{ min = {}, max = {} }}
 quantity = "velocity"
+component = "x"
+[[probe]]
+name = "clamp"
+region = {{ min = {}, max = {} }}
+quantity = "reaction"
 component = "x"
 [output]
 history_interval = 1e-8
@@ -41,7 +47,9 @@ keep = 3
 "#,
         mixed_scene(dim, shape, update),
         v(0.002, 0.002),
-        v(0.04, 0.012)
+        v(0.04, 0.012),
+        v(0.0, 0.0),
+        v(0.003, if dim == 2 { 0.032 } else { 0.016 }),
     )
 }
 
@@ -162,7 +170,7 @@ fn restart_is_bit_exact_with_plastic_state() {
 #[test]
 fn restart_is_bit_exact_with_a_crack() {
     let crack = "[[crack]]\nline = { start = [0.02, 0.0005], end = [0.02, 0.0135], spacing = 5e-4 }\ntips = []\n";
-    let text = scene(2, "ugimp", "usavg").replace("[[probe]]", &format!("{crack}[[probe]]"));
+    let text = scene(2, "ugimp", "usavg").replacen("[[probe]]", &format!("{crack}[[probe]]"), 1);
     restart_is_bit_exact(&text, 29, 2, "crack");
 }
 
@@ -170,7 +178,7 @@ fn restart_is_bit_exact_with_a_crack() {
 fn restart_is_bit_exact_with_j_on_two_contours() {
     let crack = "[[crack]]\nline = { start = [0.02, 0.0005], end = [0.02, 0.0071], spacing = 5e-4 }\n\
                  tips = [\"end\"]\n[fracture]\ncontour = 2\ncompare = [3]\n";
-    let text = scene(2, "ugimp", "usavg").replace("[[probe]]", &format!("{crack}[[probe]]"));
+    let text = scene(2, "ugimp", "usavg").replacen("[[probe]]", &format!("{crack}[[probe]]"), 1);
     let dir = scratch("paths-exist");
     let out = run(&source(&text), &opts(&dir, 1)).unwrap();
     assert!(!out.history.paths.is_empty() && dir.join("paths.csv").exists());
@@ -196,7 +204,7 @@ fn restart_is_bit_exact_with_a_3d_crack() {
                  compare = [3]\n";
     let text = scene(3, "ugimp", "usavg")
         .replace("duration = 1e-5", "duration = 4e-6")
-        .replace("[[probe]]", &format!("{crack}[[probe]]"));
+        .replacen("[[probe]]", &format!("{crack}[[probe]]"), 1);
     let dir = scratch("3d-paths");
     let h = run(&source(&text), &opts(&dir, 1)).unwrap().history;
     assert_eq!(
@@ -234,7 +242,7 @@ fn restart_is_bit_exact_with_a_3d_crack() {
 fn collections_after_a_resume_elsewhere_point_to_existing_frames() {
     let dir = scratch("elsewhere");
     let crack = "[[crack]]\nline = { start = [0.02, 0.0005], end = [0.02, 0.0135], spacing = 5e-4 }\ntips = []\n";
-    let text = scene(2, "ugimp", "usavg").replace("[[probe]]", &format!("{crack}[[probe]]"));
+    let text = scene(2, "ugimp", "usavg").replacen("[[probe]]", &format!("{crack}[[probe]]"), 1);
     let src = source(&text);
     let part = run(
         &src,

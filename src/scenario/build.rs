@@ -497,13 +497,18 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         };
         if qty == ProbeQty::Reaction {
             let supports = supports::<D>(src, &key, &p.region, &bcs, &geom, comp)?;
+            let mut centre = [0.0; 3];
+            for &(b, k) in &supports {
+                let x = D::to_xyz(geom.node_position(bcs[b as usize].nodes[k as usize] as usize));
+                (0..3).for_each(|a| centre[a] += x[a] / supports.len() as f64);
+            }
             probes.push(Probe {
                 name: p.name.clone(),
                 particles: Vec::new(),
                 supports,
                 qty,
                 comp,
-                centre: [0.0; 3],
+                centre,
             });
             continue;
         }

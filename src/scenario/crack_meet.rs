@@ -24,13 +24,27 @@ fn edge_crosses<D: Dim>(va: &[D::Vec], a: &D::Elem, vb: &[D::Vec], b: D::Elem) -
         .any(|&[p, q]| D::crossing(va[p as usize], va[q as usize], vb, b) != 0)
 }
 
-/// The first crack of `store` that the new crack of `points` and `elems` meets, with the
-/// indices of the two elements that meet (the new crack's, then the other's within its
-/// crack), in index order.
+/// Whether element `a` (vertices `va`) touches element `b` (vertices `vb`) within `tol`
+/// (m): a vertex of `a` on `b`, or an edge of `a` on a boundary feature of `b` (in 2D one
+/// of `b`'s ends on `a`). It catches what the crossing predicates pass over: elements that
+/// overlap on one line (2D) or plane (3D).
+fn touches<D: Dim>(va: &[D::Vec], a: &D::Elem, vb: &[D::Vec], b: D::Elem, tol: f64) -> bool {
+    let features = b.vertices().len();
+    (a.vertices().iter()).any(|&p| D::elem_distance(va[p as usize], vb, b) <= tol)
+        || edges::<D>(a).iter().any(|&[p, q]| {
+            (0..features)
+                .any(|k| D::feature_distance(va[p as usize], va[q as usize], vb, b, k) <= tol)
+        })
+}
+
+/// The first crack of `store` that the new crack of `points` and `elems` meets (crosses,
+/// or comes within `tol` m of), with the indices of the two elements that meet (the new
+/// crack's, then the other's within its crack), in index order.
 pub(super) fn meets<D: Dim>(
     store: &Cracks<D>,
     points: &[D::Vec],
     elems: &[D::Elem],
+    tol: f64,
 ) -> Option<(usize, usize, usize)> {
     let topo = &store.topology;
     let vx = &store.geometry.x;
@@ -59,7 +73,9 @@ pub(super) fn meets<D: Dim>(
                 let (bb, ib, eb) = &theirs[j];
                 if overlap(ba, bb)
                     && (edge_crosses::<D>(points, ea, vx, *eb)
-                        || edge_crosses::<D>(vx, eb, points, *ea))
+                        || edge_crosses::<D>(vx, eb, points, *ea)
+                        || touches::<D>(points, ea, vx, *eb, tol)
+                        || touches::<D>(vx, eb, points, *ea, tol))
                     && found.is_none_or(|f| (ia, *ib) < f)
                 {
                     found = Some((ia, *ib));

@@ -109,7 +109,7 @@ pub(super) fn build<D: Dim>(
             ));
         }
         if let Some((k, mine, theirs)) =
-            super::crack_meet::meets(&store, &piece.points, &piece.elems)
+            super::crack_meet::meets(&store, &piece.points, &piece.elems, 1e-6 * geom.min_cell())
         {
             let what = if D::D == 2 { "segment" } else { "triangle" };
             return Err(src.error(
