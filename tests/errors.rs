@@ -464,6 +464,15 @@ fn bad_crack_surfaces_name_the_problem() {
         "[0, 1, 2]",
     );
     assert_error(&e, "crack[0].mesh", Some(19), "no area");
+    // Two triangles sharing no vertex: one through the other, then one lying over the other.
+    let apart = "[0.006, 0.006, 0.01], [0.014, 0.006, 0.01], [0.006, 0.014, 0.01], \
+                 [0.008, 0.008, 0.006], [0.008, 0.008, 0.014], [0.012, 0.012, 0.01]";
+    let e = mesh(apart, "[0, 1, 2], [3, 4, 5]");
+    assert_error(&e, "crack[0]", Some(18), "meets itself (triangles 0 and 1");
+    let over = "[0.006, 0.006, 0.01], [0.014, 0.006, 0.01], [0.006, 0.014, 0.01], \
+                [0.008, 0.008, 0.01], [0.013, 0.008, 0.01], [0.008, 0.013, 0.01]";
+    let e = mesh(over, "[0, 1, 2], [3, 4, 5]");
+    assert_error(&e, "crack[0]", Some(18), "meets itself (triangles 0 and 1");
     let e = mesh(square, "[0, 1, 7]");
     assert_error(
         &e,
@@ -526,7 +535,12 @@ fn crossing_cracks_are_refused() {
         "[[crack]]\nname = \"a\"\nline = { start = [0.006, 0.01], end = [0.012, 0.01] }\n\
          [[crack]]\nline = { start = [0.009, 0.01], end = [0.014, 0.01] }\n",
     );
-    assert_error(&e, "crack[1].line", Some(22), "meets crack `a` (its segment 0");
+    assert_error(
+        &e,
+        "crack[1].line",
+        Some(22),
+        "meets crack `a` (its segment 0",
+    );
     let e = error_3d(
         "[[crack]]\nname = \"a\"\npenny = { center = [0.01, 0.01, 0.01], normal = [0.0, 0.0, 1.0], \
          radius = 0.003 }\n[[crack]]\npenny = { center = [0.012, 0.01, 0.01], \

@@ -1,6 +1,6 @@
-//! Whether a new crack meets one already in the store. Cracks must not cross or touch:
-//! each crack splits the velocity field on its own, so where two meet a node's fields
-//! would be ambiguous.
+//! Whether a new crack meets one already in the store, or a surface meets itself. Cracks
+//! must not cross or touch: each crack splits the velocity field on its own, so where two
+//! meet a node's fields would be ambiguous.
 
 use crate::crack::{Bounds, Cracks, Element, bounds, overlap};
 use crate::dim::Dim;
@@ -90,4 +90,40 @@ pub(super) fn meets<D: Dim>(
         }
     }
     None
+}
+
+/// The first pair of elements of one crack (`points`, `elems`) sharing no vertex that cross
+/// or come within `tol` m of each other, in index order: a surface that passes through or
+/// lies over itself. Boxes are swept along x, so a surface whose elements keep apart costs
+/// about its element count.
+pub(super) fn self_meets<D: Dim>(
+    points: &[D::Vec],
+    elems: &[D::Elem],
+    tol: f64,
+) -> Option<(usize, usize)> {
+    let boxes: Vec<Bounds> = elems.iter().map(|e| bounds::<D>(points, e)).collect();
+    let mut order: Vec<usize> = (0..elems.len()).collect();
+    order.sort_by(|&i, &j| boxes[i].0[0].total_cmp(&boxes[j].0[0]));
+    let mut found: Option<(usize, usize)> = None;
+    for (k, &i) in order.iter().enumerate() {
+        for &j in &order[k + 1..] {
+            if boxes[j].0[0] > boxes[i].1[0] {
+                break;
+            }
+            let (a, b) = (&elems[i], elems[j]);
+            let shared = (a.vertices().iter()).any(|v| b.vertices().contains(v));
+            let pair = (i.min(j), i.max(j));
+            if !shared
+                && overlap(&boxes[i], &boxes[j])
+                && found.is_none_or(|f| pair < f)
+                && (edge_crosses::<D>(points, a, points, b)
+                    || edge_crosses::<D>(points, &b, points, *a)
+                    || touches::<D>(points, a, points, b, tol)
+                    || touches::<D>(points, &b, points, *a, tol))
+            {
+                found = Some(pair);
+            }
+        }
+    }
+    found
 }

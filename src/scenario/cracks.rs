@@ -50,7 +50,7 @@ pub(super) fn build<D: Dim>(
             polyline::<D>(src, c, spec, geom)?
         } else {
             let s = surface::surface(src, c, spec, geom.min_cell())?;
-            Piece {
+            let piece = Piece {
                 key: format!("crack[{c}]"),
                 points: s
                     .vertices
@@ -67,7 +67,20 @@ pub(super) fn build<D: Dim>(
                 } else {
                     vec![(0, s.front)]
                 },
+            };
+            let tol = 1e-6 * geom.min_cell();
+            if let Some((a, b)) =
+                super::crack_meet::self_meets::<D>(&piece.points, &piece.elems, tol)
+            {
+                return Err(src.error(
+                    &piece.key,
+                    format!(
+                        "the surface meets itself (triangles {a} and {b}, which share no \
+                         vertex, cross or touch)"
+                    ),
+                ));
             }
+            piece
         };
         // Every vertex lies in the grid and every front vertex in a body; the rest may
         // overhang a body's edge by any length (a crack that cuts through it), so that a
