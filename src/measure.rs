@@ -583,8 +583,9 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
     }
 }
 
-/// How far the energy balance E = K + W + W_p - W_ext + W_damp strays from its start: the
-/// largest |E(t) - E(0)| over the largest of K + W + W_p, |W_ext| and W_damp in the run.
+/// How far the energy balance E = K + W + W_p - W_ext + W_damp + W_f strays from its start:
+/// the largest |E(t) - E(0)| over the largest of K + W + W_p, |W_ext|, W_damp and W_f in the
+/// run.
 pub fn energy_balance(h: &History) -> Option<f64> {
     let drift = balance_drift(h)?;
     // NaN (a run with no energy at all) stays NaN, as a failed measurement.
@@ -607,6 +608,7 @@ pub fn balance_drift(h: &History) -> Option<Vec<(f64, f64)>> {
             (e.internal())
                 .max(e.external_work.abs())
                 .max(e.damping_work)
+                .max(e.friction_work)
         })
         .fold(0.0, f64::max);
     Some(

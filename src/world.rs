@@ -57,6 +57,8 @@ pub struct Work {
     pub external: f64,
     /// Energy removed by damping.
     pub damping: f64,
+    /// Energy dissipated by Coulomb friction on crack faces.
+    pub friction: f64,
 }
 
 /// One row of energy.csv (J).
@@ -72,6 +74,8 @@ pub struct Energies {
     pub damping_work: f64,
     /// Energy dissipated by plastic flow (zero in an elastic scene).
     pub plastic_work: f64,
+    /// Energy dissipated by friction on crack faces (zero without a friction law).
+    pub friction_work: f64,
 }
 
 impl Energies {
@@ -80,9 +84,10 @@ impl Energies {
         self.kinetic + self.strain + self.plastic_work
     }
 
-    /// The balance E = K + W + W_p - W_ext + W_damp, constant when energy is conserved.
+    /// The balance E = K + W + W_p - W_ext + W_damp + W_f, constant when energy is
+    /// conserved.
     pub fn balance(&self) -> f64 {
-        self.internal() - self.external_work + self.damping_work
+        self.internal() - self.external_work + self.damping_work + self.friction_work
     }
 }
 
@@ -142,6 +147,7 @@ impl<D: Dim> World<D> {
             plastic_work: sum(2),
             external_work: self.work.external,
             damping_work: self.work.damping,
+            friction_work: self.work.friction,
         }
     }
 

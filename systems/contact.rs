@@ -2,7 +2,8 @@
 //! (Guo & Nairn 3D (2006) Appendix B). Contact is detected where the nodal displacements of
 //! the two fields overlap along the crack normal (Eq. 69), optionally only while the faces
 //! approach (Eq. 70); the law's momentum change goes to the field above and its negative to
-//! the field below, so momentum is conserved exactly.
+//! the field below, so momentum is conserved exactly. Coulomb friction's dissipation is
+//! booked as work.
 
 use crate::crack::{COLORS, Cracks, ElementBins, Law};
 use crate::dim::Dim;
@@ -129,6 +130,7 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
     }
     let h = D::to_xyz(g.geom.h);
     let cell = std::array::from_fn(|k| if k < D::D { h[k] } else { 1.0 });
+    let mut friction = 0.0;
     for (r, normal_r) in normals.iter_mut().enumerate() {
         let mask = f.mask[r];
         if mask.count_ones() != 1 {
@@ -175,6 +177,9 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
             continue;
         }
         let dp = contact.law.momentum_change::<D>(ma, va, mb, vb, nrm);
+        if let Law::Coulomb(_) = contact.law {
+            friction += friction_work::<D>(dp, va + dp * (1.0 / ma) - (vb - dp * (1.0 / mb)), nrm);
+        }
         if update {
             g.velocity[a] += dp * (1.0 / ma);
             g.accel[a] += dp * (1.0 / (ma * dt));
@@ -191,4 +196,18 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
     if !update {
         cracks.scratch.contact_dp = changes;
     }
+    world.work.friction += friction;
+}
+
+/// The energy friction dissipates at a contact row: its tangential impulse against the
+/// slip it leaves, -dp_t . v_t with `dp` the momentum change of the field above and `slip`
+/// the velocity of that field relative to the one below after the change (`n` the crack's
+/// normal). Zero while the faces stick (no slip left) and for frictionless faces (no
+/// tangential impulse). Merging the faces' tangential velocities is the grid's projection,
+/// which the particles do not lose (a stick law closes the energy balance without it);
+/// what friction takes is the force working through the slip that goes on.
+fn friction_work<D: Dim>(dp: D::Vec, slip: D::Vec, n: D::Vec) -> f64 {
+    let dp_t = dp - n * D::dot(dp, n);
+    let slip_t = slip - n * D::dot(slip, n);
+    -D::dot(dp_t, slip_t)
 }

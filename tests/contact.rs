@@ -1,6 +1,7 @@
 //! Crack-face contact: the laws' momentum changes, a closed crack under compression
 //! transmitting load like the uncracked body, frictionless sliding, stick, and Coulomb
-//! friction bounded by mu times the normal impulse; momentum conserved throughout.
+//! friction bounded by mu times the normal impulse, its dissipation closing the energy
+//! balance; momentum conserved throughout.
 
 mod common;
 use common::final_world;
@@ -192,4 +193,26 @@ fn sliding_faces_obey_their_contact_law() {
         "sliding: |dPt| {dt} = mu |dPn| {}",
         mu * dn
     );
+}
+
+/// The same halves under Coulomb friction: the energy friction dissipates (its tangential
+/// impulse against the slip left) is booked, and with it the energy balance closes as it
+/// does without friction; left out, the balance would be short by what friction took.
+#[test]
+fn friction_work_closes_the_energy_balance() {
+    let text = |law: &str| {
+        scene(law, true, 1.0, 0.2).replace("duration = 2e-6", "duration = 6e-6\ndamping = 0.0")
+    };
+    let h = common::history(&text("{ law = \"friction\", friction = 0.3 }"));
+    let last = h.rows.last().unwrap().energies;
+    let start = h.rows[0].energies.kinetic;
+    assert!(last.friction_work > 0.05 * start, "friction took {last:?}");
+    let drift = fissure::measure::energy_balance(&h).unwrap();
+    let free = fissure::measure::energy_balance(&common::history(&text(
+        "{ law = \"frictionless\" }",
+    )))
+    .unwrap();
+    // Friction's balance within twice the frictionless one's, and far inside what it took.
+    assert!(drift <= 2.0 * free.max(1e-3), "{drift} vs frictionless {free}");
+    assert!(drift < 0.2 * last.friction_work / start, "{drift}");
 }

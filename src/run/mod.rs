@@ -786,10 +786,16 @@ fn plot_energies(path: &Path, name: &str, h: &History) -> Result<(), String> {
             points: pick(&|r| r.energies.plastic_work),
         });
     }
+    if h.rows.iter().any(|r| r.energies.friction_work != 0.0) {
+        energies.series.push(Series {
+            label: "friction work W_f",
+            points: pick(&|r| r.energies.friction_work),
+        });
+    }
     let balance = Panel {
         y_label: "balance drift (relative)",
         series: vec![Series {
-            label: "(K + W + W_p - W_ext + W_damp - E(0)) / largest energy or work",
+            label: "(K + W + W_p - W_ext + W_damp + W_f - E(0)) / largest energy or work",
             points: balance_drift(h).unwrap_or_default(),
         }],
     };

@@ -88,7 +88,7 @@ impl Writers {
         let mut energy = create("energy.csv")?;
         writeln!(
             energy,
-            "step,time,kinetic,strain,external_work,damping_work,plastic_work"
+            "step,time,kinetic,strain,external_work,damping_work,plastic_work,friction_work"
         )?;
         let mut probes = create("probes.csv")?;
         let names: String = probe_names.iter().map(|n| format!(",{n}")).collect();
@@ -158,14 +158,15 @@ impl Writers {
         let e = &row.energies;
         writeln!(
             self.energy,
-            "{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
+            "{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
             row.step,
             row.time,
             e.kinetic,
             e.strain,
             e.external_work,
             e.damping_work,
-            e.plastic_work
+            e.plastic_work,
+            e.friction_work
         )?;
         // Probes are sampled once per step from step 0, so the sample index is the step.
         let k = row.step as usize;

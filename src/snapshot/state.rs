@@ -58,7 +58,7 @@ fn path_data(p: &PathResult) -> [f64; PATH_WIDTH] {
     [p.time, p.line[0], p.line[1], p.area[0], p.area[1]]
 }
 
-fn row_from(step: u64, d: &[f64], plastic_work: f64) -> Row {
+fn row_from(step: u64, d: &[f64], plastic_work: f64, friction_work: f64) -> Row {
     Row {
         step,
         time: d[0],
@@ -68,6 +68,7 @@ fn row_from(step: u64, d: &[f64], plastic_work: f64) -> Row {
             external_work: d[3],
             damping_work: d[4],
             plastic_work,
+            friction_work,
         },
         momentum: [d[5], d[6], d[7]],
         momentum_scale: d[8],
@@ -88,11 +89,13 @@ pub fn write<D: Dim>(
     let poisson: Vec<f64> = m.iter().map(|m| m.poisson).collect();
     let density: Vec<f64> = m.iter().map(|m| m.density).collect();
     let run = [world.work.external, world.work.damping];
+    let friction = [world.work.friction];
     let cadence = [state.next_history, state.next_frame, state.next_checkpoint];
     let h = &state.history;
     let row_steps: Vec<u64> = h.rows.iter().map(|r| r.step).collect();
     let rows: Vec<f64> = h.rows.iter().flat_map(row_data).collect();
     let rows_plastic: Vec<f64> = h.rows.iter().map(|r| r.energies.plastic_work).collect();
+    let rows_friction: Vec<f64> = h.rows.iter().map(|r| r.energies.friction_work).collect();
     let tip_steps: Vec<u64> = h.fracture.iter().map(|t| t.step).collect();
     let tip_ids: Vec<u64> = h.fracture.iter().map(|t| tip_id(t.crack, t.tip)).collect();
     let tip_data: Vec<f64> = h.fracture.iter().flat_map(tip_data).collect();
@@ -157,6 +160,8 @@ pub fn write<D: Dim>(
     c.add("history.rows.step", &row_steps);
     c.add("history.rows.data", &rows);
     c.add("history.rows.plastic", &rows_plastic);
+    c.add("history.rows.friction", &rows_friction);
+    c.add("run.friction", &friction);
     let header = Header {
         dimension: D::D as u8,
         particles: p.len() as u64,
@@ -263,6 +268,10 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     let run: Vec<f64> = r.column("run.work", 2)?;
     w.work.external = run[0];
     w.work.damping = run[1];
+    // A snapshot from a build that did not book friction has none to resume.
+    if r.offset_of("run.friction").is_some() {
+        w.work.friction = r.column::<f64>("run.friction", 1)?[0];
+    }
     if let Some(cr) = &mut w.cracks {
         cr.topology = topology::read(r, &cr.topology)?;
         let nv = cr.topology.vertex_count();
@@ -308,9 +317,14 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     } else {
         vec![0.0; steps.len()]
     };
-    history.rows = (steps.iter().zip(&plastic))
+    let friction: Vec<f64> = if r.offset_of("history.rows.friction").is_some() {
+        r.column("history.rows.friction", steps.len())?
+    } else {
+        vec![0.0; steps.len()]
+    };
+    history.rows = (steps.iter().zip(plastic.iter().zip(&friction)))
         .zip(data.chunks_exact(ROW_WIDTH))
-        .map(|((&s, &wp), d)| row_from(s, d, wp))
+        .map(|((&s, (&wp, &wf)), d)| row_from(s, d, wp, wf))
         .collect();
     let tip_steps: Vec<u64> = r.column_any("history.fracture.step")?;
     let tip_ids: Vec<u64> = r.column("history.fracture.tip", tip_steps.len())?;
