@@ -146,3 +146,41 @@ fn holes_and_hollow_spheres() {
         "shell volume {vol} vs {want}"
     );
 }
+
+/// Where bodies overlap, the first listed keeps the points: two overlapping 40 x 40 mm
+/// squares fill their union (2,800 mm^2) once; a 10 mm disc of a second material listed
+/// before a plate is an inclusion, the plate around it filling the rest (the plate's area
+/// in all, pi 10^2 mm^2 of it the disc's material, to the lattice's 1 %).
+#[test]
+fn overlapping_bodies_fill_their_union_once() {
+    let text = scene(
+        2,
+        0.001,
+        "box = { min = [0.01, 0.01], max = [0.05, 0.05] }\n[[body]]\nmaterial = \"m\"\n\
+         box = { min = [0.03, 0.03], max = [0.07, 0.07] }",
+    );
+    let w = build::<D2>(&source(&text)).unwrap().world;
+    let vol: f64 = w.particles.volume.iter().sum();
+    assert!((vol - 2.8e-3).abs() < 1e-12, "union area {vol}");
+    let inclusion = "[[material]]\nname = \"hard\"\nE = 2e11\nnu = 0.3\nrho = 8000.0\n[[body]]\n\
+                     material = \"hard\"\ndisc = { center = [0.05, 0.05], radius = 0.01 }\n";
+    let text = scene(2, 0.001, "box = { min = [0.02, 0.02], max = [0.08, 0.08] }")
+        .replace("[[body]]", &format!("{inclusion}[[body]]"));
+    let w = build::<D2>(&source(&text)).unwrap().world;
+    let p = &w.particles;
+    let of = |m: u16| -> f64 {
+        (0..p.len())
+            .filter(|&i| p.material[i] == m)
+            .map(|i| p.volume[i])
+            .sum()
+    };
+    let disc = std::f64::consts::PI * 1e-4;
+    let hard = w.materials.iter().position(|m| m.name == "hard").unwrap() as u16;
+    assert!(
+        (of(hard) - disc).abs() / disc < 0.01,
+        "disc {} vs {disc}",
+        of(hard)
+    );
+    let all: f64 = p.volume.iter().sum();
+    assert!((all - 3.6e-3).abs() < 1e-12, "plate {all}");
+}

@@ -208,11 +208,13 @@ fn friction_work_closes_the_energy_balance() {
     let start = h.rows[0].energies.kinetic;
     assert!(last.friction_work > 0.05 * start, "friction took {last:?}");
     let drift = fissure::measure::energy_balance(&h).unwrap();
-    let free = fissure::measure::energy_balance(&common::history(&text(
-        "{ law = \"frictionless\" }",
-    )))
-    .unwrap();
+    let free =
+        fissure::measure::energy_balance(&common::history(&text("{ law = \"frictionless\" }")))
+            .unwrap();
     // Friction's balance within twice the frictionless one's, and far inside what it took.
-    assert!(drift <= 2.0 * free.max(1e-3), "{drift} vs frictionless {free}");
+    assert!(
+        drift <= 2.0 * free.max(1e-3),
+        "{drift} vs frictionless {free}"
+    );
     assert!(drift < 0.2 * last.friction_work / start, "{drift}");
 }

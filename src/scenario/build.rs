@@ -1,5 +1,6 @@
 //! Building a World from a parsed scenario, validating every value on the way.
 
+use super::claim::Claim;
 use super::region::{Region, region};
 use super::schema::{AnchorSpec, BodySpec, BoxSpec, RegionSpec, RoundSpec};
 use super::source::Source;
@@ -274,6 +275,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     let mut used = vec![false; materials.len()];
     // Particles per cell per direction of each particle's body (for face tractions).
     let mut ppc = Vec::new();
+    let mut claims = Vec::new();
     for (b, body) in sc.bodies.iter().enumerate() {
         add_body::<D>(
             src,
@@ -285,6 +287,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             shape,
             thickness,
             &mut particles,
+            &mut claims,
         )?;
         ppc.resize(particles.len(), body.ppc as f64);
     }
@@ -1051,7 +1054,8 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
     Ok(Geometry::Polygon { points, z })
 }
 
-/// Fills body `b` with particles and appends them to the store.
+/// Fills body `b` with particles, less the points of the bodies before it (`claims`, to
+/// which it adds its own), and appends them to the store.
 #[allow(clippy::too_many_arguments)]
 fn add_body<D: Dim>(
     src: &Source,
@@ -1063,6 +1067,7 @@ fn add_body<D: Dim>(
     shape: ShapeKind,
     thickness: f64,
     particles: &mut Particles<D>,
+    claims: &mut Vec<Claim>,
 ) -> R<()> {
     let key = |k: &str| format!("body[{b}].{k}");
     let mat = materials
@@ -1096,10 +1101,14 @@ fn add_body<D: Dim>(
         ));
     }
     let mut pts = fill(&g, D::D, origin, h, geom.cells, body.ppc);
-    if let Some(clip) = &body.clip {
-        let clip = super::region::region::<D>(src, &key("clip"), clip)?;
+    let clip = match &body.clip {
+        Some(clip) => Some(super::region::region::<D>(src, &key("clip"), clip)?),
+        None => None,
+    };
+    if let Some(clip) = &clip {
         pts.retain(|x| clip.contains(*x, D::D, 0.0));
     }
+    let mut holes = Vec::new();
     for (k, hole) in body.holes.iter().enumerate() {
         let key = key(&format!("holes[{k}]"));
         let center = vec3::<D>(src, &format!("{key}.center"), &hole.center)?;
@@ -1111,12 +1120,19 @@ fn add_body<D: Dim>(
             ));
         }
         pts.retain(|x| (0..D::D).map(|a| (x[a] - center[a]).powi(2)).sum::<f64>() >= r * r);
+        holes.push((center, r));
+    }
+    let earlier: Vec<&Claim> = (claims.iter())
+        .filter(|c| c.reaches((lo, hi), D::D))
+        .collect();
+    if !earlier.is_empty() {
+        pts.retain(|x| !earlier.iter().any(|c| c.contains(*x, D::D)));
     }
     if pts.is_empty() {
         return Err(src.error(
             &format!("body[{b}]"),
-            "body contains no particle (is it smaller than a particle spacing, outside the grid, or \
-             clipped or cut away?)",
+            "body contains no particle (is it smaller than a particle spacing, outside the grid, \
+             clipped or cut away, or covered by the bodies listed before it?)",
         ));
     }
     let n = body.ppc as f64;
@@ -1175,5 +1191,11 @@ fn add_body<D: Dim>(
             particles.half.push(to_vec::<D>(half));
         }
     }
+    claims.push(Claim {
+        geometry: g,
+        clip,
+        holes,
+        bounds: (lo, hi),
+    });
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! World from them (`build::build`).
 
 pub mod build;
+mod claim;
 mod crack_meet;
 mod cracks;
 mod eta;
