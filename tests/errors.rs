@@ -181,6 +181,26 @@ fn empty_body() {
     assert_error(&e, "body[0].holes[0].inner_radius", None, "does not apply");
     let e = error_with(&["body[0].holes=[{ center = [0.01, 0.01], radius = 0.02 }]"]);
     assert_error(&e, "body[0]", None, "or cut away");
+    // A body inside the one listed before it has no points of its own.
+    let e = error_with_text(
+        "[[body]]\nmaterial = \"steel\"\nbox = { min = [0.006, 0.006], max = [0.01, 0.01] }\n",
+    );
+    assert_error(
+        &e,
+        "body[1]",
+        None,
+        "covered by the bodies listed before it",
+    );
+    let e = error_with_text(
+        "[[body]]\nmaterial = \"steel\"\npolygon = { points = [[0.002, 0.002], [0.018, 0.018], \
+         [0.018, 0.002], [0.002, 0.018]] }\n",
+    );
+    assert_error(
+        &e,
+        "body[1].polygon.points",
+        None,
+        "crosses itself: edges 0 and 2",
+    );
 }
 
 #[test]

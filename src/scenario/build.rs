@@ -1039,6 +1039,7 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
         }
         points.push([pt[0], pt[1]]);
     }
+    super::region::simple_polygon(src, &key("polygon.points"), &points)?;
     let z = match (&p.z, D::D) {
         (Some(z), 3) if z.len() == 2 && z[1] > z[0] => Some([z[0], z[1]]),
         (None, 2) => None,

@@ -241,31 +241,53 @@ fn polygon<D: Dim>(src: &Source, key: &str, points: &[Vec<f64>]) -> R<Region> {
         let c = vec3::<D>(src, &format!("{key}[{i}]"), v)?;
         p.push([c[0], c[1]]);
     }
-    let area: f64 = (0..p.len())
+    simple_polygon(src, key, &p)?;
+    Ok(Region::Polygon(p))
+}
+
+/// Refuses a polygon (region or body outline) of zero area or whose edges meet other than
+/// neighbours at their shared vertex; edges are swept along x, so an outline of many
+/// vertices costs about its edge count.
+pub(super) fn simple_polygon(src: &Source, key: &str, p: &[[f64; 2]]) -> R<()> {
+    let n = p.len();
+    let area: f64 = (0..n)
         .map(|k| {
-            let (a, b) = (p[k], p[(k + 1) % p.len()]);
+            let (a, b) = (p[k], p[(k + 1) % n]);
             a[0] * b[1] - a[1] * b[0]
         })
         .sum();
     if area == 0.0 || !area.is_finite() {
         return Err(src.error(key, "the polygon is degenerate (zero area)"));
     }
-    let n = p.len();
-    for i in 0..n {
-        for j in i + 1..n {
+    let x_range = |i: usize| {
+        let (a, b) = (p[i][0], p[(i + 1) % n][0]);
+        (a.min(b), a.max(b))
+    };
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&i, &j| x_range(i).0.total_cmp(&x_range(j).0));
+    let mut first: Option<(usize, usize)> = None;
+    for (k, &i) in order.iter().enumerate() {
+        for &j in &order[k + 1..] {
+            if x_range(j).0 > x_range(i).1 {
+                break;
+            }
+            let (i, j) = (i.min(j), i.max(j));
             // Neighbouring edges share a vertex; every other pair must not meet.
-            if j == i + 1 || (i == 0 && j == n - 1) {
+            if j == i + 1 || (i == 0 && j == n - 1) || first.is_some_and(|f| f <= (i, j)) {
                 continue;
             }
             if segments_meet(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]) {
-                return Err(src.error(
-                    key,
-                    format!("the polygon crosses itself: edges {i} and {j} meet"),
-                ));
+                first = Some((i, j));
             }
         }
     }
-    Ok(Region::Polygon(p))
+    match first {
+        Some((i, j)) => Err(src.error(
+            key,
+            format!("the polygon crosses itself: edges {i} and {j} meet"),
+        )),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
