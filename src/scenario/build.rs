@@ -499,12 +499,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             (Some(c), _) => axis_index::<D>(src, &key("component"), c)?,
         };
         if qty == ProbeQty::Reaction {
-            let supports = supports::<D>(src, &key, &p.region, &bcs, &geom, comp)?;
-            let mut centre = [0.0; 3];
-            for &(b, k) in &supports {
-                let x = D::to_xyz(geom.node_position(bcs[b as usize].nodes[k as usize] as usize));
-                (0..3).for_each(|a| centre[a] += x[a] / supports.len() as f64);
-            }
+            let (supports, centre) = supports::<D>(src, &key, &p.region, &bcs, &geom, comp)?;
             probes.push(Probe {
                 name: p.name.clone(),
                 particles: Vec::new(),
@@ -933,9 +928,12 @@ fn hole(src: &Source, key: &str, round: &RoundSpec) -> R<f64> {
     }
 }
 
-/// A reaction probe's nodes: every prescribed-velocity node inside `region` (within a
-/// millionth of a cell, as boundaries select them), as (boundary, place in its node list),
-/// refused when none of them prescribes component `comp`.
+/// A prescribed-velocity node: (its boundary, its place in that boundary's node list).
+type Support = (u32, u32);
+
+/// A reaction probe's nodes, with their centroid: every prescribed-velocity node inside
+/// `region` (within a millionth of a cell, as boundaries select them), as (boundary, place
+/// in its node list), refused when none of them prescribes component `comp`.
 fn supports<D: Dim>(
     src: &Source,
     key: &dyn Fn(&str) -> String,
@@ -943,7 +941,7 @@ fn supports<D: Dim>(
     bcs: &[VelocityBc<D>],
     geom: &GridGeom<D>,
     comp: usize,
-) -> R<Vec<(u32, u32)>> {
+) -> R<(Vec<Support>, [f64; 3])> {
     let r = region::<D>(src, &key("region"), spec)?;
     let tol = 1e-6 * (0..D::D).map(|a| geom.h[a]).fold(f64::INFINITY, f64::min);
     let mut supports = Vec::new();
@@ -961,7 +959,12 @@ fn supports<D: Dim>(
              its component",
         ));
     }
-    Ok(supports)
+    let mut centre = [0.0; 3];
+    for &(b, k) in &supports {
+        let x = D::to_xyz(geom.node_position(bcs[b as usize].nodes[k as usize] as usize));
+        (0..3).for_each(|a| centre[a] += x[a] / supports.len() as f64);
+    }
+    Ok((supports, centre))
 }
 
 /// The geometry of body `b`, from exactly one geometry key.
