@@ -296,6 +296,16 @@ fn bad_cracks_name_the_key() {
     assert_error(&e, "crack[0].line.end", None, "coincide");
     let e = error_with_text("[[crack]]\ntips = [\"end\"]\n");
     assert_error(&e, "crack[0]", None, "exactly one of");
+    // Names that would break the CSV files they head or fill.
+    let e = error_with_text(
+        "[[crack]]\nname = \"a\\\"b\"\nline = { start = [0.006, 0.01], end = [0.012, 0.01] }\n",
+    );
+    assert_error(&e, "crack[0].name", None, "without commas, double quotes");
+    let e = error_with_text(
+        "[[probe]]\nname = \"x,y\"\nregion = { min = [0.004, 0.004], max = [0.006, 0.006] }\n\
+         quantity = \"velocity\"\ncomponent = \"x\"\n",
+    );
+    assert_error(&e, "probe[0].name", None, "`x,y` names a column");
 }
 
 #[test]

@@ -139,6 +139,22 @@ fn check_name(src: &Source, name: &str) -> R<()> {
     }
 }
 
+/// Refuses a probe's or crack's name that would break the CSV files it heads or fills: an
+/// empty one, or one with a comma, a double quote or a control character.
+pub(super) fn csv_name(src: &Source, key: &str, name: &str) -> R<()> {
+    if name.is_empty() || name.contains([',', '"']) || name.chars().any(char::is_control) {
+        return Err(src.error(
+            key,
+            format!(
+                "`{}` names a column or rows of the CSV outputs: give a non-empty name without \
+                 commas, double quotes or control characters",
+                name.escape_debug()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 pub(super) fn positive(src: &Source, key: &str, v: f64, unit: &str) -> R<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
@@ -453,6 +469,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     let mut probes: Vec<Probe> = Vec::new();
     for (i, p) in sc.probes.iter().enumerate() {
         let key = |k: &str| format!("probe[{i}].{k}");
+        csv_name(src, &key("name"), &p.name)?;
         if probes.iter().any(|q| q.name == p.name) {
             return Err(src.error(&key("name"), format!("duplicate probe `{}`", p.name)));
         }

@@ -136,6 +136,7 @@ pub(super) fn build<D: Dim>(
         }
         let contact = contact(src, c, spec)?;
         let name = spec.name.clone().unwrap_or_else(|| format!("crack{c}"));
+        super::build::csv_name(src, &format!("crack[{c}].name"), &name)?;
         if store.topology.cracks().iter().any(|k| k.name == name) {
             return Err(src.error(
                 &format!("crack[{c}].name"),
