@@ -174,6 +174,18 @@ fn restart_is_bit_exact_with_a_crack() {
     restart_is_bit_exact(&text, 29, 2, "crack");
 }
 
+/// With a crack whose faces slide under friction: the friction work resumes too.
+#[test]
+fn restart_is_bit_exact_with_friction() {
+    let crack = "[[crack]]\nline = { start = [0.0025, 0.0075], end = [0.0395, 0.0075], \
+                 spacing = 5e-4 }\ntips = []\ncontact = { law = \"friction\", friction = 0.3 }\n";
+    let text = scene(2, "ugimp", "usavg").replacen("[[probe]]", &format!("{crack}[[probe]]"), 1);
+    let h = run(&source(&text), &RunOptions::default()).unwrap().history;
+    let took = h.rows.last().unwrap().energies.friction_work;
+    assert!(took > 0.0, "the faces slide under friction");
+    restart_is_bit_exact(&text, 29, 2, "friction");
+}
+
 #[test]
 fn restart_is_bit_exact_with_j_on_two_contours() {
     let crack = "[[crack]]\nline = { start = [0.02, 0.0005], end = [0.02, 0.0071], spacing = 5e-4 }\n\
