@@ -264,7 +264,8 @@ pub struct GrowthRow {
     pub x: [f64; 2],
     /// K_I and K_II read at this check (NaN when the check read none).
     pub k: [f64; 2],
-    /// The new segment's turn from the last one (rad, counterclockwise).
+    /// The new segment's turn from the last one (rad, counterclockwise); for a 3D front,
+    /// the largest turn of its vertices (rad, a magnitude).
     pub kink: f64,
     /// The new segment's direction (rad from x, counterclockwise).
     pub heading: f64,

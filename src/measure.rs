@@ -330,7 +330,8 @@ pub enum Measure {
 /// What a growth expect reads from a tip's growth rows.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum GrowthQty {
-    /// The first new segment's turn from the crack's last segment (degrees).
+    /// The first new segment's turn from the crack's last segment (degrees); along a 3D
+    /// front, its largest turn at the first check.
     Kink,
     /// The path's line over the last quarter of the length grown (the chord between the
     /// tip positions there, smoother than one segment), as an angle to x in (-90, 90]

@@ -1,18 +1,20 @@
-//! `grow` in 3D: advances growing crack fronts in their own plane. At a check each front
-//! vertex reads K_I, K_II and J from the front measurement, and its criterion (the hoop
-//! stress reaching K_Ic, J reaching G_c, or a set time) says whether it advances; under a
-//! Paris law every vertex advances by its share of the fastest rate (Belytschko et al.
-//! 1995, Eqs. 38-40, vertex by vertex), the shares smoothed along the front so that the
-//! scatter of K between neighbours does not roughen it. A vertex advances along its
-//! frame's x1 axis (normal to the front, in the crack surface); the band it leaves behind
-//! becomes a strip of new triangles. A front stops as a whole where a vertex would leave
-//! the body or come within a quarter cell of another crack.
+//! `grow` in 3D: advances growing crack fronts. At a check each front vertex reads K_I,
+//! K_II and J from the front measurement, and its criterion (the hoop stress reaching K_Ic,
+//! J reaching G_c, or a set time) says whether it advances; under a Paris law every vertex
+//! advances by its share of the fastest rate (Belytschko et al. 1995, Eqs. 38-40, vertex by
+//! vertex), the shares smoothed along the front so that the scatter of K between
+//! neighbours does not roughen it. A vertex advances along its frame's x1 axis (normal to
+//! the front, in the crack surface) or, under the hoop direction, turned from it towards
+//! x2 by the angle of the largest hoop stress of its K_I and K_II (Erdogan & Sih 1963;
+//! K_III does not turn it), smoothed along the front the same way; the band it leaves
+//! behind becomes a strip of new triangles. A front stops as a whole where a vertex would
+//! leave the body or come within a quarter cell of another crack.
 
 use crate::dim::D3;
 use crate::error::Unstable;
 use crate::fracture::{FracturePlan, TipResult};
 use crate::front::front_line;
-use crate::growth::{Growth, GrowthRow, Initiation, Stopped, hoop_angle, hoop_k};
+use crate::growth::{Direction, Growth, GrowthRow, Initiation, Stopped, hoop_angle, hoop_k};
 use crate::shape::ShapeKind;
 use crate::systems::{fracture_front, grow::inside};
 use crate::world::World;
@@ -115,10 +117,27 @@ fn advance(
             (smooth(&on, line.closed), [f64::NAN; 2])
         }
     };
+    // Each vertex's turn from x1 towards x2: the hoop angle of its K (none where K was not
+    // read), smoothed along the front.
+    let turn = match g.direction {
+        Direction::Hoop => {
+            let raw: Vec<f64> = (0..n)
+                .map(|i| {
+                    let [k1, k2, _] = reading(i);
+                    let t = hoop_angle(k1, k2);
+                    if t.is_finite() { t } else { 0.0 }
+                })
+                .collect();
+            smooth(&raw, line.closed)
+        }
+        Direction::Straight => vec![0.0; n],
+    };
     let h = (0..3).map(|a| world.grid.geom.h[a]).fold(0.0, f64::max);
     let ds: Vec<f64> = share.iter().map(|s| s * g.extension).collect();
-    let to: Vec<Option<DVec3>> = (line.frames.iter().zip(&ds))
-        .map(|(fr, &d)| (d >= 0.01 * h).then(|| fr.x + fr.e[0] * d))
+    let to: Vec<Option<DVec3>> = (line.frames.iter().zip(&ds).zip(&turn))
+        .map(|((fr, &d), &t)| {
+            (d >= 0.01 * h).then(|| fr.x + (fr.e[0] * t.cos() + fr.e[1] * t.sin()) * d)
+        })
         .collect();
     let c = front.crack as usize;
     let name = &cracks.topology.cracks()[c].name;
@@ -153,6 +172,11 @@ fn advance(
             [0, 1].map(|m| mean(&r.iter().map(|t| t.k[m]).collect::<Vec<_>>()))
         });
         let centre = line.frames.iter().map(|fr| fr.x).sum::<DVec3>() / n as f64;
+        // The front's largest turn among the vertices that moved, as a magnitude (a front
+        // under mode II turns both ways, where K_II changes sign along it).
+        let kink = (to.iter().zip(&turn))
+            .filter(|(t, _)| t.is_some())
+            .fold(0.0, |m: f64, (_, a)| m.max(a.abs()));
         let row = GrowthRow {
             step: world.step,
             time: world.time,
@@ -161,7 +185,7 @@ fn advance(
             grown: st.grown,
             x: [centre.x, centre.y],
             k,
-            kink: 0.0,
+            kink,
             heading: f64::NAN,
             fatigue,
         };

@@ -865,12 +865,12 @@ fn bad_growth_tables_name_the_key() {
          crack = \"crack0\"\nlength = 1e-3\nreference = 1.0\nsource = \"x\"\ntolerance = 0.1\n"
     ));
     assert_error(&e, "expect[0].quantity", None, "no `paris`");
-    // A 3D front grows in its plane, not by the hoop direction or at a set speed, and its
-    // cycles are the front's, not a tip's.
+    // A 3D front turns by the hoop stress only where K is measured, does not run at a set
+    // speed, and its cycles are the front's, not a tip's.
     let penny = "[[crack]]\npenny = { center = [0.01, 0.01, 0.01], normal = [0.0, 0.0, 1.0], \
                  radius = 0.003 }\n[crack.growth]\ninitiation = \"time\"\nat = 0.0\n";
     let e = error_3d(&format!("{penny}direction = \"hoop\"\n"));
-    assert_error(&e, "crack[0].growth.direction", None, "in its own plane");
+    assert_error(&e, "crack[0].growth", None, "add a [fracture] table");
     let e = error_3d(&format!("{penny}speed = 100.0\n"));
     assert_error(&e, "crack[0].growth.speed", None, "set speed");
     let e = error_3d(&format!(
@@ -880,7 +880,7 @@ fn bad_growth_tables_name_the_key() {
     ));
     assert_error(&e, "expect[0].tip", None, "along its front");
     let e = error_3d(&format!(
-        "{penny}[fracture]\ndomain = 2\n[[expect]]\nquantity = \"kink\"\ncrack = \"crack0\"\n\
+        "{penny}[fracture]\ndomain = 2\n[[expect]]\nquantity = \"path_angle\"\ncrack = \"crack0\"\n\
          reference = 1.0\nsource = \"x\"\ntolerance = 0.1\n"
     ));
     assert_error(&e, "expect[0].quantity", None, "2D tip");

@@ -7,7 +7,9 @@ mod common;
 use common::{PARIS_GROWTH, PENNY_FATIGUE, edge_plate, source};
 use fissure::dim::D3;
 use fissure::growth::GrowthRow;
-use fissure::run::{Outcome, RunOptions, run};
+use fissure::run::{Outcome, RunOptions, run, step_count};
+use fissure::scenario::build;
+use fissure::schedule::Schedule;
 use fissure::world::World;
 use glam::DVec3;
 
@@ -358,4 +360,65 @@ fn a_3d_front_grows_where_j_reaches_gc() {
     let out = run_with(&common::penny_block(&law(1.0e9), 7.2e3, 6.3e-6), 2);
     assert!(out.history.growth.is_empty());
     assert_eq!(out.summary.growth[0].started, None);
+}
+
+/// The world at the end of `text`'s run with the scene's fracture plan, so that growth
+/// reads K as the launcher's runs do.
+fn grown_world(text: &str) -> World<D3> {
+    let scene = build::<D3>(&source(text)).unwrap_or_else(|e| panic!("{e}"));
+    let mut world = scene.world;
+    let mut schedule = Schedule::for_world(&world, scene.fracture.clone());
+    let steps = step_count(scene.duration, world.settings.dt);
+    while world.step < steps {
+        schedule.step(&mut world).unwrap_or_else(|e| panic!("{e}"));
+    }
+    world
+}
+
+/// Under the hoop direction a 3D front turns by the hoop-stress angle of its own K_I and
+/// K_II. A penny normal to the load (half a cell off the node plane; no K_II) keeps its
+/// plane, to a hundredth of the extension. Tilted 45 degrees, the front turns most where
+/// K_II is largest, by about the 55.5 degrees of the infinite body's K_II / K_I there (this
+/// small, coarse block reads within 5 degrees), and towards the plane normal to the load:
+/// the vertex that lay along (-1, 1, 0), where K_II is largest, moves within 20 degrees of
+/// the horizontal (straight on it would climb at the crack's 45).
+#[test]
+fn a_3d_front_turns_by_the_hoop_stress() {
+    let growth = "initiation = \"time\"\nat = 3.5e-6\ndirection = \"hoop\"\nextension = 2.5e-4\n\
+                  interval = 1.0e-6";
+    let text = common::penny_block(growth, 7.2e3, 4.3e-6);
+    let flat = text.replace(
+        "center = [0.006, 0.006, 0.006]",
+        "center = [0.006, 0.0065, 0.006]",
+    );
+    let row = run_with(&flat, 2).history.growth[0];
+    assert!(row.k[0] > 0.0 && row.kink.to_degrees() < 1.0, "{row:?}");
+    let world = grown_world(&flat);
+    let cracks = world.cracks.as_ref().unwrap();
+    for &v in &cracks.topology.fronts()[0].vertices {
+        let y = cracks.geometry.x[v as usize].y;
+        assert!(
+            (y - 0.0065).abs() < 2.5e-6,
+            "a vertex left the plane: y = {y}"
+        );
+    }
+    let tilted = text.replace("normal = [0.0, 1.0, 0.0]", "normal = [1.0, 1.0, 0.0]");
+    let out = run_with(&tilted, 2);
+    let kink = out.history.growth[0].kink.to_degrees();
+    assert!((kink - 55.5).abs() < 5.0, "largest turn {kink} degrees");
+    // The front keeps its vertices: follow the one along (-1, 1, 0) over the check.
+    let along = DVec3::new(-1.0, 1.0, 0.0).normalize();
+    let before = grown_world(&tilted.replace("duration = 4.3e-6", "duration = 3.9e-6"));
+    let c = before.cracks.as_ref().unwrap();
+    let offset = |v: u32| (c.geometry.x[v as usize] - DVec3::splat(0.006)).dot(along);
+    let v = (c.topology.fronts()[0].vertices.iter().copied())
+        .max_by(|&a, &b| offset(a).total_cmp(&offset(b)))
+        .unwrap() as usize;
+    let after = grown_world(&tilted);
+    let moved = after.cracks.as_ref().unwrap().geometry.x[v] - c.geometry.x[v];
+    let slope = (moved.y / moved.x.hypot(moved.z)).atan().to_degrees();
+    assert!(
+        slope.abs() < 20.0,
+        "the turn closes towards the horizontal: {moved}"
+    );
 }

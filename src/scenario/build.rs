@@ -651,7 +651,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
                 src, i, e, &ids, &materials, plane, thickness,
             )?),
             _ if ["kink", "path_angle", "turn", "cycles"].contains(&e.quantity.as_str()) => {
-                if D::D == 3 && e.quantity != "cycles" {
+                if D::D == 3 && !["cycles", "kink"].contains(&e.quantity.as_str()) {
                     return Err(src.error(
                         &key("quantity"),
                         format!("`{}` follows a growing 2D tip", e.quantity),

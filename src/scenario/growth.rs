@@ -43,15 +43,10 @@ pub(super) fn growth<D: Dim>(
         return Err(src.error(&format!("crack[{c}].growth"), why));
     }
     let initiation = initiation(src, c, g)?;
-    // A 3D front grows in its own plane; a 2D tip turns by the hoop stress unless told.
+    // A 3D front grows in its own plane unless told; a 2D tip turns by the hoop stress
+    // unless told.
     let planar = D::D == 3;
     let direction = match g.direction.as_deref() {
-        Some("hoop") if planar => {
-            return Err(src.error(
-                &key("direction"),
-                "a 3D front grows in its own plane: direction = \"straight\" (the default in 3D)",
-            ));
-        }
         Some("hoop") => Direction::Hoop,
         Some("straight") => Direction::Straight,
         None if planar => Direction::Straight,

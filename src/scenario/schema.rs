@@ -648,7 +648,8 @@ pub struct ExpectSpec {
     /// vertex `near` a point, last row); for a growing 2D tip kink (its first turn,
     /// degrees), path_angle (its line over the last quarter of the length grown, to x, degrees in
     /// (-90, 90]), turn (the chord from the tip's start to its last new vertex, as a turn
-    /// from the crack, degrees) and cycles (fatigue: load cycles to grow by `length`);
+    /// from the crack, degrees) and cycles (fatigue: load cycles to grow by `length`); for
+    /// a growing 3D front kink (its largest turn at the first check, degrees) and cycles;
     /// J_eta (|J| at a 2D tip against the `eta` estimate from a load and a displacement
     /// probe, relative).
     pub quantity: String,
