@@ -35,16 +35,16 @@ impl EtaEstimate {
             .sum();
         let largest = load.iter().fold(0.0, |m: f64, p| m.max(p.abs()));
         let window = FIT.0 * largest..=FIT.1 * largest;
-        let fitted = || {
-            load.iter()
-                .zip(displacement)
-                .filter(|(p, _)| window.contains(&p.abs()))
-        };
-        if fitted().count() < 2 || work == 0.0 || !work.is_finite() {
+        let (mut count, mut pd, mut pp) = (0, 0.0, 0.0);
+        for (p, d) in load.iter().zip(displacement) {
+            if window.contains(&p.abs()) {
+                (count, pd, pp) = (count + 1, pd + p * d, pp + p * p);
+            }
+        }
+        if count < 2 || work == 0.0 || !work.is_finite() {
             return None;
         }
-        let compliance =
-            fitted().map(|(p, d)| p * d).sum::<f64>() / fitted().map(|(p, _)| p * p).sum::<f64>();
+        let compliance = pd / pp;
         let p = *load.last()?;
         let plastic = (work - 0.5 * p * p * compliance) * work.signum();
         let k = self.k_per_load * p;

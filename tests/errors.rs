@@ -1064,7 +1064,12 @@ fn bad_reactions_and_eta_estimates_name_the_key() {
         "quantity = \"J_eta\"\nprobes = [\"load\", \"d\"]\n{}",
         eta.replace("1.9", "-1.9")
     ));
-    assert_error(&e, "expect[0].eta.factor", None, "must be > 0");
+    assert_error(
+        &e,
+        "expect[0].eta.factor",
+        None,
+        "must be a positive number",
+    );
     let e = expect(&format!(
         "quantity = \"J_eta\"\nprobes = [\"load\", \"d\"]\n{}",
         eta.replace("\"steel\"", "\"iron\"")

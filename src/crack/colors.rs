@@ -2,7 +2,7 @@
 //! scene may hold more cracks than a mask has bits for. Cracks that no particle's stencil
 //! can see at once may share a colour; with at most [`COLORS`] cracks each is its own.
 
-use super::{Bounds, Topology, bounds, overlap};
+use super::{Bounds, Topology, bounds, meeting_pairs};
 use crate::dim::Dim;
 
 /// Colours a mask has room for (two bits each in a `u64`).
@@ -44,21 +44,9 @@ pub fn colors<D: Dim>(topology: &Topology<D>, x: &[D::Vec], cell: f64) -> Result
             b.1[k] = b.1[k].max(hi[k] + g);
         }
     }
-    // The pairs of widened boxes that meet, by a sweep along x: each crack's earlier
-    // (lower-index) neighbours.
-    let mut by_x: Vec<usize> = (0..n).collect();
-    by_x.sort_by(|&a, &b| boxes[a].0[0].total_cmp(&boxes[b].0[0]).then(a.cmp(&b)));
+    // Each crack's earlier (lower-index) neighbours: the widened boxes that meet its own.
     let mut earlier: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (i, &a) in by_x.iter().enumerate() {
-        for &b in by_x[i + 1..]
-            .iter()
-            .take_while(|&&b| boxes[b].0[0] <= boxes[a].1[0])
-        {
-            if overlap(&boxes[a], &boxes[b]) {
-                earlier[a.max(b)].push(a.min(b));
-            }
-        }
-    }
+    meeting_pairs(&boxes, |a, b| earlier[b].push(a));
     let mut color = vec![0u8; n];
     for c in 0..n {
         let taken = (earlier[c].iter()).fold(0u64, |t, &d| t | 1 << color[d]);

@@ -17,7 +17,7 @@ mod topology;
 
 pub use bins::ElementBins;
 pub use colors::{COLORS, Crowded, colors};
-pub use element::{Bounds, Element, Segment, Triangle, bounds, overlap};
+pub use element::{Bounds, Element, Segment, Triangle, bounds, meeting_pairs, overlap};
 pub use fields::{Classified, Displacements, Fields, Links, Scratch, side_bit};
 pub use law::{Contact, Law};
 pub use node_lines::{NodeLine, on_node_lines};

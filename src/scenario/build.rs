@@ -155,6 +155,17 @@ pub(super) fn csv_name(src: &Source, key: &str, name: &str) -> R<()> {
     Ok(())
 }
 
+/// The index of the material called `name`, refused under `key` if there is none.
+pub(super) fn material_named(
+    src: &Source,
+    key: &str,
+    materials: &[Material],
+    name: &str,
+) -> R<usize> {
+    (materials.iter().position(|m| m.name == name))
+        .ok_or_else(|| src.error(key, format!("no [[material]] named `{name}`")))
+}
+
 pub(super) fn positive(src: &Source, key: &str, v: f64, unit: &str) -> R<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
@@ -1091,15 +1102,7 @@ fn add_body<D: Dim>(
     claims: &mut Vec<Claim>,
 ) -> R<()> {
     let key = |k: &str| format!("body[{b}].{k}");
-    let mat = materials
-        .iter()
-        .position(|m| m.name == body.material)
-        .ok_or_else(|| {
-            src.error(
-                &key("material"),
-                format!("no [[material]] named `{}`", body.material),
-            )
-        })?;
+    let mat = material_named(src, &key("material"), materials, &body.material)?;
     used[mat] = true;
     if !(1..=16).contains(&body.ppc) {
         return Err(src.error(

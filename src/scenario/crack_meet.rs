@@ -2,7 +2,7 @@
 //! must not cross or touch: each crack splits the velocity field on its own, so where two
 //! meet a node's fields would be ambiguous.
 
-use crate::crack::{Bounds, Cracks, Element, bounds, overlap};
+use crate::crack::{Bounds, Cracks, Element, bounds, meeting_pairs, overlap};
 use crate::dim::Dim;
 
 /// The edges of a crack element as vertex pairs: the segment itself in 2D, the three
@@ -94,36 +94,26 @@ pub(super) fn meets<D: Dim>(
 
 /// The first pair of elements of one crack (`points`, `elems`) sharing no vertex that cross
 /// or come within `tol` m of each other, in index order: a surface that passes through or
-/// lies over itself. Boxes are swept along x, so a surface whose elements keep apart costs
-/// about its element count.
+/// lies over itself. Only elements whose boxes meet are tried ([`meeting_pairs`]).
 pub(super) fn self_meets<D: Dim>(
     points: &[D::Vec],
     elems: &[D::Elem],
     tol: f64,
 ) -> Option<(usize, usize)> {
     let boxes: Vec<Bounds> = elems.iter().map(|e| bounds::<D>(points, e)).collect();
-    let mut order: Vec<usize> = (0..elems.len()).collect();
-    order.sort_by(|&i, &j| boxes[i].0[0].total_cmp(&boxes[j].0[0]));
     let mut found: Option<(usize, usize)> = None;
-    for (k, &i) in order.iter().enumerate() {
-        for &j in &order[k + 1..] {
-            if boxes[j].0[0] > boxes[i].1[0] {
-                break;
-            }
-            let (a, b) = (&elems[i], elems[j]);
-            let shared = (a.vertices().iter()).any(|v| b.vertices().contains(v));
-            let pair = (i.min(j), i.max(j));
-            if !shared
-                && overlap(&boxes[i], &boxes[j])
-                && found.is_none_or(|f| pair < f)
-                && (edge_crosses::<D>(points, a, points, b)
-                    || edge_crosses::<D>(points, &b, points, *a)
-                    || touches::<D>(points, a, points, b, tol)
-                    || touches::<D>(points, &b, points, *a, tol))
-            {
-                found = Some(pair);
-            }
+    meeting_pairs(&boxes, |i, j| {
+        let (a, b) = (&elems[i], elems[j]);
+        let shared = (a.vertices().iter()).any(|v| b.vertices().contains(v));
+        if !shared
+            && found.is_none_or(|f| (i, j) < f)
+            && (edge_crosses::<D>(points, a, points, b)
+                || edge_crosses::<D>(points, &b, points, *a)
+                || touches::<D>(points, a, points, b, tol)
+                || touches::<D>(points, &b, points, *a, tol))
+        {
+            found = Some((i, j));
         }
-    }
+    });
     found
 }

@@ -1,6 +1,7 @@
 //! The `J_eta` expect: a crack tip's J against the eta estimate from the scene's own
 //! load-displacement record (see [`crate::eta`]).
 
+use super::build::{material_named, positive};
 use super::cracks::expect_tip;
 use super::schema::ExpectSpec;
 use super::source::Source;
@@ -41,31 +42,17 @@ pub(super) fn eta_measure(
             "give the specimen's estimate: eta = { factor, ligament, K_per_load, material }",
         ));
     };
-    let positive = |k: &str, v: f64, unit: &str| {
-        if v.is_finite() && v > 0.0 {
-            Ok(v)
-        } else {
-            Err(src.error(&key(&format!("eta.{k}")), format!("must be > 0 ({unit})")))
-        }
-    };
-    let material = (materials.iter())
-        .find(|m| m.name == spec.material)
-        .ok_or_else(|| {
-            src.error(
-                &key("eta.material"),
-                format!("no [[material]] named `{}`", spec.material),
-            )
-        })?;
+    let material = material_named(src, &key("eta.material"), materials, &spec.material)?;
     Ok(Measure::JEta {
         crack,
         tip,
         load,
         displacement,
         estimate: EtaEstimate {
-            factor: positive("factor", spec.factor, "dimensionless")?,
-            ligament: positive("ligament", spec.ligament, "m")?,
-            k_per_load: positive("K_per_load", spec.k_per_load, "Pa sqrt(m) / N")?,
-            modulus: e_prime(material, plane),
+            factor: positive(src, &key("eta.factor"), spec.factor, "dimensionless")?,
+            ligament: positive(src, &key("eta.ligament"), spec.ligament, "m")?,
+            k_per_load: positive(src, &key("eta.K_per_load"), spec.k_per_load, "Pa sqrt(m)/N")?,
+            modulus: e_prime(&materials[material], plane),
             thickness,
         },
     })

@@ -5,6 +5,7 @@
 use super::build::vec3;
 use super::schema::RegionSpec;
 use super::source::Source;
+use crate::crack::{Bounds, meeting_pairs};
 use crate::dim::Dim;
 use crate::error::ScenarioError;
 
@@ -246,8 +247,8 @@ fn polygon<D: Dim>(src: &Source, key: &str, points: &[Vec<f64>]) -> R<Region> {
 }
 
 /// Refuses a polygon (region or body outline) of zero area or whose edges meet other than
-/// neighbours at their shared vertex; edges are swept along x, so an outline of many
-/// vertices costs about its edge count.
+/// neighbours at their shared vertex; only edges whose boxes meet are tried
+/// ([`meeting_pairs`]).
 pub(super) fn simple_polygon(src: &Source, key: &str, p: &[[f64; 2]]) -> R<()> {
     let n = p.len();
     let area: f64 = (0..n)
@@ -259,28 +260,24 @@ pub(super) fn simple_polygon(src: &Source, key: &str, p: &[[f64; 2]]) -> R<()> {
     if area == 0.0 || !area.is_finite() {
         return Err(src.error(key, "the polygon is degenerate (zero area)"));
     }
-    let x_range = |i: usize| {
-        let (a, b) = (p[i][0], p[(i + 1) % n][0]);
-        (a.min(b), a.max(b))
-    };
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&i, &j| x_range(i).0.total_cmp(&x_range(j).0));
+    let boxes: Vec<Bounds> = (0..n)
+        .map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % n]);
+            let lo = [a[0].min(b[0]), a[1].min(b[1]), 0.0];
+            (lo, [a[0].max(b[0]), a[1].max(b[1]), 0.0])
+        })
+        .collect();
     let mut first: Option<(usize, usize)> = None;
-    for (k, &i) in order.iter().enumerate() {
-        for &j in &order[k + 1..] {
-            if x_range(j).0 > x_range(i).1 {
-                break;
-            }
-            let (i, j) = (i.min(j), i.max(j));
-            // Neighbouring edges share a vertex; every other pair must not meet.
-            if j == i + 1 || (i == 0 && j == n - 1) || first.is_some_and(|f| f <= (i, j)) {
-                continue;
-            }
-            if segments_meet(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]) {
-                first = Some((i, j));
-            }
+    meeting_pairs(&boxes, |i, j| {
+        // Neighbouring edges share a vertex; every other pair must not meet.
+        let neighbours = j == i + 1 || (i == 0 && j == n - 1);
+        if !neighbours
+            && first.is_none_or(|f| (i, j) < f)
+            && segments_meet(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n])
+        {
+            first = Some((i, j));
         }
-    }
+    });
     match first {
         Some((i, j)) => Err(src.error(
             key,
