@@ -17,6 +17,7 @@ use fissure::dim::{D2, D3, Dim};
 use fissure::scenario::{Source, build};
 use fissure::schedule::Schedule;
 use fissure::sym::{Sym3, SymTensor};
+use fissure::systems::DimSystems;
 use fissure::systems::stress;
 use fissure::world::World;
 use std::time::Duration;
@@ -63,7 +64,7 @@ fn world<D: Dim>(label: &str, n: usize, plane: &str, variant: Variant) -> World<
     w
 }
 
-fn bench<D: Dim>(c: &mut Criterion, label: &str, n: usize, plane: &str) {
+fn bench<D: DimSystems>(c: &mut Criterion, label: &str, n: usize, plane: &str) {
     let mut g = c.benchmark_group(label);
     g.sample_size(10)
         .warm_up_time(Duration::from_millis(500))

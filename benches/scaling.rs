@@ -12,8 +12,9 @@
 mod common;
 
 use common::{SCENES, block};
-use fissure::dim::{D2, D3, Dim};
+use fissure::dim::{D2, D3};
 use fissure::schedule::Schedule;
+use fissure::systems::DimSystems;
 use rayon::prelude::*;
 use rayon::{ThreadPool, ThreadPoolBuilder};
 use std::hint::black_box;
@@ -60,7 +61,7 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// Measures one scene and prints its row.
-fn scene<D: Dim>(label: &str, n: usize, shape: &str, update: &str, pools: &[ThreadPool; 2]) {
+fn scene<D: DimSystems>(label: &str, n: usize, shape: &str, update: &str, pools: &[ThreadPool; 2]) {
     let mut world = block::<D>(label, n, shape, update);
     let mut schedule = Schedule::for_world(&world, None);
     let particles = world.particles.len() as f64;

@@ -10,12 +10,13 @@ mod common;
 
 use common::{SCENES, block};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use fissure::dim::{D2, D3, Dim};
+use fissure::dim::{D2, D3};
 use fissure::schedule::Schedule;
+use fissure::systems::DimSystems;
 use fissure::systems::{bin, g2p, grid_update, p2g, stress, stress_bin, stress_force};
 use std::time::{Duration, Instant};
 
-fn bench_scene<D: Dim>(c: &mut Criterion, label: &str, n: usize, shape: &str, update: &str) {
+fn bench_scene<D: DimSystems>(c: &mut Criterion, label: &str, n: usize, shape: &str, update: &str) {
     let mut world = block::<D>(label, n, shape, update);
     let mut schedule = Schedule::for_world(&world, None);
     schedule.step(&mut world).expect("stable");

@@ -150,7 +150,7 @@ fn other_crack_distance(cracks: &Cracks<D2>, tip: Tip) -> f64 {
         .enumerate()
         .filter(|(c, _)| *c != tip.crack)
         .flat_map(|(_, cr)| cr.vertices.windows(2))
-        .map(|w| point_segment::<D2>(x, at(w[0]), at(w[1])))
+        .map(|w| point_segment(x, at(w[0]), at(w[1])))
         .fold(f64::INFINITY, f64::min)
 }
 
@@ -311,7 +311,7 @@ pub(crate) fn near<D: Dim>(world: &World<D>, x: D::Vec, reach: f64) -> Vec<usize
 
 /// Distance from `x` to the segment `a`-`b` in the plane (m).
 fn seg_distance(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    point_segment::<D2>(DVec2::from(x), DVec2::from(a), DVec2::from(b))
+    point_segment(DVec2::from(x), DVec2::from(a), DVec2::from(b))
 }
 
 /// Particle `i`'s acceleration interpolated from its grid entries (its own crack side's

@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod bodies;
+pub mod columnar;
 pub mod crack;
 pub mod dim;
 pub mod disjoint;

@@ -4,6 +4,7 @@
 //! Eqs. 62-63); in plane stress the projected return of Simo & Taylor (Simo & Hughes 1998,
 //! Section 3.4.3).
 
+use crate::columnar::{Columnar, Scalar};
 use crate::sym::Sym3;
 use bytemuck::{Pod, Zeroable};
 use serde::Serialize;
@@ -48,6 +49,10 @@ pub struct Hardened {
     pub flow_stress: f64,
     /// Plastic work per unit volume, the integral of sigma_y d(eps_p) (J/m^3).
     pub work: f64,
+}
+
+impl Columnar for Hardened {
+    const SCALAR: Scalar = Scalar::F64;
 }
 
 /// Most iterations of a scalar solve (the Ramberg-Osgood return, the plane-stress return);

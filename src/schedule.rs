@@ -4,7 +4,8 @@ use crate::dim::Dim;
 use crate::error::Unstable;
 use crate::fracture::FracturePlan;
 use crate::systems::{
-    bin, classify, contact, crack_advect, g2p, grid_update, p2g, stress, stress_bin, stress_force,
+    DimSystems, bin, classify, contact, crack_advect, g2p, grid_update, grow, p2g, stress,
+    stress_bin, stress_force,
 };
 use crate::warm::with_warm_workers;
 use crate::world::{Update, World};
@@ -169,7 +170,7 @@ impl Schedule {
     }
 
     /// Advances the world one time step, measuring nothing.
-    pub fn step<D: Dim>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
+    pub fn step<D: DimSystems>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
         self.step_measuring(world, false)
     }
 
@@ -177,7 +178,7 @@ impl Schedule {
     /// at its end, and the closing stress update leaves the binning to the next step, so
     /// that the particles' stencils are still the step's own, matching the crack fields,
     /// as the J-integral reads them (the results are bitwise the same either way).
-    pub fn step_measuring<D: Dim>(
+    pub fn step_measuring<D: DimSystems>(
         &mut self,
         world: &mut World<D>,
         measure: bool,
@@ -189,7 +190,7 @@ impl Schedule {
     /// Advances the world one time step measuring nothing; with `keep_stencils` the
     /// closing stress update leaves the binning to the next step as on a measuring step
     /// (the results are bitwise the same either way, which the tests check).
-    pub fn step_keeping<D: Dim>(
+    pub fn step_keeping<D: DimSystems>(
         &mut self,
         world: &mut World<D>,
         keep_stencils: bool,
@@ -201,17 +202,14 @@ impl Schedule {
     /// the step's instructions apart from the run's outputs. The pool's other workers wait
     /// for work spinning through the step, not sleeping (`warm.rs`).
     #[inline(never)]
-    fn advance<D: Dim>(
+    fn advance<D: DimSystems>(
         &mut self,
         world: &mut World<D>,
         keep_stencils: bool,
         measure: bool,
     ) -> Result<(), Unstable> {
-        let growth = self.grows.then_some(D::GROWTH);
         // A step whose end a growing tip reads K at keeps its stencils, as a measured one.
-        let reads = growth
-            .as_ref()
-            .is_some_and(|g| (g.needs_k)(world, world.step + 1));
+        let reads = self.grows && grow::needs_k(world, world.step + 1);
         with_warm_workers(|| self.run_systems(world, keep_stencils || reads))?;
         world.step += 1;
         world.time = world.step as f64 * world.settings.dt;
@@ -220,9 +218,9 @@ impl Schedule {
         if measure {
             self.fracture_system(world);
         }
-        if let Some(g) = growth {
+        if self.grows {
             let t0 = Instant::now();
-            (g.run)(world, self.fracture.as_ref())?;
+            D::grow(world, self.fracture.as_ref())?;
             if let Some(k) = self.systems.iter().position(|s| *s == System::Grow) {
                 self.seconds[k] += t0.elapsed().as_secs_f64();
             }
@@ -233,7 +231,7 @@ impl Schedule {
     /// Measures J and K on the world as it stands (before the first step): bins the
     /// particles and classifies them near the cracks, as a step would, then runs the
     /// fracture system. Nothing to do without a fracture plan.
-    pub fn measure_now<D: Dim>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
+    pub fn measure_now<D: DimSystems>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
         if !self.measures() {
             return Ok(());
         }
@@ -244,10 +242,10 @@ impl Schedule {
     }
 
     /// Runs the fracture system, timing it under its schedule entry.
-    fn fracture_system<D: Dim>(&mut self, world: &mut World<D>) {
+    fn fracture_system<D: DimSystems>(&mut self, world: &mut World<D>) {
         if let Some(plan) = &self.fracture {
             let t0 = Instant::now();
-            D::FRACTURE(world, plan);
+            D::fracture(world, plan);
             if let Some(k) = self.systems.iter().position(|s| *s == System::Fracture) {
                 self.seconds[k] += t0.elapsed().as_secs_f64();
             }

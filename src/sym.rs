@@ -2,7 +2,7 @@
 //! stress column holds [`SymTensor`]s sized to the dimension ([`Sym2`] in 2D, four
 //! components, since yz and xz are zero in plane strain and plane stress).
 
-use crate::snapshot::Columnar;
+use crate::columnar::{Columnar, Scalar};
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 use std::fmt::Debug;
@@ -35,6 +35,10 @@ pub struct Sym2 {
     pub zz: f64,
     /// xy component.
     pub xy: f64,
+}
+
+impl Columnar for Sym2 {
+    const SCALAR: Scalar = Scalar::F64;
 }
 
 impl SymTensor for Sym2 {
@@ -87,6 +91,10 @@ pub struct Sym3 {
     pub xz: f64,
     /// xy component.
     pub xy: f64,
+}
+
+impl Columnar for Sym3 {
+    const SCALAR: Scalar = Scalar::F64;
 }
 
 impl Sym3 {

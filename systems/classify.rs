@@ -9,9 +9,10 @@
 //! longer holds (clearance used up, or a new stencil) until the skin itself is used up; the
 //! result is exactly that of a full pass.
 
-use crate::crack::{self, Classified, Cracks, Element, Fields, side_bit};
+use crate::crack::{self, Classified, Cracks, Fields, side_bit};
 use crate::dim::Dim;
 use crate::error::Unstable;
+use crate::geometry::Element;
 use crate::grid::GridGeom;
 use crate::shape::{ShapeKind, Stencil, StencilCache};
 use crate::tiles::Tiles;
@@ -155,7 +156,7 @@ impl<'a, D: Dim> Elements<'a, D> {
             if !overlaps::<D>(&line, &self.boxes[e]) {
                 continue;
             }
-            let s = D::crossing_from(xp, sp, xn, self.x, self.elems[e]);
+            let s = self.elems[e].crossing_from(xp, sp, xn, self.x);
             if s != 0 {
                 let bit = 1u32 << self.color[self.elem_crack[e] as usize];
                 odd ^= bit;
@@ -181,7 +182,7 @@ impl<'a, D: Dim> Elements<'a, D> {
 /// on the elements' connectivity only, so `run` rebuilds it only when that changes.
 fn neighbours<D: Dim>(elems: &[D::Elem]) -> Vec<[u32; 3]> {
     let mut neighbour = vec![[NONE; 3]; elems.len()];
-    if D::SHARED_FEATURE_SAFE {
+    if D::Elem::SHARED_FEATURE_SAFE {
         let mut sharing: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
         for (e, &el) in elems.iter().enumerate() {
             for k in 0..<D::Elem as Element>::FEATURES {
@@ -307,16 +308,16 @@ impl<D: Dim> Pass<'_, D> {
         let mut clearance = if clear { self.skin } else { 0.0 };
         for &e in &s.close {
             let el = elements.elems[e as usize];
-            let sp = D::elem_side(xp, x, el);
+            let sp = el.side(xp, x);
             if overlaps::<D>(&node_box, &elements.boxes[e as usize])
-                && corners.iter().any(|&c| D::elem_side(c, x, el) != sp)
+                && corners.iter().any(|&c| el.side(c, x) != sp)
             {
                 s.near.push((e, sp));
             }
             if clearance <= self.slack {
                 continue;
             }
-            clearance = clearance.min(D::elem_distance(xp, x, el));
+            clearance = clearance.min(el.distance(xp, x));
             let mut open = [false; 3];
             for (k, o) in open
                 .iter_mut()
@@ -324,12 +325,10 @@ impl<D: Dim> Pass<'_, D> {
                 .take(<D::Elem as Element>::FEATURES)
             {
                 let nb = elements.neighbour[e as usize][k];
-                if nb != NONE && D::elem_side(xp, x, elements.elems[nb as usize]) == sp {
-                    let both = D::plane_distance(xp, x, el).min(D::plane_distance(
-                        xp,
-                        x,
-                        elements.elems[nb as usize],
-                    ));
+                if nb != NONE && elements.elems[nb as usize].side(xp, x) == sp {
+                    let both = el
+                        .plane_distance(xp, x)
+                        .min(elements.elems[nb as usize].plane_distance(xp, x));
                     clearance = clearance.min(both);
                 } else {
                     *o = true;
@@ -348,9 +347,9 @@ impl<D: Dim> Pass<'_, D> {
                 if gap_sq::<D>(&from, bx) > clearance * clearance * (1.0 + 1e-9) {
                     continue;
                 }
-                let mut c = D::elem_distance(xn, x, el);
+                let mut c = el.distance(xn, x);
                 for k in (0..<D::Elem as Element>::FEATURES).filter(|&k| open[k]) {
-                    c = c.min(D::feature_distance(xp, xn, x, el, k));
+                    c = c.min(el.feature_distance(xp, xn, x, k));
                 }
                 clearance = clearance.min(c);
             }

@@ -7,6 +7,7 @@
 
 use crate::crack::{COLORS, Cracks, ElementBins, Law};
 use crate::dim::Dim;
+use crate::geometry::Element;
 use crate::shape::Stencil;
 use crate::with_shape;
 use crate::world::World;
@@ -30,7 +31,7 @@ fn nearest<D: Dim>(
         ElementBins::new::<D>(verts, elems, keep, cell, 3)
     });
     let e = bins.nearest::<D>(x, verts, elems)? as usize;
-    Some((elem_crack[e] as usize, D::elem_normal(verts, elems[e])))
+    Some((elem_crack[e] as usize, elems[e].normal(verts)))
 }
 
 /// Mass-weighted displacement sums m u at every entry of the nodes with crack fields, from

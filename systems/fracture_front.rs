@@ -7,11 +7,12 @@
 //! sqrt(2) times its radius, is short of the nearest of their triangles. Runs on output
 //! steps only; it reads the world and changes nothing.
 
-use crate::crack::{Cracks, Element};
-use crate::dim::{D3, Dim};
+use crate::crack::Cracks;
+use crate::dim::D3;
 use crate::fracture::{FracturePlan, KMethod, Measured, PathResult, TipResult};
 use crate::front::{FrontFrame, front_line};
 use crate::front_integral::{Elastic3, Facet, FrontIntegrals, Tube, front_integrals};
+use crate::geometry::Element;
 use crate::geometry::point_triangle;
 use crate::world::World;
 use glam::DVec3;
@@ -198,7 +199,7 @@ fn facets(cracks: &Cracks<D3>) -> Vec<Facet> {
                 .map(|&k| x[k as usize])
                 .sum::<glam::DVec3>()
                 / 3.0,
-            normal: D3::elem_normal(x, *e),
+            normal: e.normal(x),
         })
         .collect()
 }

@@ -8,10 +8,11 @@
 //! it. Runs after the step and its fracture measurement; the moved tip is classified, in
 //! contact and measured from the next step on.
 
-use crate::crack::{Cracks, Element};
+use crate::crack::Cracks;
 use crate::dim::{D2, Dim};
 use crate::error::Unstable;
 use crate::fracture::FracturePlan;
+use crate::geometry::Element;
 use crate::growth::{
     Direction, GrowthRow, Initiation, Paris, Stopped, TipState, hoop_angle, hoop_k,
 };

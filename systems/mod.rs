@@ -1,4 +1,6 @@
-//! The systems, one file each, in pipeline order. Each is a plain function over the World.
+//! The systems, one file each, listed in pipeline order (the order `Schedule::for_world`
+//! runs them in; `bin` and `stress_bin` also open and close the step). Each is a plain
+//! function over the World.
 
 pub mod bin;
 pub mod classify;
@@ -14,3 +16,35 @@ pub mod p2g;
 pub mod stress;
 pub mod stress_bin;
 pub mod stress_force;
+
+use crate::dim::{D2, D3, Dim};
+use crate::error::Unstable;
+use crate::fracture::FracturePlan;
+use crate::world::World;
+
+/// The systems whose algorithm differs by dimension: J and K at crack tips in 2D and at
+/// every front vertex in 3D, and the growth of tips or fronts.
+pub trait DimSystems: Dim {
+    /// Measures J and K at every crack front of the world as the plan says.
+    fn fracture(world: &mut World<Self>, plan: &FracturePlan);
+    /// Advances the growing crack tips (2D) or fronts (3D) after a step.
+    fn grow(world: &mut World<Self>, plan: Option<&FracturePlan>) -> Result<(), Unstable>;
+}
+
+impl DimSystems for D2 {
+    fn fracture(world: &mut World<D2>, plan: &FracturePlan) {
+        fracture::run(world, plan)
+    }
+    fn grow(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Unstable> {
+        grow::run(world, plan)
+    }
+}
+
+impl DimSystems for D3 {
+    fn fracture(world: &mut World<D3>, plan: &FracturePlan) {
+        fracture_front::run(world, plan)
+    }
+    fn grow(world: &mut World<D3>, plan: Option<&FracturePlan>) -> Result<(), Unstable> {
+        grow_front::run(world, plan)
+    }
+}

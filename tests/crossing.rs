@@ -1,7 +1,7 @@
 //! The particle-node line against crack elements on degenerate geometry: exact predicates
 //! and the documented tie rule (a point exactly on the crack counts as above it).
 
-use fissure::dim::{D2, D3, Dim};
+use fissure::geometry::{Element, Segment, Triangle};
 use glam::{DVec2, DVec3};
 
 fn v2(x: f64, y: f64) -> DVec2 {
@@ -11,7 +11,7 @@ fn v2(x: f64, y: f64) -> DVec2 {
 /// Crossings of the line p -> q with every segment of the polyline `pts`, per segment.
 fn crossings(p: DVec2, q: DVec2, pts: &[DVec2]) -> Vec<i8> {
     (0..pts.len() - 1)
-        .map(|k| D2::crossing(p, q, pts, [k as u32, k as u32 + 1]))
+        .map(|k| Segment::from_vertices(&[k as u32, k as u32 + 1]).crossing(p, q, pts))
         .collect()
 }
 
@@ -65,18 +65,18 @@ fn a_polyline_crossed_twice_counts_as_none() {
 #[test]
 fn triangle_crossings_in_3d() {
     let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
-    let e = [0, 1, 2];
+    let e: Triangle = [0, 1, 2];
     // Counterclockwise seen from +z: above is +z.
     let (p, q) = (DVec3::new(0.2, 0.2, 0.5), DVec3::new(0.2, 0.2, -0.5));
-    assert_eq!(D3::crossing(p, q, &tri, e), 1);
-    assert_eq!(D3::crossing(q, p, &tri, e), -1);
+    assert_eq!(e.crossing(p, q, &tri), 1);
+    assert_eq!(e.crossing(q, p, &tri), -1);
     let outside = DVec3::new(0.8, 0.8, 0.5);
-    assert_eq!(D3::crossing(outside, outside - DVec3::Z, &tri, e), 0);
+    assert_eq!(e.crossing(outside, outside - DVec3::Z, &tri), 0);
 }
 
 /// Crossings of the line `p`-`q` with each triangle of `tris`.
 fn tri_crossings(p: DVec3, q: DVec3, v: &[DVec3], tris: &[[u32; 3]]) -> Vec<i8> {
-    tris.iter().map(|&t| D3::crossing(p, q, v, t)).collect()
+    tris.iter().map(|&t| t.crossing(p, q, v)).collect()
 }
 
 /// A hexagonal fan of six counterclockwise triangles around the origin in the plane z = 0.
@@ -123,7 +123,7 @@ fn lines_through_shared_edges_and_vertices_cross_once() {
         let c = tri_crossings(p, q, &v, &tris);
         assert_eq!(c.iter().filter(|&&s| s != 0).count(), 1, "{what}: {c:?}");
         // The same as the line moved a small distance along the tie-break direction.
-        let d = fissure::dim::NUDGE[0] * 1e-9;
+        let d = fissure::geometry::NUDGE[0] * 1e-9;
         let moved = tri_crossings(p + d, q + d, &v, &tris);
         if q.z != 0.0 {
             assert_eq!(c, moved, "{what}");

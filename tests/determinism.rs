@@ -4,6 +4,7 @@ mod common;
 use common::{final_world, mixed_scene};
 use fissure::dim::{D2, D3, Dim};
 use fissure::sym::SymTensor;
+use fissure::systems::DimSystems;
 use fissure::world::World;
 
 /// Every bit of the particle state that the next step depends on.
@@ -20,7 +21,7 @@ fn bits<D: Dim>(w: &World<D>) -> Vec<u64> {
     out
 }
 
-fn same_bits_for_thread_counts<D: Dim>(text: &str) {
+fn same_bits_for_thread_counts<D: DimSystems>(text: &str) {
     let one = bits(&final_world::<D>(text, 1));
     for threads in [2, 3] {
         let many = bits(&final_world::<D>(text, threads));

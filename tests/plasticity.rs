@@ -7,6 +7,7 @@ use common::{final_world, history, mixed_scene, plastic};
 use fissure::dim::{D2, D3, Dim};
 use fissure::measure::energy_balance;
 use fissure::sym::SymTensor;
+use fissure::systems::DimSystems;
 use fissure::world::World;
 
 /// Every bit of the stress and plastic state.
@@ -29,7 +30,7 @@ fn yielded<D: Dim>(w: &World<D>) -> f64 {
     p.hardened.iter().filter(|h| h.equivalent > 0.0).count() as f64 / p.len() as f64
 }
 
-fn same_bits_for_thread_counts<D: Dim>(text: &str) {
+fn same_bits_for_thread_counts<D: DimSystems>(text: &str) {
     let one = final_world::<D>(text, 1);
     let y = yielded(&one);
     assert!(

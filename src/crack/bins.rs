@@ -2,8 +2,8 @@
 //! over rings of bins around it instead of a scan of every element (contact asks this of
 //! every node with a crack field, twice a step).
 
-use super::{Bounds, bounds};
 use crate::dim::Dim;
+use crate::geometry::{Bounds, Element};
 
 /// One crack's elements on a lattice of bins (compressed rows: the elements of bin `b` are
 /// `items[start[b]..start[b + 1]]`, in increasing element order).
@@ -32,7 +32,7 @@ impl ElementBins {
         let boxes: Vec<(usize, [f64; 3], [f64; 3])> = (elems.iter().enumerate())
             .filter(|&(e, _)| keep(e))
             .map(|(e, el)| {
-                let (lo, hi) = bounds::<D>(x, el);
+                let (lo, hi) = el.bounds(x);
                 (e, lo, hi)
             })
             .collect();
@@ -132,7 +132,7 @@ impl ElementBins {
                     return;
                 }
             }
-            let d = D::elem_distance_sq(x, verts, elems[e as usize]);
+            let d = elems[e as usize].distance_sq(x, verts);
             if best.is_none_or(|(bd, be)| d < bd || (d == bd && e < be)) {
                 *best = Some((d, e));
             }
@@ -202,7 +202,7 @@ mod tests {
     fn scan<D: Dim>(x: D::Vec, verts: &[D::Vec], elems: &[D::Elem]) -> Option<u32> {
         let mut best: Option<(f64, u32)> = None;
         for (e, &el) in elems.iter().enumerate() {
-            let d = D::elem_distance_sq(x, verts, el);
+            let d = el.distance_sq(x, verts);
             if best.is_none_or(|b| d < b.0) {
                 best = Some((d, e as u32));
             }
@@ -269,7 +269,7 @@ mod tests {
             let found = bins.nearest::<D2>(x, &pts, &segs);
             let want = (kept.iter().enumerate())
                 .filter(|(e, _)| e % 3 != 0)
-                .map(|(e, &el)| (D2::elem_distance_sq(x, &pts, el), e as u32))
+                .map(|(e, &el)| (el.distance_sq(x, &pts), e as u32))
                 .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
                 .map(|b| b.1);
             assert_eq!(found, want);

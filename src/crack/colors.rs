@@ -2,8 +2,9 @@
 //! scene may hold more cracks than a mask has bits for. Cracks that no particle's stencil
 //! can see at once may share a colour; with at most [`COLORS`] cracks each is its own.
 
-use super::{Bounds, Topology, bounds, meeting_pairs};
+use super::Topology;
 use crate::dim::Dim;
+use crate::geometry::{Bounds, Element, meeting_pairs};
 
 /// Colours a mask has room for (two bits each in a `u64`).
 pub const COLORS: usize = 32;
@@ -36,7 +37,7 @@ pub fn colors<D: Dim>(topology: &Topology<D>, x: &[D::Vec], cell: f64) -> Result
     // Each crack's box, widened along the scene's axes.
     let mut boxes: Vec<Bounds> = vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); n];
     for (el, &c) in topology.elems().iter().zip(topology.elem_crack()) {
-        let (lo, hi) = bounds::<D>(x, el);
+        let (lo, hi) = el.bounds(x);
         let b = &mut boxes[c as usize];
         for k in 0..3 {
             let g = if k < D::D { grow } else { 0.0 };

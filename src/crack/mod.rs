@@ -9,7 +9,6 @@
 
 mod bins;
 mod colors;
-mod element;
 mod fields;
 mod law;
 mod node_lines;
@@ -17,13 +16,13 @@ mod topology;
 
 pub use bins::ElementBins;
 pub use colors::{COLORS, Crowded, colors};
-pub use element::{Bounds, Element, Segment, Triangle, bounds, meeting_pairs, overlap};
 pub use fields::{Classified, Displacements, Fields, Links, Scratch, side_bit};
 pub use law::{Contact, Law};
 pub use node_lines::{NodeLine, on_node_lines};
 pub use topology::{Crack, Front, Topology, TopologyError};
 
 use crate::dim::Dim;
+use crate::geometry::{Segment, Triangle};
 use crate::growth::TipState;
 
 /// Most cracks a scene may hold (element-to-crack indices are `u16`); at most

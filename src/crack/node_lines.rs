@@ -5,8 +5,9 @@
 //! crack on a node plane reads K_I 0.1 to 6.4 % high depending on its radius, against a
 //! steady 1.9 to 2.8 % half a cell off (README, "Validation").
 
-use super::{Cracks, Element};
+use super::Cracks;
 use crate::dim::Dim;
+use crate::geometry::Element;
 use crate::grid::GridGeom;
 use std::collections::BTreeMap;
 

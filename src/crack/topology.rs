@@ -2,9 +2,9 @@
 //! changes only when a crack grows; a version number tells the systems that keep
 //! something built from it (element neighbours, the classification record) to rebuild.
 
-use super::element::Element;
 use super::law::Contact;
 use crate::dim::Dim;
+use crate::geometry::Element;
 use crate::growth::Growth;
 use std::collections::{HashMap, HashSet};
 
@@ -147,7 +147,7 @@ impl<D: Dim> Topology<D> {
     /// its index, and so does every other vertex.
     pub fn insert_behind_tip(&mut self, c: usize, end: u32, tip: u32) -> u32
     where
-        D: Dim<Elem = super::element::Segment>,
+        D: Dim<Elem = crate::geometry::Segment>,
     {
         let new = self.vertex_count as u32;
         let e = self
@@ -187,7 +187,7 @@ impl<D: Dim> Topology<D> {
         closed: bool,
     ) -> Result<Vec<u32>, TopologyError>
     where
-        D: Dim<Elem = super::element::Triangle>,
+        D: Dim<Elem = crate::geometry::Triangle>,
     {
         let c = self.fronts[front].crack;
         let fv = self.fronts[front].vertices.clone();

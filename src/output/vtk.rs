@@ -1,9 +1,10 @@
 //! VTK XML output for ParaView: particle and crack `.vtu` files (appended raw binary) and
 //! `.pvd` collections indexing them by time.
 
-use crate::crack::{Cracks, Element};
+use crate::crack::Cracks;
 use crate::dim::Dim;
 use crate::fracture::TipResult;
+use crate::geometry::Element;
 use crate::particles::Particles;
 use crate::sym::SymTensor;
 use std::io::Write;

@@ -12,6 +12,7 @@ use crate::crack::Cracks;
 use crate::dim::{D2, D3, Dim};
 use crate::error::{Unstable, UsageError};
 use crate::fracture::TipResult;
+use crate::geometry::Element;
 use crate::measure::{Expect, History, Measure, Row, balance_drift};
 use crate::output::plot::{self, Panel, Series};
 use crate::output::summary::Summary;
@@ -21,6 +22,7 @@ use crate::schedule::Schedule;
 use crate::snapshot::Reader;
 use crate::snapshot::state::restore;
 use crate::sym::SymTensor;
+use crate::systems::DimSystems;
 use crate::systems::bin;
 use crate::world::{Energies, World};
 use anyhow::Context;
@@ -97,7 +99,11 @@ pub fn run(src: &Source, opts: &RunOptions) -> anyhow::Result<Outcome> {
 pub fn resume(path: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
     let file = checkpoint::resolve(path)?;
     let mut reader = Reader::open(&file)?;
-    fn go<D: Dim>(r: &mut Reader, file: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
+    fn go<D: DimSystems>(
+        r: &mut Reader,
+        file: &Path,
+        opts: &RunOptions,
+    ) -> anyhow::Result<Outcome> {
         let restored = restore::<D>(r)?;
         let resumed = (restored.state, file.to_path_buf());
         drive::<D>(&restored.source, restored.scene, Some(resumed), opts)
@@ -159,7 +165,7 @@ enum Stop {
     Output(anyhow::Error),
 }
 
-fn drive<D: Dim>(
+fn drive<D: DimSystems>(
     src: &Source,
     scene: Scene<D>,
     resumed: Option<(RunState, PathBuf)>,
@@ -724,7 +730,7 @@ fn plot_paths<D: Dim>(path: &Path, name: &str, cracks: &Cracks<D>) -> Result<(),
     let mut normal = [0.0f64; 3];
     for (e, &c) in topo.elems().iter().zip(topo.elem_crack()) {
         if growing(c as usize) {
-            let n = D::to_xyz(D::elem_normal(x, *e));
+            let n = D::to_xyz(e.normal(x));
             (0..3).for_each(|a| normal[a] += n[a].abs());
         }
     }

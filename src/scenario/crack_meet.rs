@@ -2,8 +2,9 @@
 //! must not cross or touch: each crack splits the velocity field on its own, so where two
 //! meet a node's fields would be ambiguous.
 
-use crate::crack::{Bounds, Cracks, Element, bounds, meeting_pairs, overlap};
+use crate::crack::Cracks;
 use crate::dim::Dim;
+use crate::geometry::{Bounds, Element, meeting_pairs, overlap};
 
 /// The edges of a crack element as vertex pairs: the segment itself in 2D, the three
 /// edges of a triangle in 3D.
@@ -21,7 +22,7 @@ fn edges<D: Dim>(e: &D::Elem) -> Vec<[u32; 2]> {
 fn edge_crosses<D: Dim>(va: &[D::Vec], a: &D::Elem, vb: &[D::Vec], b: D::Elem) -> bool {
     edges::<D>(a)
         .iter()
-        .any(|&[p, q]| D::crossing(va[p as usize], va[q as usize], vb, b) != 0)
+        .any(|&[p, q]| b.crossing(va[p as usize], va[q as usize], vb) != 0)
 }
 
 /// Whether element `a` (vertices `va`) touches element `b` (vertices `vb`) within `tol`
@@ -30,10 +31,9 @@ fn edge_crosses<D: Dim>(va: &[D::Vec], a: &D::Elem, vb: &[D::Vec], b: D::Elem) -
 /// overlap on one line (2D) or plane (3D).
 fn touches<D: Dim>(va: &[D::Vec], a: &D::Elem, vb: &[D::Vec], b: D::Elem, tol: f64) -> bool {
     let features = b.vertices().len();
-    (a.vertices().iter()).any(|&p| D::elem_distance(va[p as usize], vb, b) <= tol)
+    (a.vertices().iter()).any(|&p| b.distance(va[p as usize], vb) <= tol)
         || edges::<D>(a).iter().any(|&[p, q]| {
-            (0..features)
-                .any(|k| D::feature_distance(va[p as usize], va[q as usize], vb, b, k) <= tol)
+            (0..features).any(|k| b.feature_distance(va[p as usize], va[q as usize], vb, k) <= tol)
         })
 }
 
@@ -48,7 +48,7 @@ pub(super) fn meets<D: Dim>(
 ) -> Option<(usize, usize, usize)> {
     let topo = &store.topology;
     let vx = &store.geometry.x;
-    let mine: Vec<Bounds> = elems.iter().map(|e| bounds::<D>(points, e)).collect();
+    let mine: Vec<Bounds> = elems.iter().map(|e| e.bounds(points)).collect();
     for c in 0..topo.cracks().len() {
         // The other crack's elements sorted by the low x of their boxes, so that only those
         // whose box can reach a new element's are tried.
@@ -56,7 +56,7 @@ pub(super) fn meets<D: Dim>(
             .zip(topo.elem_crack())
             .filter(|(_, k)| **k as usize == c)
             .enumerate()
-            .map(|(i, (e, _))| (bounds::<D>(vx, e), i, *e))
+            .map(|(i, (e, _))| (e.bounds(vx), i, *e))
             .collect();
         let widest = theirs
             .iter()
@@ -100,7 +100,7 @@ pub(super) fn self_meets<D: Dim>(
     elems: &[D::Elem],
     tol: f64,
 ) -> Option<(usize, usize)> {
-    let boxes: Vec<Bounds> = elems.iter().map(|e| bounds::<D>(points, e)).collect();
+    let boxes: Vec<Bounds> = elems.iter().map(|e| e.bounds(points)).collect();
     let mut found: Option<(usize, usize)> = None;
     meeting_pairs(&boxes, |i, j| {
         let (a, b) = (&elems[i], elems[j]);

@@ -4,10 +4,11 @@ use super::build::{positive, to_vec, vec3};
 use super::schema::{AlongSpec, CrackSpec, ExpectSpec, FractureSpec};
 use super::source::Source;
 use super::surface;
-use crate::crack::{COLORS, Contact, Cracks, Element, Law, MAX_CRACKS, colors};
+use crate::crack::{COLORS, Contact, Cracks, Law, MAX_CRACKS, colors};
 use crate::dim::{D3, Dim};
 use crate::error::ScenarioError;
 use crate::fracture::{FracturePlan, KMethod};
+use crate::geometry::Element;
 use crate::grid::GridGeom;
 use crate::growth::TipState;
 use crate::material::Material;
@@ -478,7 +479,7 @@ fn self_crossing<D: Dim>(pts: &[D::Vec]) -> Option<(usize, usize)> {
                 }
                 let (p, q) = (pts[b], pts[b + 1]);
                 // Touching counts as crossing here: a crack must not meet itself at all.
-                if D::crossing(p, q, pts, e(a)) != 0 || D::crossing(q, p, pts, e(a)) != 0 {
+                if (e(a)).crossing(p, q, pts) != 0 || (e(a)).crossing(q, p, pts) != 0 {
                     first = Some((a, b));
                 }
             }

@@ -5,9 +5,9 @@
 use super::build::vec3;
 use super::schema::RegionSpec;
 use super::source::Source;
-use crate::crack::{Bounds, meeting_pairs};
 use crate::dim::Dim;
 use crate::error::ScenarioError;
+use crate::geometry::{Bounds, meeting_pairs};
 
 type R<T> = Result<T, ScenarioError>;
 

@@ -12,8 +12,7 @@
 //! last 8       xxh3-64 of bytes [0, 20+H)
 //! ```
 
-use bytemuck::Pod;
-use glam::{DMat2, DMat3, DVec2, DVec3};
+use crate::columnar::{Columnar, Scalar};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom, Write};
@@ -35,50 +34,13 @@ const PREAMBLE: u64 = 20;
 /// Bytes of the trailing header checksum.
 const TRAILER: u64 = 8;
 
-/// Scalar type of a column's elements.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Elem {
-    /// 64-bit float.
-    F64,
-    /// 64-bit unsigned integer.
-    U64,
-    /// 16-bit unsigned integer.
-    U16,
-    /// Byte (UTF-8 text).
-    U8,
-}
-
-impl Elem {
-    /// Bytes per element.
-    pub fn size(self) -> u64 {
-        match self {
-            Elem::F64 | Elem::U64 => 8,
-            Elem::U16 => 2,
-            Elem::U8 => 1,
-        }
-    }
-}
-
-/// Plain-old-data types stored as columns, with their scalar type.
-pub trait Columnar: Pod {
-    /// The scalar every component has.
-    const ELEM: Elem;
-}
-
-macro_rules! columnar {
-    ($($t:ty => $e:ident),*) => { $(impl Columnar for $t { const ELEM: Elem = Elem::$e; })* };
-}
-columnar!(f64 => F64, u64 => U64, u16 => U16, u8 => U8, DVec2 => F64, DVec3 => F64,
-    DMat2 => F64, DMat3 => F64, crate::sym::Sym2 => F64, crate::sym::Sym3 => F64,
-    crate::plastic::Hardened => F64);
-
 /// One entry of the column table.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Column {
     /// Name, e.g. `particles.x`.
     pub name: String,
     /// Scalar type.
-    pub elem: Elem,
+    pub elem: Scalar,
     /// Number of scalars.
     pub len: u64,
     /// Byte offset from the start of the column section.
@@ -157,8 +119,8 @@ impl<'a> ColumnSet<'a> {
         let bytes: &[u8] = bytemuck::cast_slice(data);
         self.table.push(Column {
             name: name.to_string(),
-            elem: T::ELEM,
-            len: bytes.len() as u64 / T::ELEM.size(),
+            elem: T::SCALAR,
+            len: bytes.len() as u64 / T::SCALAR.size(),
             offset: self.len,
             checksum: xxh3_64(bytes),
         });
@@ -354,7 +316,7 @@ impl Reader {
             .cloned()
             .ok_or_else(|| self.invalid(format!("column `{name}` is missing")))?;
         let bytes = (count as u64).checked_mul(std::mem::size_of::<T>() as u64);
-        if c.elem != T::ELEM || Some(c.len * c.elem.size()) != bytes {
+        if c.elem != T::SCALAR || Some(c.len * c.elem.size()) != bytes {
             return Err(self.invalid(format!(
                 "column `{name}` holds {} {:?} scalars; expected {count} items of {} bytes",
                 c.len,

@@ -5,4 +5,4 @@ pub mod format;
 pub mod state;
 mod topology;
 
-pub use format::{Columnar, Reader, SnapshotError};
+pub use format::{Reader, SnapshotError};

@@ -3,8 +3,9 @@
 //! laws come from the stored scenario.
 
 use super::format::{ColumnSet, Reader, SnapshotError};
-use crate::crack::{Crack, Element, Front, Topology};
+use crate::crack::{Crack, Front, Topology};
 use crate::dim::Dim;
+use crate::geometry::Element;
 
 /// A topology flattened into integer columns.
 pub struct Encoded {

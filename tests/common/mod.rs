@@ -1,11 +1,11 @@
 //! Helpers shared by the integration tests: scenario text for bars, running to a history.
 #![allow(dead_code)]
 
-use fissure::dim::Dim;
 use fissure::measure::History;
 use fissure::run::{Outcome, RunOptions, run};
 use fissure::scenario::{Source, build};
 use fissure::schedule::{Schedule, System};
+use fissure::systems::DimSystems;
 use fissure::world::World;
 
 /// Parses scenario text (panics with the located error if it does not parse).
@@ -24,12 +24,12 @@ pub fn history(text: &str) -> History {
 }
 
 /// Builds the scene and steps it to the end on `threads` threads, returning the world.
-pub fn final_world<D: Dim>(text: &str, threads: usize) -> World<D> {
+pub fn final_world<D: DimSystems>(text: &str, threads: usize) -> World<D> {
     final_world_with(text, threads, |_| {})
 }
 
 /// As [`final_world`], with `prepare` applied to the world before the first step.
-pub fn final_world_with<D: Dim>(
+pub fn final_world_with<D: DimSystems>(
     text: &str,
     threads: usize,
     prepare: impl FnOnce(&mut World<D>) + Send,
@@ -185,7 +185,7 @@ history_interval = {hist:e}
 /// The world of `text` after `steps` steps run twice: on its schedule, whose closing stress
 /// update is fused with the binning (checked), and keeping the stencils every step, which
 /// runs that update unfused (binning waits for the next step). Returns (fused, unfused).
-pub fn fused_and_unfused<D: Dim>(text: &str, steps: usize) -> (World<D>, World<D>) {
+pub fn fused_and_unfused<D: DimSystems>(text: &str, steps: usize) -> (World<D>, World<D>) {
     let mut fused = build::<D>(&source(text)).unwrap().world;
     let mut apart = fused.clone();
     let mut fused_schedule = Schedule::for_world(&fused, None);

@@ -1,25 +1,25 @@
 //! Euclidean distances between points, segments and triangles, for the crack
 //! classification's clearances (how far things must move before a crossing can change).
 
-use crate::dim::Dim;
+use super::Point;
 use glam::DVec3;
 
 /// Distance from `x` to the segment `a`-`b` (m).
-pub fn point_segment<D: Dim>(x: D::Vec, a: D::Vec, b: D::Vec) -> f64 {
-    point_segment_sq::<D>(x, a, b).sqrt()
+pub fn point_segment<P: Point>(x: P, a: P, b: P) -> f64 {
+    point_segment_sq(x, a, b).sqrt()
 }
 
 /// Squared distance from `x` to the segment `a`-`b` (m^2).
-pub fn point_segment_sq<D: Dim>(x: D::Vec, a: D::Vec, b: D::Vec) -> f64 {
+pub fn point_segment_sq<P: Point>(x: P, a: P, b: P) -> f64 {
     let ab = b - a;
-    let len2 = D::dot(ab, ab);
+    let len2 = ab.dot(ab);
     let t = if len2 > 0.0 {
-        (D::dot(x - a, ab) / len2).clamp(0.0, 1.0)
+        ((x - a).dot(ab) / len2).clamp(0.0, 1.0)
     } else {
         0.0
     };
     let d = x - (a + ab * t);
-    D::dot(d, d)
+    d.dot(d)
 }
 
 /// Distance from `x` to the triangle `a`, `b`, `c` (m): to its plane when `x` projects
@@ -37,7 +37,7 @@ pub fn point_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     }
     [(a, b), (b, c), (c, a)]
         .iter()
-        .map(|&(p, q)| point_segment::<crate::dim::D3>(x, p, q))
+        .map(|&(p, q)| point_segment(x, p, q))
         .fold(f64::INFINITY, f64::min)
 }
 
@@ -45,11 +45,10 @@ pub fn point_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
 /// interior points when the segments are not parallel, never more than the distance of an
 /// endpoint to the other segment.
 pub fn segment_segment(p1: DVec3, q1: DVec3, p2: DVec3, q2: DVec3) -> f64 {
-    use crate::dim::D3;
-    let ends = point_segment::<D3>(p1, p2, q2)
-        .min(point_segment::<D3>(q1, p2, q2))
-        .min(point_segment::<D3>(p2, p1, q1))
-        .min(point_segment::<D3>(q2, p1, q1));
+    let ends = point_segment(p1, p2, q2)
+        .min(point_segment(q1, p2, q2))
+        .min(point_segment(p2, p1, q1))
+        .min(point_segment(q2, p1, q1));
     let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
     let (a, b, e) = (d1.dot(d1), d1.dot(d2), d2.dot(d2));
     let denom = a * e - b * b;
@@ -71,15 +70,14 @@ pub fn segment_segment(p1: DVec3, q1: DVec3, p2: DVec3, q2: DVec3) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dim::D2;
     use glam::DVec2;
 
     #[test]
     fn point_segment_interior_and_ends() {
         let (a, b) = (DVec2::new(0.0, 0.0), DVec2::new(2.0, 0.0));
-        assert_eq!(point_segment::<D2>(DVec2::new(1.0, 3.0), a, b), 3.0);
-        assert_eq!(point_segment::<D2>(DVec2::new(5.0, 4.0), a, b), 5.0);
-        assert_eq!(point_segment::<D2>(DVec2::new(-3.0, 0.0), a, a), 3.0);
+        assert_eq!(point_segment(DVec2::new(1.0, 3.0), a, b), 3.0);
+        assert_eq!(point_segment(DVec2::new(5.0, 4.0), a, b), 5.0);
+        assert_eq!(point_segment(DVec2::new(-3.0, 0.0), a, a), 3.0);
     }
 
     #[test]
