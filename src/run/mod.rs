@@ -16,7 +16,7 @@ use crate::geometry::Element;
 use crate::measure::{Expect, History, Measure, Row, balance_drift};
 use crate::output::plot::{self, Panel, Series};
 use crate::output::summary::Summary;
-use crate::scenario::build::MAX_STEPS;
+use crate::scenario::MAX_STEPS;
 use crate::scenario::{Scene, Source, build};
 use crate::schedule::Schedule;
 use crate::snapshot::Reader;

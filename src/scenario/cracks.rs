@@ -1,6 +1,6 @@
 //! Building the crack store from `[[crack]]` tables, with every check a crack needs.
 
-use super::build::{positive, to_vec, vec3};
+use super::check::{positive, to_vec, vec3};
 use super::schema::{AlongSpec, CrackSpec, ExpectSpec, FractureSpec};
 use super::source::Source;
 use super::surface;
@@ -137,7 +137,7 @@ pub(super) fn build<D: Dim>(
         }
         let contact = contact(src, c, spec)?;
         let name = spec.name.clone().unwrap_or_else(|| format!("crack{c}"));
-        super::build::csv_name(src, &format!("crack[{c}].name"), &name)?;
+        super::check::csv_name(src, &format!("crack[{c}].name"), &name)?;
         if store.topology.cracks().iter().any(|k| k.name == name) {
             return Err(src.error(
                 &format!("crack[{c}].name"),

@@ -1,7 +1,7 @@
 //! The `J_eta` expect: a crack tip's J against the eta estimate from the scene's own
 //! load-displacement record (see [`crate::eta`]).
 
-use super::build::{material_named, positive};
+use super::check::{material_named, positive};
 use super::cracks::expect_tip;
 use super::schema::ExpectSpec;
 use super::source::Source;

@@ -1,6 +1,6 @@
 //! The `[[material]]` tables: elastic constants, and the J2 parameters of plastic ones.
 
-use super::build::positive;
+use super::check::positive;
 use super::schema::{MaterialSpec, ModelKind};
 use super::source::Source;
 use crate::error::ScenarioError;

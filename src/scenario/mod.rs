@@ -1,19 +1,30 @@
 //! Scenario files: format ([`schema`]), reading with overrides ([`source`]) and building a
 //! World from them (`build::build`).
 
+mod bodies;
+mod boundaries;
 pub mod build;
+mod check;
 mod claim;
 mod crack_meet;
 mod cracks;
 mod eta;
+mod expects;
+mod grid;
 mod growth;
+mod loads;
 mod material;
 mod memory;
+mod output;
+mod probes;
 mod region;
 pub mod schema;
+mod settings;
 pub mod source;
 mod surface;
 mod traction;
 
-pub use build::{CheckpointPlan, OutputPlan, Scene, build};
+pub use build::{Scene, build};
+pub use output::{CheckpointPlan, OutputPlan};
+pub use settings::MAX_STEPS;
 pub use source::Source;

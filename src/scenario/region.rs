@@ -2,14 +2,12 @@
 //! boxes, polygons (2D), oriented boxes, discs or balls and half-spaces, so that a specimen rotated in the
 //! grid is as easy to describe as an aligned one.
 
-use super::build::vec3;
+use super::check::{R, vec3};
 use super::schema::RegionSpec;
 use super::source::Source;
 use crate::dim::Dim;
-use crate::error::ScenarioError;
 use crate::geometry::{Bounds, meeting_pairs};
-
-type R<T> = Result<T, ScenarioError>;
+use crate::particles::Particles;
 
 /// Most vertices a region polygon may have (its self-crossing check is quadratic).
 const MAX_POLYGON: usize = 1000;
@@ -117,6 +115,24 @@ fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
         || (d2 == 0.0 && on(c, d, b))
         || (d3 == 0.0 && on(a, b, c))
         || (d4 == 0.0 && on(a, b, d))
+}
+
+/// The particles inside the region a `region` table describes, refused when it holds none.
+pub(super) fn particles_in<D: Dim>(
+    src: &Source,
+    key: &str,
+    r: &RegionSpec,
+    particles: &Particles<D>,
+) -> R<Vec<u32>> {
+    let r = region::<D>(src, key, r)?;
+    let sel: Vec<u32> = (0..particles.len())
+        .filter(|&p| r.contains(D::to_xyz(particles.x[p]), D::D, 0.0))
+        .map(|p| p as u32)
+        .collect();
+    if sel.is_empty() {
+        return Err(src.error(key, "the region contains no particle"));
+    }
+    Ok(sel)
 }
 
 /// The region a scenario's `region` table describes, checked (errors name `key`).

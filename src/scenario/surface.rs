@@ -2,7 +2,7 @@
 //! rectangles, ellipses (whole or half) and pennies, with the checks a crack surface needs
 //! (indices in range, no degenerate triangle, a manifold surface oriented one way).
 
-use super::build::{positive, vec3};
+use super::check::{positive, vec3};
 use super::schema::{CrackSpec, EllipseSpec, MeshSpec, PennySpec, PlanarSpec};
 use super::source::Source;
 use crate::dim::D3;

@@ -1,7 +1,7 @@
 //! Traction loads: a pressure, or the stress of a closed-form 2D field, applied on a body
 //! face (planar, or a circle or sphere about a centre) as a force on each face particle.
 
-use super::build::{to_vec, vec3};
+use super::check::{to_vec, vec3};
 use super::schema::{LoadSpec, PressureSpec};
 use super::source::Source;
 use crate::dim::Dim;
