@@ -3,7 +3,7 @@
 //! particles' classification cannot be reused from step to step. Measured: the DCB reads
 //! K_I 1.2 % low on a node row against 0.3 % half a cell off, in 60 % more time; a penny
 //! crack on a node plane reads K_I 0.1 to 6.4 % high depending on its radius, against a
-//! steady 1.9 to 2.8 % half a cell off (README, "Validation").
+//! steady 1.9 to 2.8 % half a cell off (docs/validation.md).
 
 use super::Cracks;
 use crate::dim::Dim;
