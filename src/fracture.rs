@@ -41,8 +41,8 @@ pub enum KMethod {
     Opening,
 }
 
-/// What one fracture measurement found: J and K at every tip, and J on the compared
-/// contours.
+/// What a step measured at its cracks, for the run to write: J and K at every tip (or
+/// front vertex), J on the compared contours, and the growth rows of the tips that moved.
 #[derive(Clone, Debug, Default)]
 pub struct Measured {
     /// One result per crack tip.

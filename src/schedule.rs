@@ -2,7 +2,7 @@
 
 use crate::dim::Dim;
 use crate::error::Unstable;
-use crate::fracture::FracturePlan;
+use crate::fracture::{FracturePlan, Measured};
 use crate::systems::{
     DimSystems, bin, classify, contact, crack_advect, g2p, grid_update, grow, p2g, stress,
     stress_bin, stress_force,
@@ -169,20 +169,22 @@ impl Schedule {
         self.fracture.is_some()
     }
 
-    /// Advances the world one time step, measuring nothing.
-    pub fn step<D: DimSystems>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
+    /// Advances the world one time step, measuring nothing (a growing crack still reports
+    /// its growth rows).
+    pub fn step<D: DimSystems>(&mut self, world: &mut World<D>) -> Result<Measured, Unstable> {
         self.step_measuring(world, false)
     }
 
     /// Advances the world one time step; with `measure` the fracture system (if any) runs
     /// at its end, and the closing stress update leaves the binning to the next step, so
     /// that the particles' stencils are still the step's own, matching the crack fields,
-    /// as the J-integral reads them (the results are bitwise the same either way).
+    /// as the J-integral reads them (the results are bitwise the same either way). Returns
+    /// what the step measured: J and K at the fronts, and the growth rows.
     pub fn step_measuring<D: DimSystems>(
         &mut self,
         world: &mut World<D>,
         measure: bool,
-    ) -> Result<(), Unstable> {
+    ) -> Result<Measured, Unstable> {
         let measure = measure && self.measures();
         self.advance(world, measure, measure)
     }
@@ -194,7 +196,7 @@ impl Schedule {
         &mut self,
         world: &mut World<D>,
         keep_stencils: bool,
-    ) -> Result<(), Unstable> {
+    ) -> Result<Measured, Unstable> {
         self.advance(world, keep_stencils, false)
     }
 
@@ -207,7 +209,7 @@ impl Schedule {
         world: &mut World<D>,
         keep_stencils: bool,
         measure: bool,
-    ) -> Result<(), Unstable> {
+    ) -> Result<Measured, Unstable> {
         // A step whose end a growing tip reads K at keeps its stencils, as a measured one.
         let reads = self.grows && grow::needs_k(world, world.step + 1);
         with_warm_workers(|| self.run_systems(world, keep_stencils || reads))?;
@@ -215,41 +217,47 @@ impl Schedule {
         world.time = world.step as f64 * world.settings.dt;
         // The fracture system measures the state at the step's end, so it runs once the
         // clock has moved to it; then the tips grow from what it saw.
-        if measure {
-            self.fracture_system(world);
-        }
+        let mut measured = if measure {
+            self.fracture_system(world)
+        } else {
+            Measured::default()
+        };
         if self.grows {
             let t0 = Instant::now();
-            D::grow(world, self.fracture.as_ref())?;
+            measured.growth = D::grow(world, self.fracture.as_ref())?;
             if let Some(k) = self.systems.iter().position(|s| *s == System::Grow) {
                 self.seconds[k] += t0.elapsed().as_secs_f64();
             }
         }
-        Ok(())
+        Ok(measured)
     }
 
     /// Measures J and K on the world as it stands (before the first step): bins the
     /// particles and classifies them near the cracks, as a step would, then runs the
-    /// fracture system. Nothing to do without a fracture plan.
-    pub fn measure_now<D: DimSystems>(&mut self, world: &mut World<D>) -> Result<(), Unstable> {
+    /// fracture system and returns what it measured. Nothing to do without a fracture plan.
+    pub fn measure_now<D: DimSystems>(
+        &mut self,
+        world: &mut World<D>,
+    ) -> Result<Measured, Unstable> {
         if !self.measures() {
-            return Ok(());
+            return Ok(Measured::default());
         }
         bin::run(world)?;
         classify::run(world)?;
-        self.fracture_system(world);
-        Ok(())
+        Ok(self.fracture_system(world))
     }
 
     /// Runs the fracture system, timing it under its schedule entry.
-    fn fracture_system<D: DimSystems>(&mut self, world: &mut World<D>) {
-        if let Some(plan) = &self.fracture {
-            let t0 = Instant::now();
-            D::fracture(world, plan);
-            if let Some(k) = self.systems.iter().position(|s| *s == System::Fracture) {
-                self.seconds[k] += t0.elapsed().as_secs_f64();
-            }
+    fn fracture_system<D: DimSystems>(&mut self, world: &World<D>) -> Measured {
+        let Some(plan) = &self.fracture else {
+            return Measured::default();
+        };
+        let t0 = Instant::now();
+        let measured = D::fracture(world, plan);
+        if let Some(k) = self.systems.iter().position(|s| *s == System::Fracture) {
+            self.seconds[k] += t0.elapsed().as_secs_f64();
         }
+        measured
     }
 
     /// Runs the step's systems once, in order, timing each (the fracture system apart).

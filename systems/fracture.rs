@@ -51,16 +51,7 @@ impl Nodal {
     }
 }
 
-/// J and K at every tip of every crack, and J on the compared contours, into the crack
-/// scratch's `measured`.
-pub fn run(world: &mut World<D2>, plan: &FracturePlan) {
-    let measured = measure(world, plan);
-    if let Some(c) = world.cracks.as_mut() {
-        c.scratch.measured = measured;
-    }
-}
-
-/// What [`run`] stores: J and K at every tip, J on the compared contours.
+/// J and K at every tip of every crack, and J on the compared contours.
 pub fn measure(world: &World<D2>, plan: &FracturePlan) -> Measured {
     let mut m = Measured::default();
     let Some(cracks) = &world.cracks else {

@@ -19,16 +19,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::SQRT_2;
 
-/// J and K at every front vertex, into the crack scratch's `measured`.
-pub fn run(world: &mut World<D3>, plan: &FracturePlan) {
-    let measured = measure(world, plan);
-    if let Some(c) = world.cracks.as_mut() {
-        c.scratch.measured = measured;
-    }
-}
-
-/// What [`run`] stores: J and K at every vertex of every front, each crack's fronts
-/// numbered on from one to the next.
+/// J and K at every vertex of every front, each crack's fronts numbered on from one to the
+/// next.
 pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
     let mut m = Measured::default();
     let Some(cracks) = &world.cracks else {

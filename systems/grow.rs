@@ -37,10 +37,10 @@ pub fn needs_k<D: Dim>(world: &World<D>, step: u64) -> bool {
     })
 }
 
-/// Advances every growing tip by what this step allows. `plan` is the scene's fracture
-/// plan (present whenever a criterion or direction reads K). A tip leaving the grid makes
-/// the run unstable.
-pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Unstable> {
+/// Advances every growing tip by what this step allows, and returns a row for each new
+/// segment. `plan` is the scene's fracture plan (present whenever a criterion or direction
+/// reads K). A tip leaving the grid makes the run unstable.
+pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<Vec<GrowthRow>, Unstable> {
     let fronts = world
         .cracks
         .as_ref()
@@ -62,9 +62,10 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
         })
         .filter(|r| r.is_finite())
         .fold(0.0, f64::max);
+    let mut rows = Vec::new();
     for (f, &measured) in readings.iter().enumerate() {
         let Some(cracks) = &world.cracks else {
-            return Ok(());
+            return Ok(rows);
         };
         let front = &cracks.topology.fronts()[f];
         let Some(g) = cracks.topology.cracks()[front.crack as usize].growth else {
@@ -144,20 +145,18 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
             }
             if fresh {
                 let k = measured.map_or([f64::NAN; 2], |(k1, k2, _)| [k1, k2]);
-                if let Some(c) = world.cracks.as_mut() {
-                    c.scratch.measured.growth.push(GrowthRow {
-                        step: world.step,
-                        time: world.time,
-                        crack: u32::from(crack),
-                        tip: end,
-                        grown: st.grown,
-                        x: tip.to_array(),
-                        k,
-                        kink: dir.perp_dot(taken).atan2(dir.dot(taken)),
-                        heading: taken.y.atan2(taken.x),
-                        fatigue,
-                    });
-                }
+                rows.push(GrowthRow {
+                    step: world.step,
+                    time: world.time,
+                    crack: u32::from(crack),
+                    tip: end,
+                    grown: st.grown,
+                    x: tip.to_array(),
+                    k,
+                    kink: dir.perp_dot(taken).atan2(dir.dot(taken)),
+                    heading: taken.y.atan2(taken.x),
+                    fatigue,
+                });
             }
             grown
         } else {
@@ -170,7 +169,7 @@ pub fn run(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Uns
             c.tips[f] = st;
         }
     }
-    Ok(())
+    Ok(rows)
 }
 
 /// K_I, K_II and G along the direction of front `f`'s tip, where this step is a check of

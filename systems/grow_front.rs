@@ -20,12 +20,12 @@ use crate::systems::{fracture_front, grow::inside};
 use crate::world::World;
 use glam::DVec3;
 
-/// Advances every growing front by what this step's check allows. `plan` is the scene's
-/// fracture plan (present whenever a criterion reads K). A front leaving the grid makes
-/// the run unstable.
-pub fn run(world: &mut World<D3>, plan: Option<&FracturePlan>) -> Result<(), Unstable> {
+/// Advances every growing front by what this step's check allows, and returns a row for
+/// each front that moved. `plan` is the scene's fracture plan (present whenever a criterion
+/// reads K). A front leaving the grid makes the run unstable.
+pub fn run(world: &mut World<D3>, plan: Option<&FracturePlan>) -> Result<Vec<GrowthRow>, Unstable> {
     let Some(cracks) = &world.cracks else {
-        return Ok(());
+        return Ok(Vec::new());
     };
     let due: Vec<Option<Growth>> = (cracks.topology.fronts().iter().zip(&cracks.tips))
         .map(|(f, st)| {
@@ -34,7 +34,7 @@ pub fn run(world: &mut World<D3>, plan: Option<&FracturePlan>) -> Result<(), Uns
         })
         .collect();
     if due.iter().all(Option::is_none) {
-        return Ok(());
+        return Ok(Vec::new());
     }
     // K and J at every front vertex, read once for all fronts before any of them moves.
     let reads =
@@ -44,26 +44,27 @@ pub fn run(world: &mut World<D3>, plan: Option<&FracturePlan>) -> Result<(), Uns
         _ => Vec::new(),
     };
     let mut first = 0;
+    let mut grown = Vec::new();
     for (f, g) in due.into_iter().enumerate() {
         let cracks = world.cracks.as_ref().expect("a growing crack");
         let n = cracks.topology.fronts()[f].vertices.len();
         let rows = measured.get(first..first + n);
         first += n;
         if let Some(g) = g {
-            advance(world, f, &g, rows)?;
+            grown.extend(advance(world, f, &g, rows)?);
         }
     }
-    Ok(())
+    Ok(grown)
 }
 
 /// One check of front `f` under growth law `g`, with its vertices' readings `rows` (None
-/// when this check reads none).
+/// when this check reads none): the front's growth row if it moved.
 fn advance(
     world: &mut World<D3>,
     f: usize,
     g: &Growth,
     rows: Option<&[TipResult]>,
-) -> Result<(), Unstable> {
+) -> Result<Option<GrowthRow>, Unstable> {
     let cracks = world.cracks.as_ref().expect("a growing crack");
     let front = &cracks.topology.fronts()[f];
     let line = front_line(cracks, front);
@@ -82,7 +83,7 @@ fn advance(
         .collect();
     if st.started.is_nan() {
         if !holds.contains(&true) {
-            return Ok(());
+            return Ok(None);
         }
         st.started = world.time;
     }
@@ -106,7 +107,7 @@ fn advance(
             }
             if st.stopped != 0 {
                 world.cracks.as_mut().expect("a growing crack").tips[f] = st;
-                return Ok(());
+                return Ok(None);
             }
             st.count_cycles(mean(&rate));
             let dk = mean(&rated.iter().map(|r| r.1).collect::<Vec<_>>());
@@ -167,6 +168,7 @@ fn advance(
         .collect();
     let grown = mean(&moved);
     let moves = st.stopped == 0 && to.iter().any(Option::is_some);
+    let mut grew = None;
     if moves {
         let k = rows.map_or([f64::NAN; 2], |r| {
             [0, 1].map(|m| mean(&r.iter().map(|t| t.k[m]).collect::<Vec<_>>()))
@@ -191,7 +193,7 @@ fn advance(
         };
         let closed = line.closed;
         let cracks = world.cracks.as_mut().expect("a growing crack");
-        cracks.scratch.measured.growth.push(row);
+        grew = Some(row);
         cracks.advance_front(f, &to, closed).map_err(|e| Unstable {
             step: world.step,
             time: world.time,
@@ -209,7 +211,7 @@ fn advance(
         0.0
     };
     world.cracks.as_mut().expect("a growing crack").tips[f] = st;
-    Ok(())
+    Ok(grew)
 }
 
 /// `v` smoothed along a front by the weights 1/4, 1/2, 1/4 of each vertex and its two

@@ -19,32 +19,43 @@ pub mod stress_force;
 
 use crate::dim::{D2, D3, Dim};
 use crate::error::Unstable;
-use crate::fracture::FracturePlan;
+use crate::fracture::{FracturePlan, Measured};
+use crate::growth::GrowthRow;
 use crate::world::World;
 
 /// The systems whose algorithm differs by dimension: J and K at crack tips in 2D and at
-/// every front vertex in 3D, and the growth of tips or fronts.
+/// every front vertex in 3D, and the growth of tips or fronts. Each returns what it
+/// measured, for the step to report.
 pub trait DimSystems: Dim {
-    /// Measures J and K at every crack front of the world as the plan says.
-    fn fracture(world: &mut World<Self>, plan: &FracturePlan);
-    /// Advances the growing crack tips (2D) or fronts (3D) after a step.
-    fn grow(world: &mut World<Self>, plan: Option<&FracturePlan>) -> Result<(), Unstable>;
+    /// J and K at every crack front of the world as the plan says.
+    fn fracture(world: &World<Self>, plan: &FracturePlan) -> Measured;
+    /// Advances the growing crack tips (2D) or fronts (3D) after a step: a row per growth.
+    fn grow(
+        world: &mut World<Self>,
+        plan: Option<&FracturePlan>,
+    ) -> Result<Vec<GrowthRow>, Unstable>;
 }
 
 impl DimSystems for D2 {
-    fn fracture(world: &mut World<D2>, plan: &FracturePlan) {
-        fracture::run(world, plan)
+    fn fracture(world: &World<D2>, plan: &FracturePlan) -> Measured {
+        fracture::measure(world, plan)
     }
-    fn grow(world: &mut World<D2>, plan: Option<&FracturePlan>) -> Result<(), Unstable> {
+    fn grow(
+        world: &mut World<D2>,
+        plan: Option<&FracturePlan>,
+    ) -> Result<Vec<GrowthRow>, Unstable> {
         grow::run(world, plan)
     }
 }
 
 impl DimSystems for D3 {
-    fn fracture(world: &mut World<D3>, plan: &FracturePlan) {
-        fracture_front::run(world, plan)
+    fn fracture(world: &World<D3>, plan: &FracturePlan) -> Measured {
+        fracture_front::measure(world, plan)
     }
-    fn grow(world: &mut World<D3>, plan: Option<&FracturePlan>) -> Result<(), Unstable> {
+    fn grow(
+        world: &mut World<D3>,
+        plan: Option<&FracturePlan>,
+    ) -> Result<Vec<GrowthRow>, Unstable> {
         grow_front::run(world, plan)
     }
 }

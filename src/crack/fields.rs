@@ -3,7 +3,6 @@
 //! topology stands, and what contact measures. None of it is part of a snapshot.
 
 use crate::dim::Dim;
-use crate::fracture::Measured;
 use std::ops::Range;
 
 /// Which grid entry each particle-node pair of a particle near a crack uses, and the extra
@@ -97,8 +96,6 @@ pub struct Scratch<D: Dim> {
     /// pass and reused by the second (the cracks do not move between them); None where
     /// not needed.
     pub contact_normals: Vec<Option<(usize, D::Vec)>>,
-    /// What the fracture system last measured, until the run loop takes it.
-    pub measured: Measured,
 }
 
 impl<D: Dim> Scratch<D> {
@@ -118,7 +115,6 @@ impl<D: Dim> Default for Scratch<D> {
             disp: Displacements::default(),
             contact_dp: Vec::new(),
             contact_normals: Vec::new(),
-            measured: Measured::default(),
         }
     }
 }

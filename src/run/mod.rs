@@ -11,7 +11,7 @@ pub mod writers;
 use crate::crack::Cracks;
 use crate::dim::{D2, D3, Dim};
 use crate::error::{Unstable, UsageError};
-use crate::fracture::TipResult;
+use crate::fracture::{Measured, TipResult};
 use crate::geometry::Element;
 use crate::measure::{Expect, History, Measure, Row, balance_drift};
 use crate::output::plot::{self, Panel, Series};
@@ -246,12 +246,8 @@ fn drive<D: DimSystems>(
     {
         w.frames_in(run_dir, state.frames.len());
     }
-    // Takes what the fracture and growth systems recorded to their files and the history.
-    let take = |world: &mut World<D>, state: &mut RunState, w: &mut Option<Writers>| {
-        let Some(c) = world.cracks.as_mut() else {
-            return Ok::<(), anyhow::Error>(());
-        };
-        let m = std::mem::take(&mut c.scratch.measured);
+    // Writes what a step measured (J and K, paths, growth) to its files and the history.
+    let report = |m: Measured, state: &mut RunState, w: &mut Option<Writers>| {
         if let Some(w) = w {
             w.fracture(&m.tips, &m.paths)?;
             w.growth(&m.growth)?;
@@ -273,8 +269,8 @@ fn drive<D: DimSystems>(
     if resumed_from.is_none() {
         state.sample(&world, &probes);
         let row = *state.record(&world, world.energies());
-        schedule.measure_now(&mut world)?;
-        take(&mut world, &mut state, &mut writers)?;
+        let measured = schedule.measure_now(&mut world)?;
+        report(measured, &mut state, &mut writers)?;
         if let Some(w) = &mut writers {
             w.row(&row, &state.history)?;
             if vtk {
@@ -323,12 +319,15 @@ fn drive<D: DimSystems>(
             state.next_history,
             next == steps,
         );
-        if let Err(e) = schedule.step_measuring(&mut world, ends_at_row) {
-            stop = Stop::Unstable(e);
-            break;
-        }
+        let measured = match schedule.step_measuring(&mut world, ends_at_row) {
+            Ok(m) => m,
+            Err(e) => {
+                stop = Stop::Unstable(e);
+                break;
+            }
+        };
         state.sample(&world, &probes);
-        or_stop!(take(&mut world, &mut state, &mut writers));
+        or_stop!(report(measured, &mut state, &mut writers));
         let last = world.step == steps;
         if row_due(world.time, state.next_history, last) {
             state.next_history += output.history_interval;
