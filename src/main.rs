@@ -4,7 +4,7 @@ use clap::{Parser, Subcommand};
 use fissure::dim::{D2, D3};
 use fissure::error::{ScenarioError, UsageError};
 use fissure::measure::ExpectResult;
-use fissure::output::summary::Summary;
+use fissure::output::summary::{Status, Summary};
 use fissure::run::checkpoint::resolve;
 use fissure::run::stop::StopRequests;
 use fissure::run::{Outcome, RunOptions, resume, run};
@@ -242,7 +242,7 @@ fn stop_flag(out: &Path) -> Arc<AtomicBool> {
 /// Prints a finished run's line and its expects; the exit code says how it ended.
 fn finish(o: &Outcome, out: &Path) -> ExitCode {
     let s = &o.summary;
-    if s.status == "interrupted" {
+    if s.status == Status::Interrupted {
         eprintln!("{}", s.message.as_deref().unwrap_or("interrupted"));
         return ExitCode::from(INTERRUPTED);
     }

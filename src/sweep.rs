@@ -134,7 +134,7 @@ pub fn header(vary: &[Vary], expects: &[String]) -> String {
 pub fn row(values: &[String], summary: &Summary) -> String {
     let mut cols: Vec<String> = values.iter().map(|v| quote(v)).collect();
     cols.extend([
-        summary.status.clone(),
+        summary.status.to_string(),
         summary.particles.to_string(),
         summary.nodes.to_string(),
         summary.steps.to_string(),

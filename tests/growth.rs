@@ -7,6 +7,7 @@ mod common;
 use common::{PARIS_GROWTH, PENNY_FATIGUE, edge_plate, source};
 use fissure::dim::D3;
 use fissure::growth::GrowthRow;
+use fissure::output::summary::Status;
 use fissure::run::{Outcome, RunOptions, run, step_count};
 use fissure::scenario::build;
 use fissure::schedule::Schedule;
@@ -124,7 +125,7 @@ fn a_tip_stops_at_the_free_surface() {
         8.0e-6,
     );
     let out = run_with(&text, 2);
-    assert_eq!(out.summary.status, "completed");
+    assert_eq!(out.summary.status, Status::Completed);
     let g = &out.summary.growth[0];
     assert_eq!(g.stopped.as_deref(), Some("reached the free surface"));
     assert!(

@@ -5,6 +5,7 @@
 mod common;
 use common::{mixed_scene, source};
 use fissure::dim::{D2, D3};
+use fissure::output::summary::Status;
 use fissure::run::stop::StopRequests;
 use fissure::run::{Outcome, RunOptions, resume, run};
 use fissure::snapshot::Reader;
@@ -89,11 +90,11 @@ fn restart_is_bit_exact(text: &str, k: u64, threads: usize, name: &str) {
         },
     )
     .unwrap();
-    assert_eq!(part.summary.status, "interrupted");
+    assert_eq!(part.summary.status, Status::Interrupted);
     assert_eq!(part.summary.steps, k);
     let snap = part.snapshot.expect("a stopped run writes a snapshot");
     let resumed: Outcome = resume(&snap, &opts(&dir.join("resumed"), threads)).unwrap();
-    assert_eq!(resumed.summary.status, "completed");
+    assert_eq!(resumed.summary.status, Status::Completed);
     let steps = full.summary.steps;
     assert_eq!(resumed.summary.steps, steps);
     assert!(k < steps && steps > 20, "the stop falls inside the run");
@@ -572,7 +573,7 @@ fn resume_until_extends_a_finished_run() {
     };
     let more = resume(&snap, &later).unwrap();
     let dt = more.summary.dt;
-    assert_eq!(more.summary.status, "completed");
+    assert_eq!(more.summary.status, Status::Completed);
     assert_eq!(more.summary.steps, fissure::run::step_count(3e-6, dt));
     assert!(more.summary.steps > first.summary.steps);
     assert_eq!(
@@ -639,7 +640,7 @@ fn a_stop_during_set_up_ends_the_run_before_its_first_step() {
         },
     )
     .unwrap();
-    assert_eq!(out.summary.status, "interrupted");
+    assert_eq!(out.summary.status, Status::Interrupted);
     assert_eq!(out.summary.steps, 0);
     assert!(out.snapshot.is_none());
     let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();

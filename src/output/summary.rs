@@ -5,6 +5,38 @@ use crate::world::Energies;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
+/// How a run ended (summary.json's `status`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// Reached its end time.
+    Completed,
+    /// Stopped on request (a signal, or a pause after a set step).
+    Interrupted,
+    /// Went unstable (a NaN, a particle leaving the grid, a crack growing out of it).
+    Unstable,
+    /// An output file could not be written.
+    Failed,
+}
+
+impl Status {
+    /// The name summary.json and sweep.csv give it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Completed => "completed",
+            Status::Interrupted => "interrupted",
+            Status::Unstable => "unstable",
+            Status::Failed => "failed",
+        }
+    }
+}
+
+impl std::fmt::Display for Status {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// The run summary written to summary.json at the end of a run.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -12,9 +44,8 @@ pub struct Summary {
     pub scenario: String,
     /// 2 or 3.
     pub dimension: usize,
-    /// "completed", "interrupted" (stopped on request), "unstable" or "failed" (an output
-    /// file could not be written).
-    pub status: String,
+    /// How the run ended.
+    pub status: Status,
     /// Why the run stopped early, if it did.
     pub message: Option<String>,
     /// Particle count.
