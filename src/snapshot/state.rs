@@ -6,13 +6,16 @@
 
 use super::format::{ColumnSet, Header, Reader, SnapshotError};
 use super::topology::{self, Encoded};
+use crate::crack::Cracks;
 use crate::dim::Dim;
 use crate::fracture::{PathResult, TipResult};
 use crate::growth::{GrowthRow, TipState};
+use crate::material::Material;
 use crate::measure::{History, Row};
+use crate::particles::Particles;
 use crate::run::state::RunState;
 use crate::scenario::{Scene, Source, build};
-use crate::world::{Energies, World};
+use crate::world::{Energies, Work, World};
 use std::path::Path;
 use xxhash_rust::xxh3::xxh3_64;
 
@@ -190,9 +193,33 @@ pub struct Restored<D: Dim> {
     pub state: RunState,
 }
 
-/// Rebuilds the run stored in `r` as a `D`-dimensional run.
+/// Rebuilds the run stored in `r` as a `D`-dimensional run: the scene from the stored
+/// scenario, then each store's columns in the order [`write`] adds them.
 pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     let h = r.header.clone();
+    let (source, mut scene) = stored_scene::<D>(r, &h)?;
+    let w = &mut scene.world;
+    read_particles(r, &mut w.particles)?;
+    read_materials(r, &mut w.materials)?;
+    read_work(r, &mut w.work)?;
+    if let Some(cr) = &mut w.cracks {
+        read_cracks(r, cr)?;
+    }
+    w.time = h.time;
+    w.step = h.step;
+    w.tiles.fresh = false;
+    let history = read_history(r, h.step, scene.probes.len())?;
+    let state = read_run_state(r, history)?;
+    Ok(Restored {
+        source,
+        scene,
+        state,
+    })
+}
+
+/// The stored scenario, checked against the header (dimension, build, hash), and the scene
+/// it builds, which must have the snapshot's particle and node counts and time step.
+fn stored_scene<D: Dim>(r: &mut Reader, h: &Header) -> anyhow::Result<(Source, Scene<D>)> {
     if h.dimension as usize != D::D {
         return Err(r
             .invalid(format!(
@@ -220,8 +247,8 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     }
     let file = utf8(r, "scenario.file")?;
     let source = Source::parse(&file, &text, &[])?;
-    let mut scene = build::<D>(&source)?;
-    let w = &mut scene.world;
+    let scene = build::<D>(&source)?;
+    let w = &scene.world;
     let n = w.particles.len();
     if n as u64 != h.particles || w.grid.geom.node_count() as u64 != h.nodes {
         return Err(r
@@ -241,7 +268,13 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
             ))
             .into());
     }
-    let p = &mut w.particles;
+    Ok((source, scene))
+}
+
+/// The particle columns; the optional ones (uGIMP size, gradients, plastic state) where
+/// the rebuilt scene keeps them.
+fn read_particles<D: Dim>(r: &mut Reader, p: &mut Particles<D>) -> Result<(), SnapshotError> {
+    let n = p.len();
     p.x = r.column("particles.x", n)?;
     p.v = r.column("particles.v", n)?;
     p.x0 = r.column("particles.x0", n)?;
@@ -258,57 +291,89 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
         p.plastic_strain = r.column("particles.plastic_strain", n)?;
         p.hardened = r.column("particles.hardened", n)?;
     }
-    let nm = w.materials.len();
+    Ok(())
+}
+
+/// The elastic constants of every material.
+fn read_materials(r: &mut Reader, materials: &mut [Material]) -> Result<(), SnapshotError> {
+    let nm = materials.len();
     let youngs: Vec<f64> = r.column("materials.youngs", nm)?;
     let poisson: Vec<f64> = r.column("materials.poisson", nm)?;
     let density: Vec<f64> = r.column("materials.density", nm)?;
-    for (k, m) in w.materials.iter_mut().enumerate() {
+    for (k, m) in materials.iter_mut().enumerate() {
         *m = m.with_elastic(youngs[k], poisson[k], density[k]);
     }
+    Ok(())
+}
+
+/// The external, damping and friction work done so far.
+fn read_work(r: &mut Reader, work: &mut Work) -> Result<(), SnapshotError> {
     let run: Vec<f64> = r.column("run.work", 2)?;
-    w.work.external = run[0];
-    w.work.damping = run[1];
+    work.external = run[0];
+    work.damping = run[1];
     // A snapshot from a build that did not book friction has none to resume.
     if r.offset_of("run.friction").is_some() {
-        w.work.friction = r.column::<f64>("run.friction", 1)?[0];
+        work.friction = r.column::<f64>("run.friction", 1)?[0];
     }
-    if let Some(cr) = &mut w.cracks {
-        cr.topology = topology::read(r, &cr.topology)?;
-        let nv = cr.topology.vertex_count();
-        cr.geometry.x = r.column("cracks.x", nv)?;
-        cr.geometry.top = r.column("cracks.top", nv)?;
-        cr.geometry.bottom = r.column("cracks.bottom", nv)?;
-        // A snapshot from a build without crack growth has no tip states: none grew.
-        let fronts = cr.topology.fronts().len();
-        cr.tips = if r.offset_of("cracks.tips").is_some() {
-            let tips: Vec<f64> = r.column("cracks.tips", fronts * TipState::VALUES)?;
-            (tips.chunks_exact(TipState::VALUES))
-                .map(TipState::from_values)
-                .collect::<Option<_>>()
-                .ok_or_else(|| r.invalid("cracks.tips: a tip's growth state is not one"))?
-        } else {
-            vec![TipState::default(); fronts]
-        };
-    }
-    w.time = h.time;
-    w.step = h.step;
-    w.tiles.fresh = false;
+    Ok(())
+}
 
-    let cadence: Vec<f64> = r.column("run.cadence", 3)?;
-    let centre: Vec<f64> = r.column("run.centre", 3)?;
-    let samples = h
-        .step
+/// The crack topology (grown cracks have more vertices than the scenario builds), the
+/// vertex and surface positions, and each front's growth state.
+fn read_cracks<D: Dim>(r: &mut Reader, cr: &mut Cracks<D>) -> Result<(), SnapshotError> {
+    cr.topology = topology::read(r, &cr.topology)?;
+    let nv = cr.topology.vertex_count();
+    cr.geometry.x = r.column("cracks.x", nv)?;
+    cr.geometry.top = r.column("cracks.top", nv)?;
+    cr.geometry.bottom = r.column("cracks.bottom", nv)?;
+    // A snapshot from a build without crack growth has no tip states: none grew.
+    let fronts = cr.topology.fronts().len();
+    cr.tips = if r.offset_of("cracks.tips").is_some() {
+        let tips: Vec<f64> = r.column("cracks.tips", fronts * TipState::VALUES)?;
+        (tips.chunks_exact(TipState::VALUES))
+            .map(TipState::from_values)
+            .collect::<Option<_>>()
+            .ok_or_else(|| r.invalid("cracks.tips: a tip's growth state is not one"))?
+    } else {
+        vec![TipState::default(); fronts]
+    };
+    Ok(())
+}
+
+/// The history up to `step`: probe samples, history rows, J and K at the tips, the path
+/// record and the growth rows.
+fn read_history(r: &mut Reader, step: u64, probes: usize) -> Result<History, SnapshotError> {
+    let samples = step
         .checked_add(1)
         .ok_or_else(|| r.invalid("step count overflows"))? as usize;
     let mut history = History {
         time: r.column("history.time", samples)?,
         ..History::default()
     };
-    for k in 0..scene.probes.len() {
+    for k in 0..probes {
         history
             .probes
             .push(r.column(&format!("history.probe.{k}"), samples)?);
     }
+    history.rows = read_rows(r)?;
+    history.fracture = read_tips(r)?;
+    history.paths = read_paths(r)?;
+    // A snapshot from a build without crack growth has no growth rows.
+    if r.offset_of("history.growth.step").is_some() {
+        let steps: Vec<u64> = r.column_any("history.growth.step")?;
+        let ids: Vec<u64> = r.column("history.growth.id", steps.len())?;
+        let data: Vec<f64> = r.column("history.growth.data", steps.len() * GrowthRow::VALUES)?;
+        history.growth = (steps.iter().zip(&ids))
+            .zip(data.chunks_exact(GrowthRow::VALUES))
+            .map(|((&step, &id), d)| GrowthRow::from_values(step, (id >> 32) as u32, id as u32, d))
+            .collect();
+    }
+    Ok(history)
+}
+
+/// The history rows (energies, momenta), with the plastic and friction work of builds
+/// that booked them.
+fn read_rows(r: &mut Reader) -> Result<Vec<Row>, SnapshotError> {
     let steps: Vec<u64> = r.column_any("history.rows.step")?;
     let data: Vec<f64> = r.column("history.rows.data", steps.len() * ROW_WIDTH)?;
     // A snapshot from a build without plasticity has no plastic work: there was none.
@@ -322,10 +387,14 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     } else {
         vec![0.0; steps.len()]
     };
-    history.rows = (steps.iter().zip(plastic.iter().zip(&friction)))
+    Ok((steps.iter().zip(plastic.iter().zip(&friction)))
         .zip(data.chunks_exact(ROW_WIDTH))
         .map(|((&s, (&wp, &wf)), d)| row_from(s, d, wp, wf))
-        .collect();
+        .collect())
+}
+
+/// J and K at the tips over time.
+fn read_tips(r: &mut Reader) -> Result<Vec<TipResult>, SnapshotError> {
     let tip_steps: Vec<u64> = r.column_any("history.fracture.step")?;
     let tip_ids: Vec<u64> = r.column("history.fracture.tip", tip_steps.len())?;
     // A snapshot from a build without the length and speed columns has two values fewer
@@ -335,7 +404,7 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
         .into_iter()
         .find(|w| data.len() == tip_steps.len() * w)
         .ok_or_else(|| r.invalid("history.fracture.data: rows of an unknown width"))?;
-    history.fracture = tip_steps
+    Ok(tip_steps
         .iter()
         .zip(&tip_ids)
         .zip(data.chunks_exact(width))
@@ -347,12 +416,16 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
             }
             TipResult::from_values(step, d[0], (id >> 32) as u32, id as u32, &v)
         })
-        .collect();
+        .collect())
+}
+
+/// J on the compared contours over time.
+fn read_paths(r: &mut Reader) -> Result<Vec<PathResult>, SnapshotError> {
     let path_steps: Vec<u64> = r.column_any("history.paths.step")?;
     let path_ids: Vec<u64> = r.column("history.paths.id", path_steps.len())?;
     let contours: Vec<u64> = r.column("history.paths.contour", path_steps.len())?;
     let data: Vec<f64> = r.column("history.paths.data", path_steps.len() * PATH_WIDTH)?;
-    history.paths = path_steps
+    Ok(path_steps
         .iter()
         .zip(path_ids.iter().zip(&contours))
         .zip(data.chunks_exact(PATH_WIDTH))
@@ -365,29 +438,21 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
             line: [d[1], d[2]],
             area: [d[3], d[4]],
         })
-        .collect();
-    // A snapshot from a build without crack growth has no growth rows.
-    if r.offset_of("history.growth.step").is_some() {
-        let steps: Vec<u64> = r.column_any("history.growth.step")?;
-        let ids: Vec<u64> = r.column("history.growth.id", steps.len())?;
-        let data: Vec<f64> = r.column("history.growth.data", steps.len() * GrowthRow::VALUES)?;
-        history.growth = (steps.iter().zip(&ids))
-            .zip(data.chunks_exact(GrowthRow::VALUES))
-            .map(|((&step, &id), d)| GrowthRow::from_values(step, (id >> 32) as u32, id as u32, d))
-            .collect();
-    }
-    let state = RunState {
+        .collect())
+}
+
+/// The run-loop state: output and checkpoint cadence, frames written, the centre of mass
+/// angular momentum is taken about.
+fn read_run_state(r: &mut Reader, history: History) -> Result<RunState, SnapshotError> {
+    let cadence: Vec<f64> = r.column("run.cadence", 3)?;
+    let centre: Vec<f64> = r.column("run.centre", 3)?;
+    Ok(RunState {
         history,
         next_history: cadence[0],
         next_frame: cadence[1],
         next_checkpoint: cadence[2],
         frames: r.column_any("run.frames")?,
         centre: [centre[0], centre[1], centre[2]],
-    };
-    Ok(Restored {
-        source,
-        scene,
-        state,
     })
 }
 
