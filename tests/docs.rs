@@ -80,7 +80,7 @@ fn every_key_the_parser_accepts_is_in_the_scenario_format_chapter() {
     let mut missing = Vec::new();
     for (file, table) in TABLES {
         let set = format!("{table}zz_not_a_key=1");
-        let err = match Source::load(Path::new(file), &[set.clone()]) {
+        let err = match Source::load(Path::new(file), std::slice::from_ref(&set)) {
             Ok(_) => panic!("{file}: --set {set} was accepted"),
             Err(e) => e.to_string(),
         };
