@@ -406,8 +406,9 @@ impl Expect {
     }
 }
 
+/// The value an expect measures in the history, None where it has none (or a non-finite
+/// one).
 fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
-    let finite = |v: f64| v.is_finite().then_some(v);
     match *m {
         Measure::Final { probe, at } => {
             let samples = &h.probes[probe];
@@ -419,49 +420,14 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             tip,
             qty,
             at,
-        } => {
-            let value = |r: &TipResult| [r.k[0], r.k[1], r.j[0], r.j[1]][qty];
-            let mut rows = h
-                .fracture
-                .iter()
-                .filter(|r| r.crack == crack && r.tip == tip);
-            let Some(t) = at else {
-                return finite(value(rows.next_back()?));
-            };
-            let rows: Vec<&TipResult> = rows.collect();
-            let k = rows.iter().position(|r| r.time >= t)?;
-            if k == 0 {
-                return (rows[0].time == t).then(|| value(rows[0])).and_then(finite);
-            }
-            let (a, b) = (rows[k - 1], rows[k]);
-            let w = (t - a.time) / (b.time - a.time);
-            finite(value(a) + w * (value(b) - value(a)))
-        }
+        } => tip_value(h, crack, tip, qty, at),
         Measure::Front {
             crack,
             qty,
             reference,
             along,
             near,
-        } => {
-            let rows = last_rows(h, crack)?;
-            let factors = match along {
-                Some(a) => a.factors(&rows.iter().map(|r| r.x).collect::<Vec<_>>()),
-                None => vec![1.0; rows.len()],
-            };
-            let nearest = near.map(|p| nearest_row(&rows, p));
-            rows.iter()
-                .zip(factors)
-                .enumerate()
-                .filter(|(k, _)| nearest.is_none_or(|n| n == Some(*k)))
-                .map(|(_, rf)| rf)
-                .map(|(r, f)| [r.k[0], r.k[1], r.k[2], r.j[0]][qty] - reference * f)
-                .try_fold(0.0, |worst: f64, d| {
-                    let d = finite(d)?;
-                    Some(if d.abs() > worst.abs() { d } else { worst })
-                })
-                .map(|d| reference + d)
-        }
+        } => front_value(h, crack, qty, reference, along, near),
         Measure::JEta {
             crack,
             tip,
@@ -494,56 +460,8 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
             main,
             ref compare,
             from,
-        } => {
-            let tips: Vec<u32> = match (tip, near) {
-                (Some(t), _) => vec![t],
-                (None, Some(p)) => {
-                    let rows = last_rows(h, crack)?;
-                    vec![rows[nearest_row(&rows, p)?].tip]
-                }
-                (None, None) => path_tips(h, crack),
-            };
-            (tips.iter())
-                .flat_map(|&t| compare.iter().map(move |&n| (t, n)))
-                .map(|(t, n)| path_difference(h, crack, t, main, n, from, true))
-                .try_fold(None, |worst: Option<f64>, d| {
-                    d.map(|d| Some(worst.map_or(d, |w| w.max(d))))
-                })
-                .flatten()
-                .and_then(finite)
-        }
-        Measure::Growth { crack, tip, qty } => {
-            let rows: Vec<&GrowthRow> = (h.growth.iter())
-                .filter(|g| g.crack == crack && g.tip == tip)
-                .collect();
-            match qty {
-                GrowthQty::Kink => finite(rows.first()?.kink.to_degrees()),
-                GrowthQty::PathAngle => {
-                    let last = rows.last()?;
-                    let from = rows.iter().find(|g| g.grown >= 0.75 * last.grown)?;
-                    let (dx, dy) = (last.x[0] - from.x[0], last.x[1] - from.x[1]);
-                    let a = if from.step == last.step {
-                        last.heading.to_degrees()
-                    } else {
-                        dy.atan2(dx).to_degrees()
-                    };
-                    finite(a - 180.0 * ((a + 90.0) / 180.0).ceil() + 180.0)
-                }
-                GrowthQty::Turn => {
-                    let (first, last) = (rows.first()?, rows.last()?);
-                    let chord = (last.x[1] - first.x[1]).atan2(last.x[0] - first.x[0]);
-                    let turn = (chord - (first.heading - first.kink)).to_degrees();
-                    finite(turn - 360.0 * ((turn + 180.0) / 360.0).ceil() + 360.0)
-                }
-                GrowthQty::Cycles(length) => {
-                    // The lengths are sums of extensions: allow for their rounding.
-                    let k = rows.iter().position(|g| g.grown >= length * (1.0 - 1e-9))?;
-                    let (a, b) = (rows[k.checked_sub(1)?], rows[k]);
-                    let w = (length - a.grown) / (b.grown - a.grown);
-                    finite(a.fatigue[1] + w * (b.fatigue[1] - a.fatigue[1]))
-                }
-            }
-        }
+        } => path_value(h, crack, tip, near, main, compare, from),
+        Measure::Growth { crack, tip, qty } => growth_value(h, crack, tip, qty),
         Measure::Max(p) => h.probes[p].iter().copied().reduce(f64::max),
         Measure::Min(p) => h.probes[p].iter().copied().reduce(f64::min),
         Measure::Frequency(p) => frequency(&h.time, &h.probes[p]),
@@ -580,6 +498,125 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
         Measure::AngularMomentumDrift => {
             let (first, last) = (h.rows.first()?, h.rows.last()?);
             finite(norm3(sub3(last.angular, first.angular)) / norm3(first.angular))
+        }
+    }
+}
+
+/// `v` if finite.
+fn finite(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
+/// K_I, K_II, J_x or J_y (`qty` 0..4) at a 2D tip: the last value, or at time `at`
+/// (interpolated between the rows around it).
+fn tip_value(h: &History, crack: u32, tip: u32, qty: usize, at: Option<f64>) -> Option<f64> {
+    let value = |r: &TipResult| [r.k[0], r.k[1], r.j[0], r.j[1]][qty];
+    let mut rows = h
+        .fracture
+        .iter()
+        .filter(|r| r.crack == crack && r.tip == tip);
+    let Some(t) = at else {
+        return finite(value(rows.next_back()?));
+    };
+    let rows: Vec<&TipResult> = rows.collect();
+    let k = rows.iter().position(|r| r.time >= t)?;
+    if k == 0 {
+        return (rows[0].time == t).then(|| value(rows[0])).and_then(finite);
+    }
+    let (a, b) = (rows[k - 1], rows[k]);
+    let w = (t - a.time) / (b.time - a.time);
+    finite(value(a) + w * (value(b) - value(a)))
+}
+
+/// K_I, K_II, K_III or J (`qty` 0..4) along a 3D front at the last measurement: the value
+/// farthest from its reference (`reference` times the `along` shape) over the vertices, or
+/// at the vertex nearest `near`.
+fn front_value(
+    h: &History,
+    crack: u32,
+    qty: usize,
+    reference: f64,
+    along: Option<Along>,
+    near: Option<[f64; 3]>,
+) -> Option<f64> {
+    let rows = last_rows(h, crack)?;
+    let factors = match along {
+        Some(a) => a.factors(&rows.iter().map(|r| r.x).collect::<Vec<_>>()),
+        None => vec![1.0; rows.len()],
+    };
+    let nearest = near.map(|p| nearest_row(&rows, p));
+    rows.iter()
+        .zip(factors)
+        .enumerate()
+        .filter(|(k, _)| nearest.is_none_or(|n| n == Some(*k)))
+        .map(|(_, rf)| rf)
+        .map(|(r, f)| [r.k[0], r.k[1], r.k[2], r.j[0]][qty] - reference * f)
+        .try_fold(0.0, |worst: f64, d| {
+            let d = finite(d)?;
+            Some(if d.abs() > worst.abs() { d } else { worst })
+        })
+        .map(|d| reference + d)
+}
+
+/// The largest path difference of J between the main contour and the compared ones, at
+/// a tip, at the front vertex nearest `near`, or over every tip.
+fn path_value(
+    h: &History,
+    crack: u32,
+    tip: Option<u32>,
+    near: Option<[f64; 3]>,
+    main: u32,
+    compare: &[u32],
+    from: f64,
+) -> Option<f64> {
+    let tips: Vec<u32> = match (tip, near) {
+        (Some(t), _) => vec![t],
+        (None, Some(p)) => {
+            let rows = last_rows(h, crack)?;
+            vec![rows[nearest_row(&rows, p)?].tip]
+        }
+        (None, None) => path_tips(h, crack),
+    };
+    (tips.iter())
+        .flat_map(|&t| compare.iter().map(move |&n| (t, n)))
+        .map(|(t, n)| path_difference(h, crack, t, main, n, from, true))
+        .try_fold(None, |worst: Option<f64>, d| {
+            d.map(|d| Some(worst.map_or(d, |w| w.max(d))))
+        })
+        .flatten()
+        .and_then(finite)
+}
+
+/// A growing tip's kink, path angle, turn or cycles to a length (degrees, cycles).
+fn growth_value(h: &History, crack: u32, tip: u32, qty: GrowthQty) -> Option<f64> {
+    let rows: Vec<&GrowthRow> = (h.growth.iter())
+        .filter(|g| g.crack == crack && g.tip == tip)
+        .collect();
+    match qty {
+        GrowthQty::Kink => finite(rows.first()?.kink.to_degrees()),
+        GrowthQty::PathAngle => {
+            let last = rows.last()?;
+            let from = rows.iter().find(|g| g.grown >= 0.75 * last.grown)?;
+            let (dx, dy) = (last.x[0] - from.x[0], last.x[1] - from.x[1]);
+            let a = if from.step == last.step {
+                last.heading.to_degrees()
+            } else {
+                dy.atan2(dx).to_degrees()
+            };
+            finite(a - 180.0 * ((a + 90.0) / 180.0).ceil() + 180.0)
+        }
+        GrowthQty::Turn => {
+            let (first, last) = (rows.first()?, rows.last()?);
+            let chord = (last.x[1] - first.x[1]).atan2(last.x[0] - first.x[0]);
+            let turn = (chord - (first.heading - first.kink)).to_degrees();
+            finite(turn - 360.0 * ((turn + 180.0) / 360.0).ceil() + 360.0)
+        }
+        GrowthQty::Cycles(length) => {
+            // The lengths are sums of extensions: allow for their rounding.
+            let k = rows.iter().position(|g| g.grown >= length * (1.0 - 1e-9))?;
+            let (a, b) = (rows[k.checked_sub(1)?], rows[k]);
+            let w = (length - a.grown) / (b.grown - a.grown);
+            finite(a.fatigue[1] + w * (b.fatigue[1] - a.fatigue[1]))
         }
     }
 }

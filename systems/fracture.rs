@@ -9,6 +9,7 @@ use crate::dim::{D2, Dim};
 use crate::fracture::{
     FracturePlan, KMethod, Measured, PathResult, TipResult, k_from_g, k_from_mixity, k_from_opening,
 };
+use crate::grid::GridGeom;
 use crate::growth::TipState;
 use crate::interaction::{Tip, interaction_k, near};
 use crate::shape::Stencil;
@@ -267,59 +268,177 @@ fn contour_j(
     n: usize,
     area_term: bool,
 ) -> Option<ContourJ> {
-    let g = &world.grid;
-    let geom = &g.geom;
-    // The contour around the node nearest the tip, shrunk to fit inside the grid.
-    let node = |a: usize| ((xt[a] - geom.origin[a]) * geom.inv_h[a]).round().max(0.0) as usize;
-    let (i0, j0) = (node(0), node(1));
-    let room = i0
-        .min(j0)
-        .min(geom.cells[0] - i0.min(geom.cells[0]))
-        .min(geom.cells[1] - j0.min(geom.cells[1]));
-    let n = n.min(room);
-    if n == 0 {
-        return None;
-    }
-    let ring = contour(i0, j0, n);
-    let pos = |q: [usize; 2]| {
-        [
-            geom.origin[0] + q[0] as f64 * geom.h[0],
-            geom.origin[1] + q[1] as f64 * geom.h[1],
-        ]
-    };
-    let index = |q: [usize; 2]| q[0] + geom.stride[1] * q[1];
-
-    // Where the crack leaves the contour: edge e at parameter s, crossing crack segment k.
-    let mut cut = None;
-    'find: for e in 0..ring.len() - 1 {
-        let (a, b) = (pos(ring[e]), pos(ring[e + 1]));
-        for w in path.windows(2) {
-            let (ca, cb) = (xy(cracks.geometry.x[w[0]]), xy(cracks.geometry.x[w[1]]));
-            if let Some(s) = intersect(a, b, ca, cb) {
-                cut = Some((e, s, (ca, cb)));
-                break 'find;
-            }
-        }
-    }
-    let (e, s, (ca, cb)) = cut?;
-    // The path starts on the side of the crack that ring[e + 1] is on and ends on the other.
-    let after = pos(ring[e + 1]);
-    let orient = (cb[0] - ca[0]) * (after[1] - ca[1]) - (cb[1] - ca[1]) * (after[0] - ca[0]);
-    let first: i8 = if orient >= 0.0 { 1 } else { -1 };
+    let k = Contour::around(&world.grid.geom, cracks, path, xt, n)?;
     let fields = &cracks.scratch.fields;
-
     // Nodal values of every field at the contour nodes (Eq. 11).
     let mut acc: HashMap<usize, [f64; 10]> = HashMap::new();
-    for q in &ring {
-        let nidx = index(*q);
+    for q in &k.ring {
+        let nidx = k.index(*q);
         acc.insert(nidx, [0.0; 10]);
         for r in fields.rows_of(nidx as u32) {
             acc.insert(r, [0.0; 10]);
         }
     }
+    let gathered = gather(world, cracks, &k, xt, area_term, &mut acc);
+    let value = |entry: usize| -> Nodal {
+        let a = acc.get(&entry).copied().unwrap_or([0.0; 10]);
+        if a[0] <= world.settings.mass_tol {
+            return Nodal::default();
+        }
+        let m = a[0];
+        Nodal {
+            s: [a[1] / m, a[2] / m, a[3] / m],
+            gu: [a[4] / m, a[5] / m, a[6] / m, a[7] / m],
+            w: a[8] / m,
+            k: a[9] / m,
+        }
+    };
+    let color = cracks.scratch.color(c);
+    let at = |q: usize, side: i8| value(fields.side_entry(k.index(k.ring[q]), color, side));
+    Some(ContourJ {
+        line: k.line_integral(at),
+        ..gathered
+    })
+}
+
+/// A square contour of n cells along grid lines about the node nearest a tip, and where
+/// the crack leaves it.
+struct Contour<'a> {
+    geom: &'a GridGeom<D2>,
+    /// Its nodes in order, the first repeated at the end.
+    ring: Vec<[usize; 2]>,
+    /// Its lower-left and upper-right corners (m).
+    lo: [f64; 2],
+    hi: [f64; 2],
+    /// The edge the crack crosses (from ring[edge] to ring[edge + 1]) and where along it.
+    edge: usize,
+    s: f64,
+    /// The side of the crack the path starts on: that of ring[edge + 1].
+    first: i8,
+}
+
+impl<'a> Contour<'a> {
+    /// The contour of `n` cells (shrunk to fit inside the grid) about the node nearest the
+    /// tip `xt`, cut where it first crosses the crack `path`; None if it has no room or
+    /// the crack does not cross it.
+    fn around(
+        geom: &'a GridGeom<D2>,
+        cracks: &Cracks<D2>,
+        path: &[usize],
+        xt: [f64; 2],
+        n: usize,
+    ) -> Option<Self> {
+        let node = |a: usize| ((xt[a] - geom.origin[a]) * geom.inv_h[a]).round().max(0.0) as usize;
+        let (i0, j0) = (node(0), node(1));
+        let room = i0
+            .min(j0)
+            .min(geom.cells[0] - i0.min(geom.cells[0]))
+            .min(geom.cells[1] - j0.min(geom.cells[1]));
+        let n = n.min(room);
+        if n == 0 {
+            return None;
+        }
+        let mut k = Contour {
+            geom,
+            ring: contour(i0, j0, n),
+            lo: [0.0; 2],
+            hi: [0.0; 2],
+            edge: 0,
+            s: 0.0,
+            first: 1,
+        };
+        (k.lo, k.hi) = (k.pos([i0 - n, j0 - n]), k.pos([i0 + n, j0 + n]));
+        // Where the crack leaves the contour: edge e at parameter s, crossing crack segment k.
+        let mut cut = None;
+        'find: for e in 0..k.ring.len() - 1 {
+            let (a, b) = (k.pos(k.ring[e]), k.pos(k.ring[e + 1]));
+            for w in path.windows(2) {
+                let (ca, cb) = (xy(cracks.geometry.x[w[0]]), xy(cracks.geometry.x[w[1]]));
+                if let Some(s) = intersect(a, b, ca, cb) {
+                    cut = Some((e, s, (ca, cb)));
+                    break 'find;
+                }
+            }
+        }
+        let (e, s, (ca, cb)) = cut?;
+        // The path starts on the side of the crack that ring[e + 1] is on and ends on the other.
+        let after = k.pos(k.ring[e + 1]);
+        let orient = (cb[0] - ca[0]) * (after[1] - ca[1]) - (cb[1] - ca[1]) * (after[0] - ca[0]);
+        k.first = if orient >= 0.0 { 1 } else { -1 };
+        (k.edge, k.s) = (e, s);
+        Some(k)
+    }
+
+    /// Position of grid node `q` (m).
+    fn pos(&self, q: [usize; 2]) -> [f64; 2] {
+        let geom = self.geom;
+        [
+            geom.origin[0] + q[0] as f64 * geom.h[0],
+            geom.origin[1] + q[1] as f64 * geom.h[1],
+        ]
+    }
+
+    /// Linear index of grid node `q`.
+    fn index(&self, q: [usize; 2]) -> usize {
+        q[0] + self.geom.stride[1] * q[1]
+    }
+
+    /// The line integral (Eq. 7) along the split path: crossing point, ring[e + 1], ...,
+    /// ring[e], crossing point (Eq. 12), by the trapezoidal rule on each edge, with `at(q,
+    /// side)` the nodal values of contour node q on the given side of the crack.
+    fn line_integral(&self, at: impl Fn(usize, i8) -> Nodal) -> [f64; 2] {
+        let (e, s, first, ring) = (self.edge, self.s, self.first, &self.ring);
+        let m = ring.len() - 1;
+        let order: Vec<usize> = (1..=m).map(|q| (e + q) % m).collect();
+        let cross = {
+            let (a, b) = (self.pos(ring[e]), self.pos(ring[e + 1]));
+            [a[0] + (b[0] - a[0]) * s, a[1] + (b[1] - a[1]) * s]
+        };
+        let mut pts = vec![cross];
+        let mut vals = vec![Nodal::lerp(&at(e, first), &at(e + 1, first), s)];
+        for (q, &r) in order.iter().enumerate() {
+            let side = if 2 * q < order.len() { first } else { -first };
+            pts.push(self.pos(ring[r]));
+            vals.push(at(r, side));
+        }
+        pts.push(cross);
+        vals.push(Nodal::lerp(&at(e, -first), &at(e + 1, -first), s));
+        let mut j = [0.0; 2];
+        for q in 0..pts.len() - 1 {
+            let (a, b) = (pts[q], pts[q + 1]);
+            let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+            if len == 0.0 {
+                continue;
+            }
+            let normal = [(b[1] - a[1]) / len, -(b[0] - a[0]) / len];
+            let (fa, fb) = (vals[q].integrand(normal), vals[q + 1].integrand(normal));
+            for (mm, jm) in j.iter_mut().enumerate() {
+                *jm += 0.5 * (fa[mm] + fb[mm]) * len;
+            }
+        }
+        j
+    }
+}
+
+/// Extrapolates the particles near contour `k` to its nodes' fields (mass-weighted sums
+/// into `acc`, Eq. 11) and, with `area_term`, integrates the area term (Eq. 8) over the
+/// particles inside it. Also finds the particle nearest the tip `xt` and whether a
+/// yielded particle lies on the contour's band (J is then not K's). The returned line
+/// integral is left at zero.
+fn gather(
+    world: &World<D2>,
+    cracks: &Cracks<D2>,
+    k: &Contour,
+    xt: [f64; 2],
+    area_term: bool,
+    acc: &mut HashMap<usize, [f64; 10]>,
+) -> ContourJ {
+    let g = &world.grid;
+    let geom = &g.geom;
+    let fields = &cracks.scratch.fields;
     let p = &world.particles;
     let shape = world.settings.shape;
-    let (lo, hi) = (pos([i0 - n, j0 - n]), pos([i0 + n, j0 + n]));
+    let (lo, hi) = (k.lo, k.hi);
     let reach = 2.0 * geom.h[0].max(geom.h[1]);
     let mut area = [0.0; 2];
     let mut nearest = (f64::INFINITY, 0usize);
@@ -404,57 +523,12 @@ fn contour_j(
             }
         }
     }
-    let value = |entry: usize| -> Nodal {
-        let a = acc.get(&entry).copied().unwrap_or([0.0; 10]);
-        if a[0] <= world.settings.mass_tol {
-            return Nodal::default();
-        }
-        let m = a[0];
-        Nodal {
-            s: [a[1] / m, a[2] / m, a[3] / m],
-            gu: [a[4] / m, a[5] / m, a[6] / m, a[7] / m],
-            w: a[8] / m,
-            k: a[9] / m,
-        }
-    };
-
-    // The split path: crossing point, ring[e + 1], ..., ring[e], crossing point (Eq. 12).
-    let m = ring.len() - 1;
-    let order: Vec<usize> = (1..=m).map(|q| (e + q) % m).collect();
-    let color = cracks.scratch.color(c);
-    let at = |q: usize, side: i8| value(fields.side_entry(index(ring[q]), color, side));
-    let cross = {
-        let (a, b) = (pos(ring[e]), pos(ring[e + 1]));
-        [a[0] + (b[0] - a[0]) * s, a[1] + (b[1] - a[1]) * s]
-    };
-    let mut pts = vec![cross];
-    let mut vals = vec![Nodal::lerp(&at(e, first), &at(e + 1, first), s)];
-    for (q, &r) in order.iter().enumerate() {
-        let side = if 2 * q < order.len() { first } else { -first };
-        pts.push(pos(ring[r]));
-        vals.push(at(r, side));
-    }
-    pts.push(cross);
-    vals.push(Nodal::lerp(&at(e, -first), &at(e + 1, -first), s));
-    let mut j = [0.0; 2];
-    for q in 0..pts.len() - 1 {
-        let (a, b) = (pts[q], pts[q + 1]);
-        let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
-        if len == 0.0 {
-            continue;
-        }
-        let normal = [(b[1] - a[1]) / len, -(b[0] - a[0]) / len];
-        let (fa, fb) = (vals[q].integrand(normal), vals[q + 1].integrand(normal));
-        for (mm, jm) in j.iter_mut().enumerate() {
-            *jm += 0.5 * (fa[mm] + fb[mm]) * len;
-        }
-    }
-    Some(ContourJ {
-        line: j,
+    ContourJ {
+        line: [0.0; 2],
         area,
         nearest: nearest.1,
         plastic,
-    })
+    }
 }
 
 /// Opening and sliding amplitudes behind a tip, for splitting G (Eqs. 14-22). The paper reads

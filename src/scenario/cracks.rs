@@ -47,94 +47,9 @@ pub(super) fn build<D: Dim>(
     let occupied = Occupied::new(particles, geom);
     let mut store = Cracks::<D>::default();
     for (c, spec) in specs.iter().enumerate() {
-        let piece = if D::D == 2 {
-            polyline::<D>(src, c, spec, geom)?
-        } else {
-            let s = surface::surface(src, c, spec, geom.min_cell())?;
-            let piece = Piece {
-                key: format!("crack[{c}]"),
-                points: s
-                    .vertices
-                    .iter()
-                    .map(|v| D::from_slice(&v.to_array()))
-                    .collect(),
-                elems: s
-                    .triangles
-                    .iter()
-                    .map(|t| D::Elem::from_vertices(t))
-                    .collect(),
-                fronts: if s.front.is_empty() {
-                    Vec::new()
-                } else {
-                    vec![(0, s.front)]
-                },
-            };
-            let tol = 1e-6 * geom.min_cell();
-            if let Some((a, b)) =
-                super::crack_meet::self_meets::<D>(&piece.points, &piece.elems, tol)
-            {
-                return Err(src.error(
-                    &piece.key,
-                    format!(
-                        "the surface meets itself (triangles {a} and {b}, which share no \
-                         vertex, cross or touch)"
-                    ),
-                ));
-            }
-            piece
-        };
-        // Every vertex lies in the grid and every front vertex in a body; the rest may
-        // overhang a body's edge by any length (a crack that cuts through it), so that a
-        // scene keeps its cracks when its cells are refined.
-        let front: Vec<u32> = piece.fronts.iter().flat_map(|f| f.1.clone()).collect();
-        let mut touches = false;
-        for (j, x) in piece.points.iter().enumerate() {
-            let at = D::to_xyz(*x);
-            let at = at[..D::D]
-                .iter()
-                .map(|c| format!("{c:e}"))
-                .collect::<Vec<_>>();
-            if !geom.fits(crate::shape::ShapeKind::Linear, *x, D::zero()) {
-                return Err(src.error(
-                    &piece.key,
-                    format!("vertex {j} at ({}) m lies outside the grid", at.join(", ")),
-                ));
-            }
-            let near = occupied.near(*x);
-            touches |= near;
-            if !near && front.contains(&(j as u32)) {
-                return Err(src.error(
-                    &piece.key,
-                    format!(
-                        "front vertex {j} at ({}) m is outside every body (more than \
-                         {REACH_CELLS} cells from any particle)",
-                        at.join(", ")
-                    ),
-                ));
-            }
-        }
-        if !touches {
-            return Err(src.error(
-                &piece.key,
-                format!(
-                    "the crack is outside every body (no vertex within {REACH_CELLS} cells of a \
-                     particle)"
-                ),
-            ));
-        }
-        if let Some((k, mine, theirs)) =
-            super::crack_meet::meets(&store, &piece.points, &piece.elems, 1e-6 * geom.min_cell())
-        {
-            let what = if D::D == 2 { "segment" } else { "triangle" };
-            return Err(src.error(
-                &piece.key,
-                format!(
-                    "the crack meets crack `{}` (its {what} {mine} and their {what} {theirs}): \
-                     cracks must not cross or touch",
-                    store.topology.cracks()[k].name
-                ),
-            ));
-        }
+        let piece = piece::<D>(src, c, spec, geom)?;
+        placed(src, &piece, geom, &occupied)?;
+        apart(src, &store, &piece, geom)?;
         let contact = contact(src, c, spec)?;
         let name = spec.name.clone().unwrap_or_else(|| format!("crack{c}"));
         super::check::csv_name(src, &format!("crack[{c}].name"), &name)?;
@@ -182,6 +97,110 @@ pub(super) fn build<D: Dim>(
     g.bottom = g.x.clone();
     store.tips = vec![TipState::default(); store.topology.fronts().len()];
     Ok(Some(store))
+}
+
+/// Crack `c` as a piece: a polyline in 2D, a triangulated surface in 3D that does not meet
+/// itself.
+fn piece<D: Dim>(src: &Source, c: usize, spec: &CrackSpec, geom: &GridGeom<D>) -> R<Piece<D>> {
+    if D::D == 2 {
+        return polyline::<D>(src, c, spec, geom);
+    }
+    let s = surface::surface(src, c, spec, geom.min_cell())?;
+    let piece = Piece {
+        key: format!("crack[{c}]"),
+        points: s
+            .vertices
+            .iter()
+            .map(|v| D::from_slice(&v.to_array()))
+            .collect(),
+        elems: s
+            .triangles
+            .iter()
+            .map(|t| D::Elem::from_vertices(t))
+            .collect(),
+        fronts: if s.front.is_empty() {
+            Vec::new()
+        } else {
+            vec![(0, s.front)]
+        },
+    };
+    let tol = 1e-6 * geom.min_cell();
+    if let Some((a, b)) = super::crack_meet::self_meets::<D>(&piece.points, &piece.elems, tol) {
+        return Err(src.error(
+            &piece.key,
+            format!(
+                "the surface meets itself (triangles {a} and {b}, which share no \
+                 vertex, cross or touch)"
+            ),
+        ));
+    }
+    Ok(piece)
+}
+
+/// Every vertex of `piece` lies in the grid and every front vertex in a body; the rest may
+/// overhang a body's edge by any length (a crack that cuts through it), so that a scene
+/// keeps its cracks when its cells are refined. Some vertex must lie in a body.
+fn placed<D: Dim>(
+    src: &Source,
+    piece: &Piece<D>,
+    geom: &GridGeom<D>,
+    occupied: &Occupied<D>,
+) -> R<()> {
+    let front: Vec<u32> = piece.fronts.iter().flat_map(|f| f.1.clone()).collect();
+    let mut touches = false;
+    for (j, x) in piece.points.iter().enumerate() {
+        let at = D::to_xyz(*x);
+        let at = at[..D::D]
+            .iter()
+            .map(|c| format!("{c:e}"))
+            .collect::<Vec<_>>();
+        if !geom.fits(crate::shape::ShapeKind::Linear, *x, D::zero()) {
+            return Err(src.error(
+                &piece.key,
+                format!("vertex {j} at ({}) m lies outside the grid", at.join(", ")),
+            ));
+        }
+        let near = occupied.near(*x);
+        touches |= near;
+        if !near && front.contains(&(j as u32)) {
+            return Err(src.error(
+                &piece.key,
+                format!(
+                    "front vertex {j} at ({}) m is outside every body (more than \
+                     {REACH_CELLS} cells from any particle)",
+                    at.join(", ")
+                ),
+            ));
+        }
+    }
+    if !touches {
+        return Err(src.error(
+            &piece.key,
+            format!(
+                "the crack is outside every body (no vertex within {REACH_CELLS} cells of a \
+                 particle)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `piece` keeps apart from the cracks already in `store`: no crossing or touching.
+fn apart<D: Dim>(src: &Source, store: &Cracks<D>, piece: &Piece<D>, geom: &GridGeom<D>) -> R<()> {
+    if let Some((k, mine, theirs)) =
+        super::crack_meet::meets(store, &piece.points, &piece.elems, 1e-6 * geom.min_cell())
+    {
+        let what = if D::D == 2 { "segment" } else { "triangle" };
+        return Err(src.error(
+            &piece.key,
+            format!(
+                "the crack meets crack `{}` (its {what} {mine} and their {what} {theirs}): \
+                 cracks must not cross or touch",
+                store.topology.cracks()[k].name
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// One crack before it joins the store: the key errors about its vertices name, its
