@@ -118,21 +118,7 @@ fn advance(
             (smooth(&on, line.closed), [f64::NAN; 2])
         }
     };
-    // Each vertex's turn from x1 towards x2: the hoop angle of its K (none where K was not
-    // read), smoothed along the front.
-    let turn = match g.direction {
-        Direction::Hoop => {
-            let raw: Vec<f64> = (0..n)
-                .map(|i| {
-                    let [k1, k2, _] = reading(i);
-                    let t = hoop_angle(k1, k2);
-                    if t.is_finite() { t } else { 0.0 }
-                })
-                .collect();
-            smooth(&raw, line.closed)
-        }
-        Direction::Straight => vec![0.0; n],
-    };
+    let turn = turns(g.direction, (0..n).map(reading), line.closed);
     let h = (0..3).map(|a| world.grid.geom.h[a]).fold(0.0, f64::max);
     let ds: Vec<f64> = share.iter().map(|s| s * g.extension).collect();
     let to: Vec<Option<DVec3>> = (line.frames.iter().zip(&ds).zip(&turn))
@@ -141,25 +127,8 @@ fn advance(
         })
         .collect();
     let c = front.crack as usize;
-    let name = &cracks.topology.cracks()[c].name;
-    for t in to.iter().flatten() {
-        if !t.is_finite() {
-            st.stopped = Stopped::Unmeasured as u8;
-        } else if !world.grid.geom.fits(ShapeKind::Linear, *t, DVec3::ZERO) {
-            return Err(Unstable {
-                step: world.step,
-                time: world.time,
-                what: format!(
-                    "crack `{name}` grew out of the grid: a front vertex reached \
-                     ({:.6e}, {:.6e}, {:.6e}) m",
-                    t.x, t.y, t.z
-                ),
-            });
-        } else if fracture_front::room(cracks, c, *t, 0.25 * h) < 0.25 * h {
-            st.stopped = Stopped::Crack as u8;
-        } else if !inside(world, *t) {
-            st.stopped = Stopped::Surface as u8;
-        }
+    if let Some(why) = stop_at(world, c, &to, h)? {
+        st.stopped = why as u8;
     }
     // The front's mean advance, counting a vertex held for a share under a hundredth of a
     // cell as not moving.
@@ -212,6 +181,55 @@ fn advance(
     };
     world.cracks.as_mut().expect("a growing crack").tips[f] = st;
     Ok(grew)
+}
+
+/// Each vertex's turn from x1 towards x2 under `direction`: the hoop angle of its K_I and
+/// K_II (none where K was not read), smoothed along the front.
+fn turns(direction: Direction, readings: impl Iterator<Item = [f64; 3]>, closed: bool) -> Vec<f64> {
+    let raw: Vec<f64> = readings
+        .map(|[k1, k2, _]| {
+            let t = hoop_angle(k1, k2);
+            if t.is_finite() { t } else { 0.0 }
+        })
+        .collect();
+    match direction {
+        Direction::Hoop => smooth(&raw, closed),
+        Direction::Straight => vec![0.0; raw.len()],
+    }
+}
+
+/// Why the front of crack `c` stops before reaching the targets `to` (the last reason met
+/// along the front: a target not finite, within a quarter cell of another crack, or outside
+/// the body), or an error when a target leaves the grid. `h` is the largest cell side (m).
+fn stop_at(
+    world: &World<D3>,
+    c: usize,
+    to: &[Option<DVec3>],
+    h: f64,
+) -> Result<Option<Stopped>, Unstable> {
+    let cracks = world.cracks.as_ref().expect("a growing crack");
+    let name = &cracks.topology.cracks()[c].name;
+    let mut stopped = None;
+    for t in to.iter().flatten() {
+        if !t.is_finite() {
+            stopped = Some(Stopped::Unmeasured);
+        } else if !world.grid.geom.fits(ShapeKind::Linear, *t, DVec3::ZERO) {
+            return Err(Unstable {
+                step: world.step,
+                time: world.time,
+                what: format!(
+                    "crack `{name}` grew out of the grid: a front vertex reached \
+                     ({:.6e}, {:.6e}, {:.6e}) m",
+                    t.x, t.y, t.z
+                ),
+            });
+        } else if fracture_front::room(cracks, c, *t, 0.25 * h) < 0.25 * h {
+            stopped = Some(Stopped::Crack);
+        } else if !inside(world, *t) {
+            stopped = Some(Stopped::Surface);
+        }
+    }
+    Ok(stopped)
 }
 
 /// `v` smoothed along a front by the weights 1/4, 1/2, 1/4 of each vertex and its two
