@@ -10,9 +10,9 @@
 //! `cargo bench --bench cracks`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use fissure::dim::{D2, D3};
-use fissure::scenario::{Source, build};
-use fissure::schedule::Schedule;
+use fissure::base::dim::{D2, D3};
+use fissure::io::scenario::{Source, build};
+use fissure::pipeline::schedule::Schedule;
 use fissure::systems::{classify, contact, fracture, fracture_front};
 use std::time::Duration;
 
@@ -31,7 +31,7 @@ fn cracks(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3));
     g.throughput(Throughput::Elements(world.particles.len() as u64));
-    let every_step = |world: &mut fissure::world::World<D2>, on: bool| {
+    let every_step = |world: &mut fissure::store::world::World<D2>, on: bool| {
         world
             .cracks
             .as_mut()
@@ -121,7 +121,7 @@ fn cracks_3d(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(5));
     g.throughput(Throughput::Elements(world.particles.len() as u64));
-    let every_step = |world: &mut fissure::world::World<D3>, on: bool| {
+    let every_step = |world: &mut fissure::store::world::World<D3>, on: bool| {
         let c = world.cracks.as_mut().expect("the penny scene has a crack");
         c.scratch.classified.every_step = on;
     };

@@ -13,13 +13,13 @@ mod common;
 
 use common::scene_text;
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
-use fissure::dim::{D2, D3, Dim};
-use fissure::scenario::{Source, build};
-use fissure::schedule::Schedule;
-use fissure::sym::{Sym3, SymTensor};
+use fissure::base::dim::{D2, D3, Dim};
+use fissure::base::sym::{Sym3, SymTensor};
+use fissure::io::scenario::{Source, build};
+use fissure::pipeline::schedule::Schedule;
+use fissure::store::world::World;
 use fissure::systems::DimSystems;
 use fissure::systems::stress;
-use fissure::world::World;
 use std::time::Duration;
 
 /// Yield stress of the plastic variants (Pa); E = 200 GPa.

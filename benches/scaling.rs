@@ -12,8 +12,8 @@
 mod common;
 
 use common::{SCENES, block};
-use fissure::dim::{D2, D3};
-use fissure::schedule::Schedule;
+use fissure::base::dim::{D2, D3};
+use fissure::pipeline::schedule::Schedule;
 use fissure::systems::DimSystems;
 use rayon::prelude::*;
 use rayon::{ThreadPool, ThreadPoolBuilder};

@@ -7,11 +7,11 @@
 mod common;
 
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
-use fissure::dim::D3;
-use fissure::run::state::RunState;
-use fissure::scenario::build;
-use fissure::snapshot::Reader;
-use fissure::snapshot::state::write;
+use fissure::base::dim::D3;
+use fissure::io::scenario::build;
+use fissure::io::snapshot::Reader;
+use fissure::io::snapshot::state::write;
+use fissure::record::state::RunState;
 use std::fs::File;
 use std::time::Duration;
 

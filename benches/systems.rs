@@ -10,8 +10,8 @@ mod common;
 
 use common::{SCENES, block};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use fissure::dim::{D2, D3};
-use fissure::schedule::Schedule;
+use fissure::base::dim::{D2, D3};
+use fissure::pipeline::schedule::Schedule;
 use fissure::systems::DimSystems;
 use fissure::systems::{bin, g2p, grid_update, p2g, stress, stress_bin, stress_force};
 use std::time::{Duration, Instant};

@@ -1,17 +1,17 @@
 //! `fissure`: the scenario launcher.
 
 use clap::{Parser, Subcommand};
-use fissure::dim::{D2, D3};
-use fissure::error::{ScenarioError, UsageError};
-use fissure::measure::ExpectResult;
-use fissure::output::summary::{Status, Summary};
-use fissure::run::checkpoint::resolve;
-use fissure::run::stop::StopRequests;
-use fissure::run::{Outcome, RunOptions, resume, run};
-use fissure::scenario::{Source, build};
-use fissure::schedule::Schedule;
-use fissure::snapshot::{Reader, SnapshotError};
-use fissure::sweep::{Vary, sweep};
+use fissure::app::run::checkpoint::resolve;
+use fissure::app::run::stop::StopRequests;
+use fissure::app::run::{Outcome, RunOptions, resume, run};
+use fissure::app::sweep::{Vary, sweep};
+use fissure::base::dim::{D2, D3};
+use fissure::base::error::{ScenarioError, UsageError};
+use fissure::io::output::summary::{Status, Summary};
+use fissure::io::scenario::{Source, build};
+use fissure::io::snapshot::{Reader, SnapshotError};
+use fissure::pipeline::schedule::Schedule;
+use fissure::record::expect::ExpectResult;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -412,7 +412,7 @@ fn cmd_inspect(path: &Path) -> ExitCode {
         );
         println!(
             "format     version {}, written by fissure {}",
-            fissure::snapshot::format::FORMAT_VERSION,
+            fissure::io::snapshot::format::FORMAT_VERSION,
             h.build
         );
         println!(
@@ -478,11 +478,11 @@ fn cmd_check(path: &Path, overrides: &[String]) -> ExitCode {
                         w.grid.geom.node_count(),
                         w.settings.dt,
                         scene.dt_limit,
-                        fissure::run::step_count(scene.duration, w.settings.dt),
+                        fissure::app::run::step_count(scene.duration, w.settings.dt),
                         names.join(" -> ")
                     );
                     let dim = usize::from(src.scenario.simulation.dimension);
-                    for note in node_line_notes(&fissure::run::node_lines(w), dim) {
+                    for note in node_line_notes(&fissure::app::run::node_lines(w), dim) {
                         println!("  note: {note}");
                     }
                     ExitCode::SUCCESS
@@ -604,7 +604,7 @@ fn k_withheld_note(s: &Summary) -> Option<&'static str> {
 
 /// What the launcher says of each crack that lies on a line or plane of grid nodes.
 fn node_line_notes(
-    lines: &[fissure::output::summary::NodeLineReport],
+    lines: &[fissure::io::output::summary::NodeLineReport],
     dimension: usize,
 ) -> Vec<String> {
     let what = if dimension == 2 { "line" } else { "plane" };

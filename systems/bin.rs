@@ -1,13 +1,13 @@
 //! `bin`: sort particle indices into spatial tiles (counting sort), evaluate every particle's
 //! stencil, and stop the run if a particle has left the grid or has a non-finite position.
 
-use crate::dim::Dim;
-use crate::error::Unstable;
-use crate::grid::GridGeom;
-use crate::shape::{ShapeKind, StencilCache};
-use crate::tiles::Tiles;
+use crate::base::dim::Dim;
+use crate::base::error::Unstable;
+use crate::physics::shape::{ShapeKind, StencilCache};
+use crate::store::grid::GridGeom;
+use crate::store::tiles::Tiles;
+use crate::store::world::{CHUNK, World};
 use crate::with_shape;
-use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Bins every particle by the tile of the cell that contains it and evaluates its stencil,

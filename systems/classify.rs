@@ -9,15 +9,15 @@
 //! longer holds (clearance used up, or a new stencil) until the skin itself is used up; the
 //! result is exactly that of a full pass.
 
-use crate::crack::{self, Classified, Cracks, Fields, side_bit};
-use crate::dim::Dim;
-use crate::error::Unstable;
-use crate::geometry::Element;
-use crate::grid::GridGeom;
-use crate::shape::{ShapeKind, Stencil, StencilCache};
-use crate::tiles::Tiles;
+use crate::base::dim::Dim;
+use crate::base::error::Unstable;
+use crate::base::geometry::Element;
+use crate::physics::shape::{ShapeKind, Stencil, StencilCache};
+use crate::store::crack::{self, Classified, Cracks, Fields, side_bit};
+use crate::store::grid::GridGeom;
+use crate::store::tiles::Tiles;
+use crate::store::world::World;
 use crate::with_shape;
-use crate::world::World;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -554,7 +554,7 @@ impl<D: Dim> Pass<'_, D> {
 /// Classifies the particles near cracks (afresh, or reusing the last record where it still
 /// holds) and sizes the grid's extra field rows. Nothing to do in a scene without cracks.
 ///
-/// Fails when more than [`crate::crack::COLORS`] cracks have come within reach of one
+/// Fails when more than [`crate::store::crack::COLORS`] cracks have come within reach of one
 /// another (their masks would have no bits left).
 pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
     let (step, time) = (world.step, world.time);
@@ -562,7 +562,7 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
         topology,
         geometry,
         scratch:
-            crate::crack::Scratch {
+            crate::store::crack::Scratch {
                 fields,
                 classified: rec,
                 links,

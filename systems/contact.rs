@@ -5,12 +5,12 @@
 //! the field below, so momentum is conserved exactly. Coulomb friction's dissipation is
 //! booked as work.
 
-use crate::crack::{COLORS, Cracks, ElementBins, Law};
-use crate::dim::Dim;
-use crate::geometry::Element;
-use crate::shape::Stencil;
+use crate::base::dim::Dim;
+use crate::base::geometry::Element;
+use crate::physics::shape::Stencil;
+use crate::store::crack::{COLORS, Cracks, ElementBins, Law};
+use crate::store::world::World;
 use crate::with_shape;
-use crate::world::World;
 
 /// The crack of colour `color` nearest to `x` and the unit normal (pointing above) of its
 /// element nearest to `x`, from that colour's bins (built on first use: scenes without

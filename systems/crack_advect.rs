@@ -2,10 +2,10 @@
 //! and the top and bottom crack surfaces with the fields above and below the crack (Guo &
 //! Nairn 3D (2006) Eqs. 21-23; 2D (2004) section 2.2), which gives the crack opening.
 
-use crate::crack::{Cracks, Fields, Geometry};
-use crate::dim::Dim;
-use crate::shape::{ShapeKind, Stencil};
-use crate::world::{Update, World};
+use crate::base::dim::Dim;
+use crate::physics::shape::{ShapeKind, Stencil};
+use crate::store::crack::{Cracks, Fields, Geometry};
+use crate::store::world::{Update, World};
 
 /// Momentum and mass at node `n`, all fields together (Eq. 23's centre of mass), and of its
 /// fields above and below the crack of colour `color`; zero for fields lighter than

@@ -4,18 +4,18 @@
 //! and from the crack opening (Eqs. 14-22); a tip running at a set speed takes K from the
 //! amplitude of its opening instead. Runs on output steps only; it changes nothing.
 
-use crate::crack::{Cracks, Front};
-use crate::dim::{D2, Dim};
-use crate::fracture::{
+use crate::base::dim::{D2, Dim};
+use crate::base::sym::SymTensor;
+use crate::fracture::interaction::{Tip, interaction_k, near};
+use crate::fracture::plan::{
     FracturePlan, KMethod, Measured, PathResult, TipResult, k_from_g, k_from_mixity, k_from_opening,
 };
-use crate::grid::GridGeom;
-use crate::growth::TipState;
-use crate::interaction::{Tip, interaction_k, near};
-use crate::shape::Stencil;
-use crate::sym::SymTensor;
+use crate::physics::growth::TipState;
+use crate::physics::shape::Stencil;
+use crate::store::crack::{Cracks, Front};
+use crate::store::grid::GridGeom;
+use crate::store::world::World;
 use crate::with_shape;
-use crate::world::World;
 use glam::DVec2;
 use std::collections::HashMap;
 

@@ -1,5 +1,5 @@
 //! `fracture` in 3D: J and K_I, K_II, K_III at every vertex of every crack front, from
-//! domain integrals over a tube around the front (`crate::front_integral`), and K split
+//! domain integrals over a tube around the front (`crate::fracture::front_integral`), and K split
 //! from G = J by the opening, sliding and tearing of the crack behind the front (Guo &
 //! Nairn 3D (2006) Eqs. 40, 46-57). With `[fracture] compare`, also J on tubes of the main
 //! and the compared sizes, none shrunk, with their volume terms apart (paths.csv). A tube
@@ -7,14 +7,14 @@
 //! sqrt(2) times its radius, is short of the nearest of their triangles. Runs on output
 //! steps only; it reads the world and changes nothing.
 
-use crate::crack::Cracks;
-use crate::dim::D3;
-use crate::fracture::{FracturePlan, KMethod, Measured, PathResult, TipResult};
-use crate::front::{FrontFrame, front_line};
-use crate::front_integral::{Elastic3, Facet, FrontIntegrals, Tube, front_integrals};
-use crate::geometry::Element;
-use crate::geometry::point_triangle;
-use crate::world::World;
+use crate::base::dim::D3;
+use crate::base::geometry::Element;
+use crate::base::geometry::point_triangle;
+use crate::fracture::front::{FrontFrame, front_line};
+use crate::fracture::front_integral::{Elastic3, Facet, FrontIntegrals, Tube, front_integrals};
+use crate::fracture::plan::{FracturePlan, KMethod, Measured, PathResult, TipResult};
+use crate::store::crack::Cracks;
+use crate::store::world::World;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::SQRT_2;

@@ -1,13 +1,13 @@
 //! `g2p`: grid-to-particle gather (FLIP velocity update, position update), and
 //! `g2p_remap`, the same followed by the momentum remap of USL and USAVG.
 
-use crate::dim::Dim;
-use crate::disjoint::Disjoint;
-use crate::particles::Particles;
-use crate::shape::{Rows, Stencil};
+use crate::base::dim::Dim;
+use crate::physics::shape::{Rows, Stencil};
+use crate::store::disjoint::Disjoint;
+use crate::store::particles::Particles;
+use crate::store::world::{CHUNK, World};
 use crate::systems::p2g::scatter_coded;
 use crate::with_shape;
-use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Updates particle velocities (v += dt sum S a_i) and positions (x += dt sum S v_i'), in

@@ -1,10 +1,10 @@
 //! `grid_update`: nodal velocities and accelerations from momenta and forces, damping
 //! (Guo & Nairn 2D (2004) Eq. 5), gravity and prescribed velocities.
 
-use crate::crack::Fields;
-use crate::dim::Dim;
-use crate::grid::Grid;
-use crate::world::{CHUNK, World};
+use crate::base::dim::Dim;
+use crate::store::crack::Fields;
+use crate::store::grid::Grid;
+use crate::store::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Overwrites prescribed components of the extrapolated momenta so that p/m equals the
@@ -124,9 +124,9 @@ pub fn run<D: Dim>(world: &mut World<D>) {
 /// of a particle's share at most.
 fn merge_slivers<D: Dim>(
     grid: &mut Grid<D>,
-    work: &mut crate::world::Work,
+    work: &mut crate::store::world::Work,
     fields: &Fields,
-    settings: &crate::world::Settings<D>,
+    settings: &crate::store::world::Settings<D>,
 ) {
     let (dt, alpha, gravity, tol) = (
         settings.dt,

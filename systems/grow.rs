@@ -8,18 +8,18 @@
 //! it. Runs after the step and its fracture measurement; the moved tip is classified, in
 //! contact and measured from the next step on.
 
-use crate::crack::Cracks;
-use crate::dim::{D2, Dim};
-use crate::error::Unstable;
-use crate::fracture::FracturePlan;
-use crate::geometry::Element;
-use crate::growth::{
+use crate::base::dim::{D2, Dim};
+use crate::base::error::Unstable;
+use crate::base::geometry::Element;
+use crate::fracture::interaction::near;
+use crate::fracture::plan::FracturePlan;
+use crate::physics::growth::{
     Direction, GrowthRow, Initiation, Paris, Stopped, TipState, hoop_angle, hoop_k,
 };
-use crate::interaction::near;
-use crate::shape::ShapeKind;
+use crate::physics::shape::ShapeKind;
+use crate::store::crack::Cracks;
+use crate::store::world::World;
 use crate::systems::fracture;
-use crate::world::World;
 use glam::DVec2;
 
 /// Whether some growing tip or front reads K or J at the end of step `step` (so that step

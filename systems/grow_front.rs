@@ -10,14 +10,16 @@
 //! behind becomes a strip of new triangles. A front stops as a whole where a vertex would
 //! leave the body or come within a quarter cell of another crack.
 
-use crate::dim::D3;
-use crate::error::Unstable;
-use crate::fracture::{FracturePlan, TipResult};
-use crate::front::front_line;
-use crate::growth::{Direction, Growth, GrowthRow, Initiation, Stopped, hoop_angle, hoop_k};
-use crate::shape::ShapeKind;
+use crate::base::dim::D3;
+use crate::base::error::Unstable;
+use crate::fracture::front::front_line;
+use crate::fracture::plan::{FracturePlan, TipResult};
+use crate::physics::growth::{
+    Direction, Growth, GrowthRow, Initiation, Stopped, hoop_angle, hoop_k,
+};
+use crate::physics::shape::ShapeKind;
+use crate::store::world::World;
 use crate::systems::{fracture_front, grow::inside};
-use crate::world::World;
 use glam::DVec3;
 
 /// Advances every growing front by what this step's check allows, and returns a row for

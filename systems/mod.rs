@@ -17,11 +17,11 @@ pub mod stress;
 pub mod stress_bin;
 pub mod stress_force;
 
-use crate::dim::{D2, D3, Dim};
-use crate::error::Unstable;
-use crate::fracture::{FracturePlan, Measured};
-use crate::growth::GrowthRow;
-use crate::world::World;
+use crate::base::dim::{D2, D3, Dim};
+use crate::base::error::Unstable;
+use crate::fracture::plan::{FracturePlan, Measured};
+use crate::physics::growth::GrowthRow;
+use crate::store::world::World;
 
 /// The systems whose algorithm differs by dimension: J and K at crack tips in 2D and at
 /// every front vertex in 3D, and the growth of tips or fronts. Each returns what it

@@ -1,14 +1,14 @@
 //! `p2g`: particle-to-grid scatter of mass, momentum and forces (Guo & Nairn 2D (2004)
 //! Eqs. 3-6, single velocity field), tile by tile in colour classes.
 
-use crate::crack::Fields;
-use crate::dim::Dim;
-use crate::disjoint::Disjoint;
-use crate::grid::Grid;
-use crate::particles::Particles;
-use crate::shape::{Rows, ShapeKind, Stencil, StencilCache};
+use crate::base::dim::Dim;
+use crate::physics::shape::{Rows, ShapeKind, Stencil, StencilCache};
+use crate::store::crack::Fields;
+use crate::store::disjoint::Disjoint;
+use crate::store::grid::Grid;
+use crate::store::particles::Particles;
+use crate::store::world::{CHUNK, World};
 use crate::with_shape;
-use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Scatters mass and momentum (and, when `internal`, the internal force -V sigma . grad S)

@@ -2,15 +2,15 @@
 //! from the grid velocities p/m, in parallel over particle chunks (the particles near a
 //! crack afterwards, from their fields' entries).
 
-use crate::dim::Dim;
-use crate::disjoint::Disjoint;
-use crate::material::{Material, Plane};
-use crate::particles::Particles;
-use crate::plastic::Hardened;
-use crate::shape::{Rows, Stencil};
-use crate::sym::{Sym3, SymTensor};
+use crate::base::dim::Dim;
+use crate::base::sym::{Sym3, SymTensor};
+use crate::physics::material::{Material, Plane};
+use crate::physics::plastic::Hardened;
+use crate::physics::shape::{Rows, Stencil};
+use crate::store::disjoint::Disjoint;
+use crate::store::particles::Particles;
+use crate::store::world::{CHUNK, World};
 use crate::with_shape;
-use crate::world::{CHUNK, World};
 use rayon::prelude::*;
 
 /// Gathers grad v = sum (p_i/m_i) ⊗ grad S and updates the stress over `fraction` of the

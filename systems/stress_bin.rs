@@ -3,15 +3,15 @@
 //! particle's old stencil is read for its velocity gradient just before its new one is
 //! written in its place.
 
-use crate::crack::Fields;
-use crate::dim::Dim;
-use crate::error::Unstable;
-use crate::material::{Material, Plane};
-use crate::particles::Particles;
-use crate::shape::{ShapeKind, Stencil};
+use crate::base::dim::Dim;
+use crate::base::error::Unstable;
+use crate::physics::material::{Material, Plane};
+use crate::physics::shape::{ShapeKind, Stencil};
+use crate::store::crack::Fields;
+use crate::store::particles::Particles;
+use crate::store::world::World;
 use crate::systems::bin::{BeforeBin, outside, place};
 use crate::systems::stress::{StressColumns, node_velocities, update_coded, velocity_gradient};
-use crate::world::World;
 
 /// Updates every particle's stress over `fraction` of the step (as
 /// [`stress::run`](crate::systems::stress::run)), then bins the particles at their new

@@ -2,15 +2,15 @@
 //! internal forces it gives, fused in one pass over the tiles so each particle's stencil is
 //! read once (the particles near a crack afterwards, field by field).
 
-use crate::dim::Dim;
-use crate::disjoint::Disjoint;
-use crate::grid::Grid;
-use crate::particles::Particles;
-use crate::shape::Stencil;
+use crate::base::dim::Dim;
+use crate::physics::shape::Stencil;
+use crate::store::disjoint::Disjoint;
+use crate::store::grid::Grid;
+use crate::store::particles::Particles;
+use crate::store::world::World;
 use crate::systems::p2g::{add_internal_force, scatter_coded};
 use crate::systems::stress::{StressColumns, node_velocities, update_coded, velocity_gradient};
 use crate::with_shape;
-use crate::world::World;
 
 /// Updates every particle's stress over `fraction` of the step from grad v gathered off
 /// p/m (as [`stress::run`](crate::systems::stress::run)), then adds its internal force

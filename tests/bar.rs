@@ -2,7 +2,7 @@
 
 mod common;
 use common::{Bar, history};
-use fissure::measure::{arrival, energy_balance, frequency};
+use fissure::record::history::{arrival, energy_balance, frequency};
 
 /// Probe averaging `quantity` `component` over the slice of particles in [x0, x1].
 fn probe(bar: &Bar, name: &str, x0: f64, x1: f64, quantity: &str) -> String {
@@ -96,7 +96,7 @@ fn first_mode_case(dim: usize) -> (f64, f64) {
     );
     let hist = history(&bar.toml());
     let f = frequency(&hist.time, &hist.probes[0]).expect("oscillates");
-    let total = |r: &fissure::measure::Row| r.energies.kinetic + r.energies.strain;
+    let total = |r: &fissure::record::history::Row| r.energies.kinetic + r.energies.strain;
     let e0 = total(&hist.rows[0]);
     let drift = (total(hist.rows.last().unwrap()) - e0) / e0;
     (f, drift)

@@ -2,8 +2,8 @@
 
 mod common;
 use common::source;
-use fissure::dim::{D2, D3};
-use fissure::scenario::build;
+use fissure::base::dim::{D2, D3};
+use fissure::io::scenario::build;
 
 fn scene(dim: usize, cell: f64, body: &str) -> String {
     let v = |x: f64| vec![format!("{x:e}"); dim].join(", ");

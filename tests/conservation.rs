@@ -2,8 +2,8 @@
 
 mod common;
 use common::{final_world, history};
-use fissure::dim::{D2, D3};
-use fissure::sym::SymTensor;
+use fissure::base::dim::{D2, D3};
+use fissure::base::sym::SymTensor;
 
 const DISKS: &str = r#"
 [simulation]

@@ -5,9 +5,9 @@
 
 mod common;
 use common::final_world;
-use fissure::crack::Law;
-use fissure::dim::D2;
-use fissure::world::World;
+use fissure::base::dim::D2;
+use fissure::store::crack::Law;
+use fissure::store::world::World;
 use glam::DVec2;
 
 #[test]
@@ -207,10 +207,11 @@ fn friction_work_closes_the_energy_balance() {
     let last = h.rows.last().unwrap().energies;
     let start = h.rows[0].energies.kinetic;
     assert!(last.friction_work > 0.05 * start, "friction took {last:?}");
-    let drift = fissure::measure::energy_balance(&h).unwrap();
-    let free =
-        fissure::measure::energy_balance(&common::history(&text("{ law = \"frictionless\" }")))
-            .unwrap();
+    let drift = fissure::record::history::energy_balance(&h).unwrap();
+    let free = fissure::record::history::energy_balance(&common::history(&text(
+        "{ law = \"frictionless\" }",
+    )))
+    .unwrap();
     // Friction's balance within twice the frictionless one's, and far inside what it took.
     assert!(
         drift <= 2.0 * free.max(1e-3),

@@ -3,9 +3,9 @@
 
 mod common;
 use common::{final_world, source};
-use fissure::dim::D2;
-use fissure::scenario::build;
-use fissure::schedule::Schedule;
+use fissure::base::dim::D2;
+use fissure::io::scenario::build;
+use fissure::pipeline::schedule::Schedule;
 
 /// A 32 x 4 mm bar of 1 mm cells whose left half moves at -1 m/s and right half at +1 m/s,
 /// with `crack` appended (may be empty).
@@ -32,7 +32,7 @@ velocity = [1.0, 0.0]
 const ON_GRID_LINE: &str = "[[crack]]\npoints = [[0.02, 0.0025], [0.02, 0.0095]]\ntips = []";
 
 /// The bar's kinetic and strain energy (J) and total momentum x (kg m/s) at the end.
-fn energies(text: &str, threads: usize) -> (f64, f64, f64, fissure::world::World<D2>) {
+fn energies(text: &str, threads: usize) -> (f64, f64, f64, fissure::store::world::World<D2>) {
     let w = final_world::<D2>(text, threads);
     let e = w.energies();
     let p = w.momentum();
@@ -154,7 +154,7 @@ fn fused_closing_stress_matches_unfused_with_a_crack() {
     let text = pulled_apart("ugimp", "usavg", ON_GRID_LINE)
         .replace("velocity = [1.0, 0.0]", "velocity = [0.3, 0.2]");
     let (fused, apart) = common::fused_and_unfused::<D2>(&text, 40);
-    let bits = |w: &fissure::world::World<D2>| {
+    let bits = |w: &fissure::store::world::World<D2>| {
         format!(
             "{:?} {:?} {:?}",
             w.particles.stress, w.particles.x, w.particles.v
@@ -168,7 +168,7 @@ fn fused_closing_stress_matches_unfused_with_a_crack() {
 fn cracked_scene_is_deterministic_across_threads() {
     let text = pulled_apart("ugimp", "usavg", ON_GRID_LINE)
         .replace("velocity = [1.0, 0.0]", "velocity = [0.3, 0.2]");
-    let bits = |w: &fissure::world::World<D2>| -> Vec<u64> {
+    let bits = |w: &fissure::store::world::World<D2>| -> Vec<u64> {
         let p = &w.particles;
         p.x.iter()
             .chain(&p.v)
@@ -243,7 +243,7 @@ tips = []
 /// Pieces cut by cracks fly apart freely: no strain energy (below 1e-20 of the kinetic),
 /// and every particle keeps the velocity along x that `want` gives at its position, and
 /// none along y, to 1e-12 m/s.
-fn assert_free_pieces(w: &fissure::world::World<D2>, want: impl Fn(f64) -> f64) {
+fn assert_free_pieces(w: &fissure::store::world::World<D2>, want: impl Fn(f64) -> f64) {
     let e = w.energies();
     assert!(
         e.strain < 1e-20 * e.kinetic,
@@ -261,7 +261,7 @@ fn assert_free_pieces(w: &fissure::world::World<D2>, want: impl Fn(f64) -> f64) 
 
 /// Steps `text` to the end on one thread, classifying every particle afresh every step when
 /// `every_step`, else reusing what still holds.
-fn stepped(text: &str, every_step: bool) -> fissure::world::World<D2> {
+fn stepped(text: &str, every_step: bool) -> fissure::store::world::World<D2> {
     common::final_world_with::<D2>(text, 1, |w| {
         w.cracks.as_mut().unwrap().scratch.classified.every_step = every_step;
     })
@@ -281,7 +281,7 @@ fn reusing_the_classification_changes_no_bit() {
     )
     .replace("2e-5", "1.2e-4")
     .replace("velocity = [1.0, 0.0]", "velocity = [15.0, 4.0]");
-    let bits = |w: &fissure::world::World<D2>| -> Vec<u64> {
+    let bits = |w: &fissure::store::world::World<D2>| -> Vec<u64> {
         let p = &w.particles;
         p.x.iter()
             .chain(&p.v)
@@ -330,7 +330,7 @@ fn j_after_a_kept_step_matches_the_unfused_schedule() {
         unfused.step_keeping(&mut apart, true).unwrap();
         fused_schedule.step(&mut fused).unwrap();
     }
-    let j = |w: &fissure::world::World<D2>| {
+    let j = |w: &fissure::store::world::World<D2>| {
         format!("{:?}", fissure::systems::fracture::measure(w, &plan).tips)
     };
     assert_eq!(j(&kept), j(&apart));
@@ -356,7 +356,7 @@ fn fracture_sizes_in_metres_follow_the_grid() {
     let metres = "lengths = \"m\"\ncontour = 1.0e-3\ncompare = [2.0e-3]\ndomain = 3.0e-3\n";
     for (cell, n) in [(5e-4, 2), (2.5e-4, 4)] {
         let src = common::source(&plate(metres, cell));
-        let plan = fissure::scenario::build::<D2>(&src)
+        let plan = fissure::io::scenario::build::<D2>(&src)
             .unwrap()
             .fracture
             .unwrap();
@@ -376,7 +376,7 @@ fn fracture_sizes_in_metres_follow_the_grid() {
         ("lengths = \"mm\"\n", "unknown unit"),
     ] {
         let src = common::source(&plate(fracture, 5e-4));
-        let Err(e) = fissure::scenario::build::<D2>(&src) else {
+        let Err(e) = fissure::io::scenario::build::<D2>(&src) else {
             panic!("`{fracture}` must be refused");
         };
         assert!(e.to_string().contains(words), "{e}");

@@ -4,8 +4,8 @@
 
 mod common;
 use common::{final_world, source};
-use fissure::dim::D3;
-use fissure::scenario::build;
+use fissure::base::dim::D3;
+use fissure::io::scenario::build;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -132,7 +132,7 @@ box = {{ min = {lo}, max = {hi} }}
 }
 
 /// The crack store of a one-crack 3D scene over a large block (the crack well inside).
-fn store(crack: &str) -> fissure::crack::Cracks<D3> {
+fn store(crack: &str) -> fissure::store::crack::Cracks<D3> {
     let text = cube(0.04, 0.002, 0.004, 1e-6, &format!("[[crack]]\n{crack}\n"));
     build::<D3>(&source(&text))
         .unwrap_or_else(|e| panic!("{e}"))
@@ -142,7 +142,7 @@ fn store(crack: &str) -> fissure::crack::Cracks<D3> {
 }
 
 /// Total area and the summed unit normal (times area) of the crack's triangles.
-fn area(c: &fissure::crack::Cracks<D3>) -> (f64, DVec3) {
+fn area(c: &fissure::store::crack::Cracks<D3>) -> (f64, DVec3) {
     let x = &c.geometry.x;
     let mut n = DVec3::ZERO;
     let mut total = 0.0;
@@ -228,7 +228,7 @@ fn reusing_the_3d_classification_changes_no_bit() {
             w.cracks.as_mut().unwrap().scratch.classified.every_step = every_step;
         })
     };
-    let bits = |w: &fissure::world::World<D3>| -> Vec<u64> {
+    let bits = |w: &fissure::store::world::World<D3>| -> Vec<u64> {
         let p = &w.particles;
         (p.x.iter().chain(&p.v))
             .chain(&w.cracks.as_ref().unwrap().geometry.x)
@@ -257,7 +257,7 @@ fn front_frames_follow_a_curved_front() {
     let c =
         store("penny = { center = [0.02, 0.02, 0.02], normal = [1.0, 2.0, 2.0], radius = 0.006 }");
     let front = &c.topology.fronts()[0];
-    let frames = fissure::front::front_line(&c, front).frames;
+    let frames = fissure::fracture::front::front_line(&c, front).frames;
     let m = frames.len() as f64;
     assert_eq!(frames.len(), front.vertices.len());
     for f in &frames {
@@ -277,7 +277,7 @@ fn front_frames_follow_a_curved_front() {
     let c = store(
         "ellipse = { center = [0.02, 0.02, 0.02], axes = [[0.007, 0.0, 0.0], [0.0, 0.0, 0.004]], half = true }",
     );
-    let frames = fissure::front::front_line(&c, &c.topology.fronts()[0]).frames;
+    let frames = fissure::fracture::front::front_line(&c, &c.topology.fronts()[0]).frames;
     for f in &frames {
         let d = f.x - centre;
         // Outward from the ellipse: along the gradient of (x/a)^2 + (z/b)^2.
@@ -443,7 +443,7 @@ fn front_tube_stays_in_the_fronts_material() {
     let last: Vec<_> = h.fracture.iter().filter(|t| t.step == step).collect();
     assert_eq!(last.len(), 36);
     let e_prime = 200e9 / (1.0 - 0.3 * 0.3);
-    let mean = |f: &dyn Fn(&fissure::fracture::TipResult) -> f64| {
+    let mean = |f: &dyn Fn(&fissure::fracture::plan::TipResult) -> f64| {
         last.iter().map(|t| f(t)).sum::<f64>() / last.len() as f64
     };
     let k_int = mean(&|t| t.k_interaction[0]);

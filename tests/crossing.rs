@@ -1,7 +1,7 @@
 //! The particle-node line against crack elements on degenerate geometry: exact predicates
 //! and the documented tie rule (a point exactly on the crack counts as above it).
 
-use fissure::geometry::{Element, Segment, Triangle};
+use fissure::base::geometry::{Element, Segment, Triangle};
 use glam::{DVec2, DVec3};
 
 fn v2(x: f64, y: f64) -> DVec2 {
@@ -123,7 +123,7 @@ fn lines_through_shared_edges_and_vertices_cross_once() {
         let c = tri_crossings(p, q, &v, &tris);
         assert_eq!(c.iter().filter(|&&s| s != 0).count(), 1, "{what}: {c:?}");
         // The same as the line moved a small distance along the tie-break direction.
-        let d = fissure::geometry::NUDGE[0] * 1e-9;
+        let d = fissure::base::geometry::NUDGE[0] * 1e-9;
         let moved = tri_crossings(p + d, q + d, &v, &tris);
         if q.z != 0.0 {
             assert_eq!(c, moved, "{what}");

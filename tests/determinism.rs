@@ -2,10 +2,10 @@
 
 mod common;
 use common::{final_world, mixed_scene};
-use fissure::dim::{D2, D3, Dim};
-use fissure::sym::SymTensor;
+use fissure::base::dim::{D2, D3, Dim};
+use fissure::base::sym::SymTensor;
+use fissure::store::world::World;
 use fissure::systems::DimSystems;
-use fissure::world::World;
 
 /// Every bit of the particle state that the next step depends on.
 fn bits<D: Dim>(w: &World<D>) -> Vec<u64> {
@@ -62,7 +62,7 @@ fn front_fracture_is_bitwise_identical_across_thread_counts() {
     let text =
         mixed_scene(3, "ugimp", "usavg").replace("duration = 1e-5", "duration = 2e-6") + crack;
     let src = common::source(&text);
-    let plan = fissure::scenario::build::<D3>(&src)
+    let plan = fissure::io::scenario::build::<D3>(&src)
         .unwrap_or_else(|e| panic!("{e}"))
         .fracture
         .unwrap();

@@ -1,7 +1,7 @@
 //! The documentation against the code: every key the scenario parser accepts is named in
 //! docs/scenario-format.md, and every TOML example in docs/ parses and builds.
 
-use fissure::scenario::{Source, build};
+use fissure::io::scenario::{Source, build};
 use std::path::Path;
 
 /// Tables of the scenario format, each with a shipped scenario that holds it: the parser
@@ -115,8 +115,8 @@ fn every_toml_example_in_the_docs_builds() {
             let src = Source::parse(&path.display().to_string(), body, &[])
                 .unwrap_or_else(|e| panic!("{}: an example does not parse: {e}", path.display()));
             let built = match src.scenario.simulation.dimension {
-                2 => build::<fissure::dim::D2>(&src).map(|_| ()),
-                _ => build::<fissure::dim::D3>(&src).map(|_| ()),
+                2 => build::<fissure::base::dim::D2>(&src).map(|_| ()),
+                _ => build::<fissure::base::dim::D3>(&src).map(|_| ()),
             };
             built.unwrap_or_else(|e| panic!("{}: an example does not build: {e}", path.display()));
         }

@@ -1,9 +1,9 @@
 //! Bad input gets a clear error naming file, line and key, never a panic; the launcher
 //! exits with code 2.
 
-use fissure::dim::D2;
-use fissure::error::ScenarioError;
-use fissure::scenario::{Source, build};
+use fissure::base::dim::D2;
+use fissure::base::error::ScenarioError;
+use fissure::io::scenario::{Source, build};
 
 const GOOD: &str = r#"name = "good"
 [simulation]
@@ -149,7 +149,7 @@ fn a_scene_too_large_for_memory_is_refused_at_once() {
             "max = [0.02, 0.02, 0.02] }",
         );
     let src = Source::parse("bad.toml", &text, &[]).unwrap();
-    match fissure::scenario::build::<fissure::dim::D3>(&src) {
+    match fissure::io::scenario::build::<fissure::base::dim::D3>(&src) {
         Ok(_) => panic!("a 2 TB scene must be refused"),
         Err(e) => assert_error(&e, "grid.cell", None, "this machine has"),
     }
@@ -467,7 +467,7 @@ fn error_3d(extra: &str) -> ScenarioError {
     let text = text_3d(extra);
     match Source::parse("bad.toml", &text, &[]) {
         Err(e) => e,
-        Ok(src) => match fissure::scenario::build::<fissure::dim::D3>(&src) {
+        Ok(src) => match fissure::io::scenario::build::<fissure::base::dim::D3>(&src) {
             Ok(_) => panic!("scenario must be refused"),
             Err(e) => e,
         },
@@ -579,7 +579,7 @@ fn crossing_cracks_are_refused() {
     assert_error(&e, "crack[1]", Some(21), "meets crack `a` (its triangle");
     let src = Source::parse("ok.toml", &text_3d(&pennies(0.0145)), &[]).unwrap();
     assert!(
-        fissure::scenario::build::<fissure::dim::D3>(&src).is_ok(),
+        fissure::io::scenario::build::<fissure::base::dim::D3>(&src).is_ok(),
         "apart, they are fine"
     );
 }
@@ -642,7 +642,7 @@ fn bad_front_expects_name_the_key() {
     ))
     .replace("crack = \"p\"\nreference", "crack = \"r\"\nreference");
     let src = Source::parse("bad.toml", &rect, &[]).unwrap();
-    match fissure::scenario::build::<fissure::dim::D3>(&src) {
+    match fissure::io::scenario::build::<fissure::base::dim::D3>(&src) {
         Ok(_) => panic!("a crack without a front has nothing to measure"),
         Err(e) => assert_error(&e, "expect[0].crack", None, "has no front"),
     }
@@ -747,9 +747,9 @@ fn unusable_command_line_values_exit_with_code_2() {
 #[test]
 fn more_threads_than_cores_are_capped() {
     let cores = std::thread::available_parallelism().unwrap().get();
-    assert_eq!(fissure::run::thread_count(1000), cores);
-    assert_eq!(fissure::run::thread_count(1), 1);
-    assert_eq!(fissure::run::thread_count(0), cores);
+    assert_eq!(fissure::app::run::thread_count(1000), cores);
+    assert_eq!(fissure::app::run::thread_count(1), 1);
+    assert_eq!(fissure::app::run::thread_count(0), cores);
 }
 
 /// An error in a value given by `--set` says so instead of pointing at the file's line of

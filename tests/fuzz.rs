@@ -3,8 +3,8 @@
 //! the scene or return an error. 64 cases each by default; PROPTEST_CASES=100000 for a
 //! longer fuzzing session.
 
-use fissure::dim::{D2, D3};
-use fissure::scenario::{Source, build};
+use fissure::base::dim::{D2, D3};
+use fissure::io::scenario::{Source, build};
 use proptest::prelude::*;
 use std::sync::OnceLock;
 

@@ -5,13 +5,13 @@
 mod common;
 
 use common::{PARIS_GROWTH, PENNY_FATIGUE, edge_plate, source};
-use fissure::dim::D3;
-use fissure::growth::GrowthRow;
-use fissure::output::summary::Status;
-use fissure::run::{Outcome, RunOptions, run, step_count};
-use fissure::scenario::build;
-use fissure::schedule::Schedule;
-use fissure::world::World;
+use fissure::app::run::{Outcome, RunOptions, run, step_count};
+use fissure::base::dim::D3;
+use fissure::io::output::summary::Status;
+use fissure::io::scenario::build;
+use fissure::physics::growth::GrowthRow;
+use fissure::pipeline::schedule::Schedule;
+use fissure::store::world::World;
 use glam::DVec3;
 
 fn run_with(text: &str, threads: usize) -> Outcome {

@@ -2,8 +2,8 @@
 
 mod common;
 use common::{final_world, source};
-use fissure::dim::D2;
-use fissure::run::{RunOptions, run};
+use fissure::app::run::{RunOptions, run};
+use fissure::base::dim::D2;
 
 /// A soft 1D column dropping onto a fixed base under gravity, compressed by a few cells so
 /// that particles cross cell boundaries. rho g H = 1000 * 10 * 0.1 = 1 kPa and E = 10 kPa:

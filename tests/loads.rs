@@ -6,9 +6,9 @@
 
 mod common;
 
-use fissure::dim::{D2, D3};
-use fissure::near_tip;
-use fissure::scenario::{Source, build};
+use fissure::base::dim::{D2, D3};
+use fissure::io::scenario::{Source, build};
+use fissure::physics::near_tip;
 
 /// A 10 mm square at 0.5 mm cells, 2 particles per cell per axis, the four faces loaded by
 /// the Williams field of a tip at its centre.

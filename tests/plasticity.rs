@@ -4,11 +4,11 @@
 
 mod common;
 use common::{final_world, history, mixed_scene, plastic};
-use fissure::dim::{D2, D3, Dim};
-use fissure::measure::energy_balance;
-use fissure::sym::SymTensor;
+use fissure::base::dim::{D2, D3, Dim};
+use fissure::base::sym::SymTensor;
+use fissure::record::history::energy_balance;
+use fissure::store::world::World;
 use fissure::systems::DimSystems;
-use fissure::world::World;
 
 /// Every bit of the stress and plastic state.
 fn bits<D: Dim>(w: &World<D>) -> Vec<u64> {
@@ -185,7 +185,7 @@ fn front_k_is_reported_only_while_the_tube_is_elastic() {
     let elastic = last_rows(&penny_cube());
     assert!(elastic.iter().all(|t| t.k[0] > 0.0), "the penny opens");
     let unyielded = last_rows(&plastic(&penny_cube(), 1e8, "H = 0"));
-    let bits = |rows: &[fissure::fracture::TipResult]| {
+    let bits = |rows: &[fissure::fracture::plan::TipResult]| {
         (rows.iter())
             .flat_map(|t| t.values().map(f64::to_bits))
             .collect::<Vec<_>>()

@@ -2,11 +2,11 @@
 
 mod common;
 use common::source;
-use fissure::dim::D2;
-use fissure::scenario::build;
-use fissure::schedule::Schedule;
+use fissure::base::dim::D2;
+use fissure::io::scenario::build;
+use fissure::pipeline::schedule::Schedule;
+use fissure::store::world::World;
 use fissure::systems::bin;
-use fissure::world::World;
 
 fn names(extra: &str, update: &str) -> Vec<&'static str> {
     let text = common::block_2d(1e-5, 0.004, 0.016, extra).replace(

@@ -4,13 +4,13 @@
 
 mod common;
 use common::{mixed_scene, source};
-use fissure::dim::{D2, D3};
-use fissure::output::summary::Status;
-use fissure::run::stop::StopRequests;
-use fissure::run::{Outcome, RunOptions, resume, run};
-use fissure::snapshot::Reader;
-use fissure::snapshot::format::{FORMAT_VERSION, Header, MAGIC};
-use fissure::snapshot::state::restore;
+use fissure::app::run::stop::StopRequests;
+use fissure::app::run::{Outcome, RunOptions, resume, run};
+use fissure::base::dim::{D2, D3};
+use fissure::io::output::summary::Status;
+use fissure::io::snapshot::Reader;
+use fissure::io::snapshot::format::{FORMAT_VERSION, Header, MAGIC};
+use fissure::io::snapshot::state::restore;
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -563,7 +563,8 @@ fn resume_until_extends_a_finished_run() {
     };
     let err = resume(&snap, &early).err().unwrap();
     assert!(
-        err.downcast_ref::<fissure::error::UsageError>().is_some(),
+        err.downcast_ref::<fissure::base::error::UsageError>()
+            .is_some(),
         "bad input (exit code 2): {err}"
     );
     assert!(err.to_string().contains("after the current time"), "{err}");
@@ -574,7 +575,7 @@ fn resume_until_extends_a_finished_run() {
     let more = resume(&snap, &later).unwrap();
     let dt = more.summary.dt;
     assert_eq!(more.summary.status, Status::Completed);
-    assert_eq!(more.summary.steps, fissure::run::step_count(3e-6, dt));
+    assert_eq!(more.summary.steps, fissure::app::run::step_count(3e-6, dt));
     assert!(more.summary.steps > first.summary.steps);
     assert_eq!(
         more.summary.steps_run,
@@ -698,7 +699,7 @@ fn a_full_disk_during_a_snapshot_leaves_no_partial_file() {
     let (path, tmp) = (dir.join("s.fsnap"), dir.join("s.fsnap.tmp"));
     std::os::unix::fs::symlink("/dev/full", &tmp).unwrap();
     let data = vec![1.0f64; 1 << 18];
-    let mut columns = fissure::snapshot::format::ColumnSet::default();
+    let mut columns = fissure::io::snapshot::format::ColumnSet::default();
     columns.add("x", &data);
     let header = Header {
         dimension: 2,

@@ -4,7 +4,7 @@
 
 mod common;
 
-use fissure::sweep::{Vary, sweep};
+use fissure::app::sweep::{Vary, sweep};
 use std::path::{Path, PathBuf};
 
 /// A fresh folder under the system temp folder, and a scenario file in it: the block of
@@ -150,9 +150,10 @@ fn an_anchored_grid_keeps_the_scene_in_place_when_cells_change() {
         )
     };
     for cell in [0.001, 0.0007, 0.0003] {
-        let w = fissure::scenario::build::<fissure::dim::D2>(&common::source(&text(cell)))
-            .unwrap_or_else(|e| panic!("{e}"))
-            .world;
+        let w =
+            fissure::io::scenario::build::<fissure::base::dim::D2>(&common::source(&text(cell)))
+                .unwrap_or_else(|e| panic!("{e}"))
+                .world;
         let g = &w.grid.geom;
         if cell == 0.001 {
             assert_eq!((g.origin.x, g.origin.y), (-0.003, -0.0035));

@@ -3,12 +3,12 @@
 
 mod common;
 use common::{final_world_with, source, strip_2d};
-use fissure::crack::Cracks;
-use fissure::dim::D2;
-use fissure::run::state::RunState;
-use fissure::scenario::build;
-use fissure::snapshot::Reader;
-use fissure::snapshot::state::{restore, write};
+use fissure::base::dim::D2;
+use fissure::io::scenario::build;
+use fissure::io::snapshot::Reader;
+use fissure::io::snapshot::state::{restore, write};
+use fissure::record::state::RunState;
+use fissure::store::crack::Cracks;
 use fissure::systems::{bin, classify};
 use glam::DVec2;
 
@@ -67,7 +67,7 @@ fn a_tip_keeps_its_vertex_when_the_crack_grows() {
     assert_eq!(segs, want);
 }
 
-fn before_x(src: &fissure::scenario::Source, tip: u32) -> DVec2 {
+fn before_x(src: &fissure::io::scenario::Source, tip: u32) -> DVec2 {
     build::<D2>(src).unwrap().world.cracks.unwrap().geometry.x[tip as usize]
 }
 

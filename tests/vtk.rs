@@ -2,7 +2,7 @@
 
 mod common;
 use common::source;
-use fissure::run::{RunOptions, run};
+use fissure::app::run::{RunOptions, run};
 
 const SCENE: &str = r#"
 [simulation]

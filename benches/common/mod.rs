@@ -2,9 +2,9 @@
 //! cells at 2 particles per cell per axis, moving at 1 mm/s.
 #![allow(dead_code)]
 
-use fissure::dim::Dim;
-use fissure::scenario::{Source, build};
-use fissure::world::World;
+use fissure::base::dim::Dim;
+use fissure::io::scenario::{Source, build};
+use fissure::store::world::World;
 
 /// Scenario text of an `n`-cells-per-axis block in `dim` dimensions with the given shape
 /// function and update order.

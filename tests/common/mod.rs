@@ -1,12 +1,12 @@
 //! Helpers shared by the integration tests: scenario text for bars, running to a history.
 #![allow(dead_code)]
 
-use fissure::measure::History;
-use fissure::run::{Outcome, RunOptions, run};
-use fissure::scenario::{Source, build};
-use fissure::schedule::{Schedule, System};
+use fissure::app::run::{Outcome, RunOptions, run};
+use fissure::io::scenario::{Source, build};
+use fissure::pipeline::schedule::{Schedule, System};
+use fissure::record::history::History;
+use fissure::store::world::World;
 use fissure::systems::DimSystems;
-use fissure::world::World;
 
 /// Parses scenario text (panics with the located error if it does not parse).
 pub fn source(text: &str) -> Source {
@@ -44,7 +44,7 @@ pub fn final_world_with<D: DimSystems>(
         let mut world = scene.world;
         prepare(&mut world);
         let mut schedule = Schedule::for_world(&world, None);
-        let steps = fissure::run::step_count(scene.duration, world.settings.dt);
+        let steps = fissure::app::run::step_count(scene.duration, world.settings.dt);
         while world.step < steps {
             schedule.step(&mut world).unwrap_or_else(|e| panic!("{e}"));
         }

@@ -1,0 +1,350 @@
+//! 3D crack surfaces: triangle meshes from vertex and triangle lists, or generated from
+//! rectangles, ellipses (whole or half) and pennies, with the checks a crack surface needs
+//! (indices in range, no degenerate triangle, a manifold surface oriented one way).
+
+use super::check::{positive, vec3};
+use super::schema::{CrackSpec, EllipseSpec, MeshSpec, PennySpec, PlanarSpec};
+use super::source::Source;
+use crate::base::dim::D3;
+use crate::base::error::ScenarioError;
+use glam::DVec3;
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+type R<T> = Result<T, ScenarioError>;
+
+/// How far (cells) a half ellipse's straight edge is carried past the surface it lies on.
+const OVERHANG_CELLS: f64 = 1.5;
+
+/// A crack surface: vertices, counterclockwise triangles (seen from above) and its front.
+#[derive(Debug, Clone)]
+pub(super) struct Surface {
+    /// Vertex positions (m).
+    pub vertices: Vec<DVec3>,
+    /// Triangles as vertex indices.
+    pub triangles: Vec<[u32; 3]>,
+    /// Front vertices in order (empty: no front).
+    pub front: Vec<u32>,
+}
+
+/// The surface of 3D crack `c`, generated or read, and checked; `cell` is the smallest
+/// cell size (m), the default spacing.
+pub(super) fn surface(src: &Source, c: usize, spec: &CrackSpec, cell: f64) -> R<Surface> {
+    let key = |k: &str| format!("crack[{c}].{k}");
+    if spec.points.is_some() || spec.line.is_some() || spec.tips.is_some() {
+        let k = if spec.points.is_some() {
+            "points"
+        } else if spec.line.is_some() {
+            "line"
+        } else {
+            "tips"
+        };
+        return Err(src.error(
+            &key(k),
+            "a 3D crack is a surface: give `mesh`, `rectangle`, `ellipse` or `penny`",
+        ));
+    }
+    let spacing = |s: Option<f64>, k: &str| match s {
+        Some(s) => positive(src, &key(k), s, "m"),
+        None => Ok(0.5 * cell),
+    };
+    let (surface, what) = match (&spec.mesh, &spec.rectangle, &spec.ellipse, &spec.penny) {
+        (Some(m), None, None, None) => (mesh(src, c, m)?, "mesh"),
+        (None, Some(r), None, None) => {
+            let h = spacing(r.spacing, "rectangle.spacing")?;
+            (rectangle(src, c, r, h)?, "rectangle")
+        }
+        (None, None, Some(e), None) => {
+            let h = spacing(e.spacing, "ellipse.spacing")?;
+            (ellipse(src, c, e, h, OVERHANG_CELLS * cell)?, "ellipse")
+        }
+        (None, None, None, Some(p)) => {
+            let h = spacing(p.spacing, "penny.spacing")?;
+            (penny(src, c, p, h)?, "penny")
+        }
+        _ => {
+            return Err(src.error(
+                &format!("crack[{c}]"),
+                "give exactly one of `mesh`, `rectangle`, `ellipse` and `penny`",
+            ));
+        }
+    };
+    check(src, &key(what), &surface)?;
+    Ok(surface)
+}
+
+fn point(src: &Source, key: &str, v: &[f64]) -> R<DVec3> {
+    vec3::<D3>(src, key, v).map(DVec3::from)
+}
+
+/// Two in-plane axis vectors, not parallel.
+fn axes(src: &Source, key: &str, a: &[Vec<f64>]) -> R<(DVec3, DVec3)> {
+    if a.len() != 2 {
+        return Err(src.error(key, "give two axis vectors [[x, y, z], [x, y, z]]"));
+    }
+    let u = point(src, key, &a[0])?;
+    let v = point(src, key, &a[1])?;
+    if u.cross(v).length() <= 1e-12 * u.length() * v.length() || u.length() == 0.0 {
+        return Err(src.error(key, "the two axes must be non-zero and not parallel"));
+    }
+    Ok((u, v))
+}
+
+fn mesh(src: &Source, c: usize, m: &MeshSpec) -> R<Surface> {
+    let key = |k: &str| format!("crack[{c}].mesh.{k}");
+    let vertices = (m.vertices.iter().enumerate())
+        .map(|(j, v)| point(src, &format!("crack[{c}].mesh.vertices[{j}]"), v))
+        .collect::<R<Vec<_>>>()?;
+    let n = vertices.len() as i64;
+    let index = |k: &str, i: i64| {
+        if (0..n).contains(&i) {
+            Ok(i as u32)
+        } else {
+            Err(src.error(&key(k), format!("vertex {i} does not exist ({n} vertices)")))
+        }
+    };
+    let mut triangles = Vec::with_capacity(m.triangles.len());
+    for t in &m.triangles {
+        if t.len() != 3 {
+            return Err(src.error(&key("triangles"), "each triangle has three vertex indices"));
+        }
+        triangles.push([
+            index("triangles", t[0])?,
+            index("triangles", t[1])?,
+            index("triangles", t[2])?,
+        ]);
+    }
+    if triangles.is_empty() {
+        return Err(src.error(&key("triangles"), "a crack surface needs a triangle"));
+    }
+    let front = (m.front.iter().flatten())
+        .map(|&i| index("front", i))
+        .collect::<R<Vec<_>>>()?;
+    Ok(Surface {
+        vertices,
+        triangles,
+        front,
+    })
+}
+
+fn rectangle(src: &Source, c: usize, r: &PlanarSpec, h: f64) -> R<Surface> {
+    let centre = point(src, &format!("crack[{c}].rectangle.center"), &r.center)?;
+    let (u, v) = axes(src, &format!("crack[{c}].rectangle.axes"), &r.axes)?;
+    let n = |a: DVec3| (2.0 * a.length() / h).ceil().clamp(1.0, 2000.0) as u32;
+    let (nu, nv) = (n(u), n(v));
+    let mut vertices = Vec::new();
+    for j in 0..=nv {
+        for i in 0..=nu {
+            let (s, t) = (
+                2.0 * i as f64 / nu as f64 - 1.0,
+                2.0 * j as f64 / nv as f64 - 1.0,
+            );
+            vertices.push(centre + u * s + v * t);
+        }
+    }
+    let at = |i: u32, j: u32| j * (nu + 1) + i;
+    let mut triangles = Vec::new();
+    for j in 0..nv {
+        for i in 0..nu {
+            let (a, b, cc, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            triangles.push([a, b, cc]);
+            triangles.push([a, cc, d]);
+        }
+    }
+    Ok(Surface {
+        vertices,
+        triangles,
+        front: Vec::new(),
+    })
+}
+
+fn penny(src: &Source, c: usize, p: &PennySpec, h: f64) -> R<Surface> {
+    let key = |k: &str| format!("crack[{c}].penny.{k}");
+    let centre = point(src, &key("center"), &p.center)?;
+    let n = point(src, &key("normal"), &p.normal)?;
+    if n.length() == 0.0 {
+        return Err(src.error(&key("normal"), "the normal must not be zero"));
+    }
+    let r = positive(src, &key("radius"), p.radius, "m")?;
+    let (u, v) = n.normalize().any_orthonormal_pair();
+    Ok(disc(centre, u * r, v * r, h, None))
+}
+
+fn ellipse(src: &Source, c: usize, e: &EllipseSpec, h: f64, overhang: f64) -> R<Surface> {
+    let centre = point(src, &format!("crack[{c}].ellipse.center"), &e.center)?;
+    let (a, b) = axes(src, &format!("crack[{c}].ellipse.axes"), &e.axes)?;
+    Ok(disc(centre, a, b, h, e.half.then_some(overhang)))
+}
+
+/// The ellipse `centre + a cos(t) + b sin(t)` meshed in rings of about `h` spacing (ring k
+/// of the unit disc at radius k/n with 6k points), its front the outer ring. With
+/// `half = Some(overhang)` only the half with a positive `b` component, its straight edge
+/// carried `overhang` (m) past the centre line, the front the outer half ring.
+fn disc(centre: DVec3, a: DVec3, b: DVec3, h: f64, half: Option<f64>) -> Surface {
+    let rings = ((a.length().max(b.length()) / h).ceil() as usize).clamp(1, 1000);
+    let span = if half.is_some() { PI } else { 2.0 * PI };
+    let at = |r: f64, t: f64| centre + a * (r * t.cos()) + b * (r * t.sin());
+    let mut vertices = vec![centre];
+    let mut ring_of: Vec<Vec<u32>> = vec![vec![0]];
+    for k in 1..=rings {
+        let count = if half.is_some() { 3 * k + 1 } else { 6 * k };
+        let r = k as f64 / rings as f64;
+        let first = vertices.len() as u32;
+        let step = if half.is_some() {
+            span / (count - 1) as f64
+        } else {
+            span / count as f64
+        };
+        vertices.extend((0..count).map(|i| at(r, i as f64 * step)));
+        ring_of.push((first..first + count as u32).collect());
+    }
+    // Fraction of the span at point i of ring k >= 1.
+    let angle = |k: usize, i: usize| {
+        let count = ring_of[k].len();
+        if half.is_some() {
+            i as f64 / (count - 1) as f64
+        } else {
+            i as f64 / count as f64
+        }
+    };
+    let mut triangles = Vec::new();
+    for k in 0..rings {
+        let (inner, outer) = (&ring_of[k], &ring_of[k + 1]);
+        if k == 0 {
+            let m = outer.len();
+            let last = if half.is_some() { m - 1 } else { m };
+            for i in 0..last {
+                triangles.push([inner[0], outer[i], outer[(i + 1) % m]]);
+            }
+            continue;
+        }
+        // Walk both rings by angle, always advancing the one whose next point comes first.
+        let (ni, no) = (inner.len(), outer.len());
+        let (ei, eo) = if half.is_some() {
+            (ni - 1, no - 1)
+        } else {
+            (ni, no)
+        };
+        let (mut i, mut o) = (0, 0);
+        while i < ei || o < eo {
+            let next_i = if i < ei {
+                angle(k, i + 1)
+            } else {
+                f64::INFINITY
+            };
+            let next_o = if o < eo {
+                angle(k + 1, o + 1)
+            } else {
+                f64::INFINITY
+            };
+            if next_o <= next_i {
+                triangles.push([inner[i % ni], outer[o % no], outer[(o + 1) % no]]);
+                o += 1;
+            } else {
+                triangles.push([inner[i % ni], outer[o % no], inner[(i + 1) % ni]]);
+                i += 1;
+            }
+        }
+    }
+    let front = ring_of[rings].clone();
+    if let Some(overhang) = half {
+        // A strip from the straight edge outwards: the edge's points are each ring's two
+        // ends (and the centre), mirrored `overhang` along -b.
+        let out = -b.normalize() * overhang;
+        let mut edge: Vec<u32> = (1..=rings)
+            .rev()
+            .map(|k| *ring_of[k].last().unwrap())
+            .collect();
+        edge.push(0);
+        edge.extend((1..=rings).map(|k| ring_of[k][0]));
+        let first = vertices.len() as u32;
+        let shifted: Vec<DVec3> = edge.iter().map(|&e| vertices[e as usize] + out).collect();
+        vertices.extend(shifted);
+        for (j, w) in edge.windows(2).enumerate() {
+            let (p, q) = (first + j as u32, first + j as u32 + 1);
+            triangles.push([w[0], p, q]);
+            triangles.push([w[0], q, w[1]]);
+        }
+    }
+    Surface {
+        vertices,
+        triangles,
+        front,
+    }
+}
+
+/// Degenerate triangles, edges shared by more than two triangles or by two of opposite
+/// orientation, and front vertices off the surface's boundary are errors.
+fn check(src: &Source, key: &str, s: &Surface) -> R<()> {
+    let scale = s
+        .triangles
+        .iter()
+        .flat_map(|t| t.map(|k| s.vertices[k as usize]))
+        .fold(0.0f64, |m, v| m.max(v.abs().max_element()))
+        .max(f64::MIN_POSITIVE);
+    let mut edges: HashMap<[u32; 2], Vec<(usize, bool)>> = HashMap::new();
+    for (k, t) in s.triangles.iter().enumerate() {
+        let [a, b, c] = t.map(|i| s.vertices[i as usize]);
+        let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+        if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] || longest == 0.0 {
+            return Err(src.error(
+                key,
+                format!("triangle {k} is degenerate (repeated vertices)"),
+            ));
+        }
+        // Twice the area against the longest edge squared: a sliver flatter than 1e-9 of
+        // its size, or one lost in round-off at the surface's scale.
+        let area2 = (b - a).cross(c - a).length();
+        if area2 <= 1e-9 * longest * longest || longest <= 1e-12 * scale {
+            return Err(src.error(key, format!("triangle {k} is degenerate (no area)")));
+        }
+        for i in 0..3 {
+            let (p, q) = (t[i], t[(i + 1) % 3]);
+            edges
+                .entry([p.min(q), p.max(q)])
+                .or_default()
+                .push((k, p < q));
+        }
+    }
+    let mut boundary = vec![false; s.vertices.len()];
+    let mut sorted: Vec<_> = edges.into_iter().collect();
+    sorted.sort_unstable_by_key(|e| e.0);
+    for (e, uses) in sorted {
+        match uses[..] {
+            [_] => {
+                boundary[e[0] as usize] = true;
+                boundary[e[1] as usize] = true;
+            }
+            [(t1, d1), (t2, d2)] if d1 == d2 => {
+                return Err(src.error(
+                    key,
+                    format!(
+                        "triangles {t1} and {t2} are oriented oppositely (they run their shared \
+                         edge {}-{} the same way); list every triangle counterclockwise seen \
+                         from the same side",
+                        e[0], e[1]
+                    ),
+                ));
+            }
+            [_, _] => {}
+            _ => {
+                return Err(src.error(
+                    key,
+                    format!(
+                        "edge {}-{} is shared by {} triangles: the surface is not a manifold",
+                        e[0],
+                        e[1],
+                        uses.len()
+                    ),
+                ));
+            }
+        }
+    }
+    if let Some(&v) = s.front.iter().find(|&&v| !boundary[v as usize]) {
+        return Err(src.error(
+            key,
+            format!("front vertex {v} is not on the surface's boundary"),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,448 @@
+//! J2 (von Mises) plasticity at small strain: an elastic predictor and a radial return
+//! (Simo & Hughes 1998, Box 3.2; Mashayekhi, Shodja & Namakian 2011, Eqs. 46-56), with
+//! linear isotropic hardening or the modified Ramberg-Osgood law (Mashayekhi et al. 2011,
+//! Eqs. 62-63); in plane stress the projected return of Simo & Taylor (Simo & Hughes 1998,
+//! Section 3.4.3).
+
+use crate::base::columnar::{Columnar, Scalar};
+use crate::base::sym::Sym3;
+use bytemuck::{Pod, Zeroable};
+use serde::Serialize;
+
+/// How the yield stress grows with the equivalent plastic strain.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum Hardening {
+    /// sigma_y = sigma_0 + H eps_p, with H >= 0 (Pa); H = 0 is perfectly plastic.
+    Linear {
+        /// Hardening modulus H (Pa).
+        modulus: f64,
+    },
+    /// The modified Ramberg-Osgood law: linear up to sigma_0, then eps / eps_0 =
+    /// (sigma / sigma_0)^n in uniaxial tension, so eps_p / eps_0 = (sigma_y/sigma_0)^n -
+    /// sigma_y/sigma_0 with eps_0 = sigma_0 / E (Mashayekhi et al. 2011, Eqs. 62-63).
+    RambergOsgood {
+        /// Hardening exponent n (> 1).
+        exponent: f64,
+    },
+}
+
+/// A von Mises material's plastic parameters (the elastic ones are the material's).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct J2 {
+    /// Initial yield stress sigma_0 (Pa).
+    pub yield_stress: f64,
+    /// Hardening law.
+    pub hardening: Hardening,
+    /// Young's modulus (Pa), which fixes the Ramberg-Osgood eps_0.
+    pub youngs: f64,
+    /// Shear modulus (Pa).
+    pub mu: f64,
+}
+
+/// A particle's hardening state.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct Hardened {
+    /// Equivalent plastic strain eps_p = sum of the plastic multipliers (Eq. 44).
+    pub equivalent: f64,
+    /// Current yield stress (Pa); meaningful once `equivalent` > 0.
+    pub flow_stress: f64,
+    /// Plastic work per unit volume, the integral of sigma_y d(eps_p) (J/m^3).
+    pub work: f64,
+}
+
+impl Columnar for Hardened {
+    const SCALAR: Scalar = Scalar::F64;
+}
+
+/// Most iterations of a scalar solve (the Ramberg-Osgood return, the plane-stress return);
+/// both converge in a handful.
+const MAX_ITERATIONS: usize = 60;
+
+/// Relative tolerance of the scalar solves.
+const TOLERANCE: f64 = 1e-13;
+
+/// r^e, by squaring when e is a small whole number (the usual Ramberg-Osgood exponents):
+/// a few multiplications inline, where `powf` (or `powi`'s library call) costs several
+/// times more in the return map's Newton iterations.
+#[inline(always)]
+fn power(r: f64, e: f64) -> f64 {
+    // `e as u32` saturates, so the round trip holds only for whole e in 0..=64 (and,
+    // unlike `fract`, it needs no library call).
+    let k = e as u32;
+    if k <= 64 && k as f64 == e {
+        let (mut k, mut base, mut acc) = (k, r, 1.0);
+        while k > 0 {
+            if k & 1 == 1 {
+                acc *= base;
+            }
+            base *= base;
+            k >>= 1;
+        }
+        acc
+    } else {
+        r.powf(e)
+    }
+}
+
+impl J2 {
+    /// The yield stress of a particle in state `h`.
+    #[inline(always)]
+    pub fn flow_stress(&self, h: &Hardened) -> f64 {
+        if h.equivalent > 0.0 {
+            h.flow_stress
+        } else {
+            self.yield_stress
+        }
+    }
+
+    /// Solves the consistency condition q - 3 G dl - sigma_y(eps_p + dl) = 0 (Eq. 55) for
+    /// the plastic multiplier dl and the new yield stress, given the trial effective stress
+    /// `q` above the current yield stress `y0`.
+    fn consistency(&self, q: f64, y0: f64, h: &Hardened) -> (f64, f64) {
+        let g3 = 3.0 * self.mu;
+        match self.hardening {
+            Hardening::Linear { modulus } => {
+                let dl = (q - y0) / (g3 + modulus);
+                (dl, y0 + modulus * dl)
+            }
+            Hardening::RambergOsgood { exponent: n } => {
+                // In the new yield stress y: f(y) = q - y - 3G (eps_p(y) - eps_p) is concave
+                // and decreasing on [y0, q]. Newton's first step from y0 (the linearised
+                // return) lands just past the root, and from there Newton falls monotonically
+                // onto it. After a step s the error left is at most K s^2 with K = |f''| /
+                // (2 |f'(y0)|) (|f'| is least at y0, |f''| largest at the iterate); the
+                // iteration stops once the plastic strain that error makes is below the
+                // tolerance: two evaluations of the law for an explicit step's increment.
+                // The new eps_p(y) is the last evaluation's, carried to y along its slope
+                // (an error of the same order).
+                let (s0, eps0) = (self.yield_stress, self.yield_stress / self.youngs);
+                // Reciprocals off the chain of dependent operations a return is.
+                let inv_s0 = 1.0 / s0;
+                let c = g3 * eps0 * inv_s0;
+                let df0 = 1.0 + c * (n * power(y0 * inv_s0, n - 1.0) - 1.0);
+                let mut y = (y0 + (q - y0) / df0).min(q);
+                let mut strain = h.equivalent;
+                for _ in 0..MAX_ITERATIONS {
+                    let r = y * inv_s0;
+                    let p = power(r, n - 1.0);
+                    let e = eps0 * (p * r - r);
+                    let df = 1.0 + c * (n * p - 1.0);
+                    let step = (q - y - g3 * (e - h.equivalent)) / df;
+                    let next = (y + step).clamp(y0, q);
+                    strain = e + (next - y) * eps0 * inv_s0 * (n * p - 1.0);
+                    y = next;
+                    // K s^2 times 2 |f'(y0)| r, with |f''(y)| r = c n (n - 1) r^(n-1) / s0; the
+                    // strain error is that over the hardening slope, eps0/s0 (n r^(n-1) - 1).
+                    let bound = c * n * (n - 1.0) * p * inv_s0 * step * step;
+                    if bound * eps0 * inv_s0 * (n * p - 1.0) <= 2.0 * df0 * TOLERANCE * strain * r {
+                        break;
+                    }
+                }
+                ((strain - h.equivalent).max(0.0), y)
+            }
+        }
+    }
+
+    /// Whether the stress `trial` lies outside the yield surface of state `h`: its
+    /// effective stress sqrt(3 J_2) = sqrt(3/2 S : S) above the yield stress.
+    #[inline(always)]
+    pub fn yields(&self, trial: &Sym3, h: &Hardened) -> bool {
+        let s = trial.deviator();
+        1.5 * s.ddot(&s) > self.flow_stress(h).powi(2)
+    }
+
+    /// Returns `trial` (an elastic predictor) to the yield surface if it lies outside,
+    /// updating the plastic strain and hardening state; a trial inside is kept.
+    #[inline]
+    pub fn radial_return(&self, trial: &mut Sym3, plastic: &mut Sym3, h: &mut Hardened) {
+        let s = trial.deviator();
+        let q2 = 1.5 * s.ddot(&s);
+        let y0 = self.flow_stress(h);
+        if q2 <= y0 * y0 {
+            return;
+        }
+        let p = trial.trace() / 3.0;
+        let q = q2.sqrt();
+        let (dl, y) = self.consistency(q, y0, h);
+        // Eq. 56: S = (1 - 3 G dl / q) S_trial = (y / q) S_trial; the flow direction is
+        // S_trial / q.
+        let inv_q = 1.0 / q;
+        *trial = s * (y * inv_q) + Sym3::identity() * p;
+        *plastic += s * (1.5 * dl * inv_q);
+        // The dissipation sigma_y d(eps_p) by the trapezoidal rule (exact for linear hardening).
+        h.work += 0.5 * (y0 + y) * dl;
+        h.equivalent += dl;
+        h.flow_stress = y;
+    }
+
+    /// Returns the plane-stress elastic trial `trial` (sigma_zz = 0) to the yield surface in
+    /// plane stress, keeping sigma_zz = 0: Simo & Taylor's projected return (Simo & Hughes
+    /// 1998, Section 3.4.3). In the eigenbasis of the J2 projection P the returned stress
+    /// is the trial's scaled by 1 / (1 + E dg / (3 (1 - nu))) along (1, 1, 0) and by
+    /// 1 / (1 + 2 mu dg) along (-1, 1, 0) and the shear, dg the plastic multiplier; one
+    /// scalar equation gives the new yield stress y, q(dg(y)) = y, with dg(y) = 3 dl /
+    /// (2 y) from the hardening law's plastic strain dl (for no hardening, q(dg) = y in
+    /// dg). Safeguarded Newton: each iterate stays inside the bracket the signs give.
+    pub fn plane_stress_return(&self, trial: &mut Sym3, plastic: &mut Sym3, h: &mut Hardened) {
+        let dev = trial.deviator();
+        let y0 = self.flow_stress(h);
+        let q_trial = (1.5 * dev.ddot(&dev)).sqrt();
+        if q_trial <= y0 {
+            return;
+        }
+        let nu = self.youngs / (2.0 * self.mu) - 1.0;
+        let (k1, k2) = (self.youngs / (3.0 * (1.0 - nu)), 2.0 * self.mu);
+        let a1 = (trial.xx + trial.yy) * std::f64::consts::FRAC_1_SQRT_2;
+        let a2 = (trial.yy - trial.xx) * std::f64::consts::FRAC_1_SQRT_2;
+        let (p1, p2) = (a1 * a1 / 3.0, a2 * a2 + 2.0 * trial.xy * trial.xy);
+        // q after a return of multiplier dg, and dq/d(dg).
+        let q_of = |dg: f64| {
+            let (f1, f2) = (1.0 / (1.0 + k1 * dg), 1.0 / (1.0 + k2 * dg));
+            let q = (1.5 * (p1 * f1 * f1 + p2 * f2 * f2)).sqrt();
+            let dxi = -2.0 * (k1 * p1 * f1 * f1 * f1 + k2 * p2 * f2 * f2 * f2);
+            (q, 0.75 * dxi / q)
+        };
+        let tol = TOLERANCE * y0;
+        let (dg, y, dl) = match self.hardening {
+            Hardening::Linear { modulus: 0.0 } => {
+                // q(dg) is convex and decreasing: Newton from dg = 0 rises onto the root.
+                let mut dg = 0.0;
+                for _ in 0..MAX_ITERATIONS {
+                    let (q, dq) = q_of(dg);
+                    let step = (q - y0) / dq;
+                    dg -= step;
+                    if step.abs() * k2 <= TOLERANCE {
+                        break;
+                    }
+                }
+                (dg, y0, 2.0 / 3.0 * dg * y0)
+            }
+            _ => {
+                // dg(y) and d(dg)/dy from the plastic strain the hardening law gives at y.
+                let (s0, eps0) = (self.yield_stress, self.yield_stress / self.youngs);
+                let strain = |y: f64| -> (f64, f64) {
+                    match self.hardening {
+                        Hardening::Linear { modulus } => ((y - y0) / modulus, 1.0 / modulus),
+                        Hardening::RambergOsgood { exponent: n } => {
+                            let r = y / s0;
+                            let p = power(r, n - 1.0);
+                            (eps0 * (p * r - r) - h.equivalent, eps0 / s0 * (n * p - 1.0))
+                        }
+                    }
+                };
+                let (mut lo, mut hi, mut y) = (y0, q_trial, y0);
+                let mut last = f64::NAN;
+                for _ in 0..MAX_ITERATIONS {
+                    let (e, de) = strain(y);
+                    let dg = 1.5 * e.max(0.0) / y;
+                    let (q, dq) = q_of(dg);
+                    let g = q - y;
+                    if g > 0.0 {
+                        lo = y;
+                    } else {
+                        hi = y;
+                    }
+                    let slope = dq * (1.5 * de / y - dg / y) - 1.0;
+                    let step = g / slope;
+                    // Newton's error after this step is about M step^2, with M estimated
+                    // from the last two steps (step ~ M last^2): stop once that is below
+                    // the tolerance, sparing the step that would only confirm it.
+                    if step.abs() <= tol || step * step * step.abs() <= tol * last * last {
+                        y -= step;
+                        break;
+                    }
+                    // Newton, or the bracket's midpoint where Newton would leave it (which
+                    // leaves no estimate of M).
+                    (y, last) = if y - step > lo && y - step < hi {
+                        (y - step, step)
+                    } else {
+                        (0.5 * (lo + hi), f64::NAN)
+                    };
+                }
+                let dl = strain(y).0.max(0.0);
+                (1.5 * dl / y, y, dl)
+            }
+        };
+        let (f1, f2) = (1.0 / (1.0 + k1 * dg), 1.0 / (1.0 + k2 * dg));
+        let (b1, b2) = (
+            a1 * f1 * std::f64::consts::FRAC_1_SQRT_2,
+            a2 * f2 * std::f64::consts::FRAC_1_SQRT_2,
+        );
+        *trial = Sym3 {
+            xx: b1 - b2,
+            yy: b1 + b2,
+            xy: trial.xy * f2,
+            ..Sym3::default()
+        };
+        // Plastic flow along the returned deviator: d(eps_p) = dg S.
+        *plastic += trial.deviator() * dg;
+        h.work += 0.5 * (y0 + y) * dl;
+        h.equivalent += dl;
+        h.flow_stress = y;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::material::{Material, Plane};
+
+    fn steel(hardening: Hardening) -> Material {
+        Material::new("steel", 200e9, 0.3, 7800.0).with_j2(250e6, hardening)
+    }
+
+    /// A stress update of `m` by `de` with plastic state, returning the new stress.
+    fn step(m: &Material, plane: Plane, de: Sym3, st: &mut (Sym3, Sym3, Hardened)) {
+        m.update_plastic(plane, de, &mut st.0, &mut st.1, &mut st.2);
+    }
+
+    /// The equivalent plastic strain at yield stress `y` on the Ramberg-Osgood curve.
+    fn ramberg_osgood_strain(j2: &J2, n: f64, y: f64) -> f64 {
+        let r = y / j2.yield_stress;
+        j2.yield_stress / j2.youngs * (r.powf(n) - r)
+    }
+
+    fn effective(s: &Sym3) -> f64 {
+        let d = s.deviator();
+        (1.5 * d.ddot(&d)).sqrt()
+    }
+
+    /// After a return, the effective stress equals the yield stress to round-off and the
+    /// Ramberg-Osgood state lies on its hardening curve (the consistency condition), in 3D
+    /// and in plane stress (whose return also keeps sigma_zz = 0).
+    #[test]
+    fn return_satisfies_consistency() {
+        for hardening in [
+            Hardening::Linear { modulus: 0.0 },
+            Hardening::Linear { modulus: 2e9 },
+            Hardening::RambergOsgood { exponent: 10.0 },
+            Hardening::RambergOsgood { exponent: 3.0 },
+        ] {
+            // In plane stress the increment is in-plane (its zz is the update's to choose).
+            // Increments of a third of the yield strain and of forty times it.
+            for (plane, out, big) in [
+                (Plane::None, 1.0, 1.0),
+                (Plane::Stress, 0.0, 1.0),
+                (Plane::None, 1.0, 125.0),
+                (Plane::Stress, 0.0, 125.0),
+            ] {
+                let m = steel(hardening);
+                let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
+                let de = Sym3 {
+                    xx: 4e-4,
+                    yy: -1e-4,
+                    zz: 0.5e-4 * out,
+                    yz: 2e-4 * out,
+                    xz: -1e-4 * out,
+                    xy: 3e-4,
+                } * big;
+                for _ in 0..20 {
+                    step(&m, plane, de, &mut st);
+                    // The elastic update leaves round-off in sigma_zz, a return none.
+                    let zz = if plane == Plane::Stress { st.0.zz } else { 0.0 };
+                    assert!(zz.abs() <= 1e-12 * 250e6, "{hardening:?}: sigma_zz {zz}");
+                    let j2 = m.j2.expect("plastic");
+                    let y = j2.flow_stress(&st.2);
+                    let q = effective(&st.0);
+                    if st.2.equivalent > 0.0 {
+                        assert!((q - y).abs() <= 1e-12 * y, "{hardening:?}: {q} vs {y}");
+                    } else {
+                        assert!(q <= y, "{hardening:?}: elastic above yield");
+                    }
+                    if let Hardening::RambergOsgood { exponent } = hardening {
+                        let e = ramberg_osgood_strain(&j2, exponent, y);
+                        assert!(
+                            (e - st.2.equivalent).abs() <= 1e-12 * e,
+                            "{hardening:?} {}",
+                            (e - st.2.equivalent) / e
+                        );
+                    }
+                    // Plastic flow is deviatoric.
+                    assert!(st.1.trace().abs() <= 1e-15 * st.2.equivalent.max(1e-30));
+                }
+            }
+        }
+    }
+
+    /// Uniaxial stress by iterating the lateral strain (3D: yy = zz; plane stress: yy) until
+    /// the lateral stress vanishes; returns sigma_xx.
+    fn uniaxial(m: &Material, plane: Plane, dx: f64, st: &mut (Sym3, Sym3, Hardened)) -> f64 {
+        let lateral = |e: f64| Sym3 {
+            xx: dx,
+            yy: e,
+            zz: if plane == Plane::None { e } else { 0.0 },
+            ..Sym3::default()
+        };
+        let try_e = |e: f64| {
+            let mut s = *st;
+            step(m, plane, lateral(e), &mut s);
+            (s.0.yy, s)
+        };
+        let (mut e0, mut e1) = (-0.3 * dx, -0.5 * dx);
+        let (mut f0, mut f1) = (try_e(e0).0, try_e(e1).0);
+        for _ in 0..100 {
+            if f1 == f0 {
+                break;
+            }
+            let e2 = e1 - f1 * (e1 - e0) / (f1 - f0);
+            (e0, f0) = (e1, f1);
+            e1 = e2;
+            f1 = try_e(e1).0;
+            if f1.abs() < 1e-15 * m.youngs {
+                break;
+            }
+        }
+        *st = try_e(e1).1;
+        st.0.xx
+    }
+
+    /// Loading past yield follows the uniaxial hardening law in 3D and in plane stress, and
+    /// unloading follows the elastic slope E: for linear hardening sigma = sigma_0 +
+    /// E H/(E + H) (eps - eps_0); for Ramberg-Osgood eps/eps_0 = (sigma/sigma_0)^n.
+    #[test]
+    fn uniaxial_cycle_follows_the_hardening_law() {
+        let (e, s0) = (200e9, 250e6);
+        let eps0 = s0 / e;
+        for plane in [Plane::None, Plane::Stress] {
+            for hardening in [
+                Hardening::Linear { modulus: 0.0 },
+                Hardening::Linear { modulus: 10e9 },
+                Hardening::RambergOsgood { exponent: 10.0 },
+            ] {
+                let m = steel(hardening);
+                let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
+                let (steps, peak) = (400, 8.0 * eps0);
+                let mut sigma = 0.0;
+                for k in 1..=steps {
+                    sigma = uniaxial(&m, plane, peak / steps as f64, &mut st);
+                    let eps = peak * k as f64 / steps as f64;
+                    let expect = match hardening {
+                        _ if eps <= eps0 => e * eps,
+                        Hardening::Linear { modulus: h } => s0 + e * h / (e + h) * (eps - eps0),
+                        Hardening::RambergOsgood { exponent: n } => {
+                            // Invert eps/eps0 = r^n by Newton in r = sigma/sigma0.
+                            let mut r: f64 = (eps / eps0).powf(1.0 / n);
+                            for _ in 0..5 {
+                                r -= (r.powf(n) - eps / eps0) / (n * r.powf(n - 1.0));
+                            }
+                            s0 * r
+                        }
+                    };
+                    assert!(
+                        (sigma - expect).abs() <= 1e-9 * s0,
+                        "{plane:?} {hardening:?} at eps = {eps}: {sigma} vs {expect}"
+                    );
+                    assert!(st.0.yy.abs() < 1e-11 * s0 && st.0.zz.abs() < 1e-11 * s0);
+                }
+                let top = sigma;
+                let back = 0.5 * eps0;
+                let unloaded = uniaxial(&m, plane, -back, &mut st);
+                assert!(
+                    (top - unloaded - e * back).abs() <= 1e-9 * s0,
+                    "{plane:?} {hardening:?}: unloading slope"
+                );
+            }
+        }
+    }
+}

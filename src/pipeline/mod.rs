@@ -1,0 +1,4 @@
+//! The step: the schedule of systems a scene needs, and the warm worker pool it runs in.
+
+pub mod schedule;
+mod warm;

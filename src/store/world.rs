@@ -1,0 +1,201 @@
+//! The World: every store, the materials, the scene settings, time and step. Nothing global.
+
+use crate::base::dim::Dim;
+use crate::base::sym::SymTensor;
+use crate::physics::loads::{Load, VelocityBc};
+use crate::physics::material::{Material, Plane};
+use crate::physics::shape::{ShapeKind, StencilCache};
+use crate::store::crack::Cracks;
+use crate::store::grid::Grid;
+use crate::store::particles::Particles;
+use crate::store::tiles::Tiles;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// When the stress is updated within a step (Bardenhagen 2002; Nairn 2003).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Update {
+    /// Update stress first, from the extrapolated momenta, before internal forces.
+    Usf,
+    /// Update stress last, from the updated grid velocities.
+    Usl,
+    /// Half the increment at each of those two points.
+    #[default]
+    Usavg,
+}
+
+/// Scene-wide settings that systems read.
+#[derive(Clone, Debug)]
+pub struct Settings<D: Dim> {
+    /// Shape function.
+    pub shape: ShapeKind,
+    /// Stress-update order.
+    pub update: Update,
+    /// Out-of-plane treatment (None in 3D).
+    pub plane: Plane,
+    /// Mass-proportional damping alpha = d_k / rho (1/s), Guo & Nairn 2D (2004) Eq. 5.
+    pub damping: f64,
+    /// Body force per unit mass (m/s^2).
+    pub gravity: D::Vec,
+    /// Time step (s).
+    pub dt: f64,
+    /// Nodes lighter than this carry no velocity (kg).
+    pub mass_tol: f64,
+    /// Nodes lighter than this do not move cracks (kg): a thousandth of the lightest
+    /// particle. A node at the edge of a particle's support gets a sliver of mass and, with
+    /// the internal force on it, a meaningless velocity.
+    pub sliver_mass: f64,
+    /// Out-of-plane thickness (m) in 2D, 1 in 3D: particle volume over particle area.
+    pub thickness: f64,
+}
+
+/// Work accumulated since t = 0 (J).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Work {
+    /// Work done by external particle forces and gravity.
+    pub external: f64,
+    /// Energy removed by damping.
+    pub damping: f64,
+    /// Energy dissipated by Coulomb friction on crack faces.
+    pub friction: f64,
+}
+
+/// One row of energy.csv (J).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Energies {
+    /// Kinetic energy.
+    pub kinetic: f64,
+    /// Material strain energy.
+    pub strain: f64,
+    /// External work done on the body.
+    pub external_work: f64,
+    /// Energy removed by damping.
+    pub damping_work: f64,
+    /// Energy dissipated by plastic flow (zero in an elastic scene).
+    pub plastic_work: f64,
+    /// Energy dissipated by friction on crack faces (zero without a friction law).
+    pub friction_work: f64,
+}
+
+impl Energies {
+    /// The stored and dissipated energy, K + W + W_p.
+    pub fn internal(&self) -> f64 {
+        self.kinetic + self.strain + self.plastic_work
+    }
+
+    /// The balance E = K + W + W_p - W_ext + W_damp + W_f, constant when energy is
+    /// conserved.
+    pub fn balance(&self) -> f64 {
+        self.internal() - self.external_work + self.damping_work + self.friction_work
+    }
+}
+
+/// All simulation state.
+#[derive(Clone, Debug)]
+pub struct World<D: Dim> {
+    /// Particle store.
+    pub particles: Particles<D>,
+    /// Grid store.
+    pub grid: Grid<D>,
+    /// Particle bins.
+    pub tiles: Tiles,
+    /// Material table, indexed by the particles' material column.
+    pub materials: Vec<Material>,
+    /// Scene settings.
+    pub settings: Settings<D>,
+    /// External particle forces.
+    pub loads: Vec<Load<D>>,
+    /// Prescribed grid velocities.
+    pub bcs: Vec<VelocityBc<D>>,
+    /// Simulated time (s).
+    pub time: f64,
+    /// Steps taken.
+    pub step: u64,
+    /// Accumulated work.
+    pub work: Work,
+    /// Explicit cracks and their velocity fields (None in a scene without cracks).
+    pub cracks: Option<Cracks<D>>,
+}
+
+/// Particles (or grid nodes) per chunk in parallel loops; fixed so reductions do not
+/// depend on the thread count.
+pub const CHUNK: usize = 1024;
+
+impl<D: Dim> World<D> {
+    /// Kinetic and strain energy now, with the accumulated work.
+    pub fn energies(&self) -> Energies {
+        let p = &self.particles;
+        let mats = &self.materials;
+        let parts: Vec<[f64; 3]> = (0..p.len().div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (mut k, mut w, mut wp) = (0.0, 0.0, 0.0);
+                for i in c * CHUNK..((c + 1) * CHUNK).min(p.len()) {
+                    k += 0.5 * p.mass[i] * D::dot(p.v[i], p.v[i]);
+                    w += p.volume[i]
+                        * mats[p.material[i] as usize].energy_density(&p.stress[i].to_sym3());
+                    wp += p.volume[i] * p.plastic_work(i);
+                }
+                [k, w, wp]
+            })
+            .collect();
+        let sum = |k: usize| parts.iter().map(|p| p[k]).sum();
+        Energies {
+            kinetic: sum(0),
+            strain: sum(1),
+            plastic_work: sum(2),
+            external_work: self.work.external,
+            damping_work: self.work.damping,
+            friction_work: self.work.friction,
+        }
+    }
+
+    /// With linear shape functions, the particles now in another grid cell than the one
+    /// they started in (None with the other shapes). Each crossing of a cell edge jumps a
+    /// linear stencil's gradients, and with them the particle's internal force (the
+    /// cell-crossing error that GIMP removes, Bardenhagen & Kober 2004).
+    pub fn cell_crossings(&self) -> Option<usize> {
+        if self.settings.shape != ShapeKind::Linear {
+            return None;
+        }
+        let g = &self.grid.geom;
+        let cell = |x: D::Vec, a: usize| ((x[a] - g.origin[a]) * g.inv_h[a]).floor();
+        let p = &self.particles;
+        let moved = (0..p.len())
+            .into_par_iter()
+            .filter(|&i| (0..D::D).any(|a| cell(p.x[i], a) != cell(p.x0[i], a)))
+            .count();
+        Some(moved)
+    }
+
+    /// Bytes held per particle: the particle columns plus the bins (tile and order, 4 bytes
+    /// each) and the cached stencil (a 4-byte first node plus the shape's parameters).
+    pub fn bytes_per_particle(&self) -> usize {
+        let params = StencilCache::per::<D>(self.settings.shape);
+        self.particles.bytes_per_particle() + 8 + 4 + 8 * params
+    }
+
+    /// Total linear momentum (kg m/s).
+    pub fn momentum(&self) -> D::Vec {
+        let p = &self.particles;
+        let mut m = D::zero();
+        for i in 0..p.len() {
+            m += p.v[i] * p.mass[i];
+        }
+        m
+    }
+
+    /// Total angular momentum about `centre` (kg m^2/s), padded to 3 components.
+    pub fn angular_momentum(&self, centre: D::Vec) -> [f64; 3] {
+        let p = &self.particles;
+        let mut l = [0.0; 3];
+        for i in 0..p.len() {
+            let c = D::cross(p.x[i] - centre, p.v[i] * p.mass[i]);
+            for a in 0..3 {
+                l[a] += c[a];
+            }
+        }
+        l
+    }
+}
