@@ -4,7 +4,7 @@
 
 use crate::base::dim::Dim;
 use crate::physics::shape::{ShapeKind, Stencil};
-use crate::store::crack::{Cracks, Fields, Geometry};
+use crate::store::crack::{Cracks, Fields, Positions};
 use crate::store::world::{Update, World};
 
 /// Momentum and mass at node `n`, all fields together (Eq. 23's centre of mass), and of its
@@ -44,7 +44,7 @@ fn node_fields<D: Dim>(
 pub fn run<D: Dim>(world: &mut World<D>) {
     let Some(Cracks {
         topology,
-        geometry: Geometry { x: xs, top, bottom },
+        geometry: Positions { x: xs, top, bottom },
         scratch,
         ..
     }) = world.cracks.as_mut()

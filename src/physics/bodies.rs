@@ -2,7 +2,7 @@
 
 /// A body's shape, in padded 3-component coordinates (z = 0 in 2D).
 #[derive(Clone, Debug)]
-pub enum Geometry {
+pub enum Solid {
     /// Axis-aligned box.
     Box {
         /// Lower corner (m).
@@ -44,12 +44,12 @@ pub enum Geometry {
     },
 }
 
-impl Geometry {
+impl Solid {
     /// Whether a point lies inside.
     pub fn contains(&self, x: [f64; 3]) -> bool {
         match self {
-            Geometry::Box { min, max } => (0..3).all(|a| x[a] >= min[a] && x[a] <= max[a]),
-            Geometry::Round {
+            Solid::Box { min, max } => (0..3).all(|a| x[a] >= min[a] && x[a] <= max[a]),
+            Solid::Round {
                 center,
                 radius,
                 inner,
@@ -59,7 +59,7 @@ impl Geometry {
                 let r2: f64 = (0..n).map(|a| (x[a] - center[a]).powi(2)).sum();
                 r2 <= radius * radius && r2 >= inner * inner
             }
-            Geometry::Cylinder {
+            Solid::Cylinder {
                 center,
                 axis,
                 radius,
@@ -73,7 +73,7 @@ impl Geometry {
                     .sum();
                 (0.0..=*length).contains(&along) && r2 <= radius * radius && r2 >= inner * inner
             }
-            Geometry::Polygon { points, z } => {
+            Solid::Polygon { points, z } => {
                 if let Some([z0, z1]) = z
                     && !(x[2] >= *z0 && x[2] <= *z1)
                 {
@@ -87,8 +87,8 @@ impl Geometry {
     /// Bounding box (lower, upper), m.
     pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
         match self {
-            Geometry::Box { min, max } => (*min, *max),
-            Geometry::Round {
+            Solid::Box { min, max } => (*min, *max),
+            Solid::Round {
                 center,
                 radius,
                 sphere,
@@ -102,7 +102,7 @@ impl Geometry {
                 }
                 (lo, hi)
             }
-            Geometry::Cylinder {
+            Solid::Cylinder {
                 center,
                 axis,
                 radius,
@@ -121,7 +121,7 @@ impl Geometry {
                 }
                 (lo, hi)
             }
-            Geometry::Polygon { points, z } => {
+            Solid::Polygon { points, z } => {
                 let mut lo = [f64::INFINITY, f64::INFINITY, 0.0];
                 let mut hi = [f64::NEG_INFINITY, f64::NEG_INFINITY, 0.0];
                 for p in points {
@@ -160,7 +160,7 @@ fn point_in_polygon(points: &[[f64; 2]], p: [f64; 2]) -> bool {
 /// Particle positions filling `geom`: `ppc` per cell per axis at sub-cell centres of the
 /// grid cells (origin, h, cells per axis; `dims` axes used).
 pub fn fill(
-    geom: &Geometry,
+    geom: &Solid,
     dims: usize,
     origin: [f64; 3],
     h: [f64; 3],
@@ -210,7 +210,7 @@ mod tests {
     #[test]
     fn disc_fill_area_converges() {
         for inner in [0.0, 0.1] {
-            let g = Geometry::Round {
+            let g = Solid::Round {
                 center: [0.5, 0.5, 0.0],
                 radius: 0.3,
                 inner,
@@ -225,7 +225,7 @@ mod tests {
 
     #[test]
     fn polygon_contains_and_excludes() {
-        let tri = Geometry::Polygon {
+        let tri = Solid::Polygon {
             points: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
             z: None,
         };

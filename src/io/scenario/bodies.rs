@@ -7,7 +7,7 @@ use super::grid::GridPlan;
 use super::schema::{BodySpec, RoundSpec};
 use super::source::Source;
 use crate::base::dim::Dim;
-use crate::physics::bodies::{Geometry, fill};
+use crate::physics::bodies::{Solid, fill};
 use crate::physics::material::Material;
 use crate::physics::shape::ShapeKind;
 use crate::store::grid::GridGeom;
@@ -101,7 +101,7 @@ pub(super) fn bodies<D: Dim>(
 }
 
 /// The geometry of body `b`, from exactly one geometry key.
-fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
+fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Solid> {
     let key = |k: &str| format!("body[{b}].{k}");
     let given = [
         body.box_.is_some(),
@@ -118,13 +118,13 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
     }
     if let Some(bx) = &body.box_ {
         let (min, max) = box_corners::<D>(src, &key("box"), bx)?;
-        return Ok(Geometry::Box { min, max });
+        return Ok(Solid::Box { min, max });
     }
     if let Some(d) = &body.disc {
         if D::D != 2 {
             return Err(src.error(&key("disc"), "disc is 2D; use sphere or cylinder in 3D"));
         }
-        return Ok(Geometry::Round {
+        return Ok(Solid::Round {
             center: vec3::<D>(src, &key("disc.center"), &d.center)?,
             radius: positive(src, &key("disc.radius"), d.radius, "m")?,
             inner: hole(src, &key("disc.inner_radius"), d)?,
@@ -135,7 +135,7 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
         if D::D != 3 {
             return Err(src.error(&key("sphere"), "sphere is 3D; use disc in 2D"));
         }
-        return Ok(Geometry::Round {
+        return Ok(Solid::Round {
             center: vec3::<D>(src, &key("sphere.center"), &s.center)?,
             radius: positive(src, &key("sphere.radius"), s.radius, "m")?,
             inner: hole(src, &key("sphere.inner_radius"), s)?,
@@ -153,7 +153,7 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
                 format!("the bore's radius must lie in [0, radius = {radius:e}) m"),
             ));
         }
-        return Ok(Geometry::Cylinder {
+        return Ok(Solid::Cylinder {
             center: vec3::<D>(src, &key("cylinder.center"), &c.center)?,
             axis: axis_index::<D>(src, &key("cylinder.axis"), &c.axis)?,
             radius,
@@ -188,7 +188,7 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Geometry> {
         (Some(_), 2) => return Err(src.error(&key("polygon.z"), "z applies to 3D scenes only")),
         (Some(_), _) => return Err(src.error(&key("polygon.z"), "z must be [z0, z1] with z1 > z0")),
     };
-    Ok(Geometry::Polygon { points, z })
+    Ok(Solid::Polygon { points, z })
 }
 
 /// The radius of a ring's or a spherical shell's hole: in [0, radius) (m).

@@ -4,12 +4,12 @@
 //! around it keeps its own material).
 
 use super::region::Region;
-use crate::physics::bodies::Geometry;
+use crate::physics::bodies::Solid;
 
 /// A body's region: its geometry, inside its clip, outside its holes.
 pub(super) struct Claim {
     /// The geometry.
-    pub geometry: Geometry,
+    pub geometry: Solid,
     /// The clip region, if any.
     pub clip: Option<Region>,
     /// The holes' centres and radii (m).

@@ -3,7 +3,7 @@
 use super::check::{R, to_vec, vec3};
 use super::region::particles_in;
 use super::source::Source;
-use super::traction::{Face, Field, tractions};
+use super::traction::{Face, StressField, tractions};
 use crate::base::dim::Dim;
 use crate::physics::loads::Load;
 use crate::store::grid::GridGeom;
@@ -25,7 +25,7 @@ pub(super) fn loads<D: Dim>(
         if let Some(msg) = l.time.check() {
             return Err(src.error(&key("time"), msg));
         }
-        let forces = match (&l.force, Field::of::<D>(src, &key, l)?) {
+        let forces = match (&l.force, StressField::of::<D>(src, &key, l)?) {
             (Some(f), None) => {
                 if l.normal.is_some() {
                     return Err(src.error(&key("normal"), "`normal` goes with a traction"));

@@ -13,7 +13,7 @@ use crate::store::particles::Particles;
 type R<T> = Result<T, ScenarioError>;
 
 /// A stress field on a face, in global axes.
-pub(super) enum Field {
+pub(super) enum StressField {
     /// A uniform pressure (Pa): the stress -p I, so the traction is -p n.
     Pressure(f64),
     /// Williams near-tip field: K_I, K_II (Pa sqrt(m)), tip (m), crack direction (rad).
@@ -32,13 +32,13 @@ pub(super) enum Field {
     },
 }
 
-impl Field {
+impl StressField {
     /// The field a `[[load]]` names, if any (at most one).
     pub fn of<D: Dim>(
         src: &Source,
         key: &dyn Fn(&str) -> String,
         l: &LoadSpec,
-    ) -> R<Option<Field>> {
+    ) -> R<Option<StressField>> {
         let named = [
             l.pressure.is_some(),
             l.williams.is_some(),
@@ -54,7 +54,7 @@ impl Field {
             if !p.value.is_finite() {
                 return Err(src.error(&key("pressure.value"), "the pressure must be finite (Pa)"));
             }
-            return Ok(Some(Field::Pressure(p.value)));
+            return Ok(Some(StressField::Pressure(p.value)));
         }
         if D::D != 2 && (l.williams.is_some() || l.centre_crack.is_some()) {
             return Err(src.error(
@@ -75,7 +75,7 @@ impl Field {
                         "KI, KII (Pa sqrt(m)) and direction (degrees) must be finite",
                     ));
                 }
-                Ok(Some(Field::Williams {
+                Ok(Some(StressField::Williams {
                     k: [w.k1, w.k2],
                     tip: coords(src, &key("williams.tip"), &w.tip)?,
                     angle: w.direction.to_radians(),
@@ -101,7 +101,7 @@ impl Field {
                     ));
                 }
                 let angle = c.angle.to_radians();
-                Ok(Some(Field::CentreCrack {
+                Ok(Some(StressField::CentreCrack {
                     remote: rotate_stress([c.stress[0], c.stress[1], c.stress[2]], -angle),
                     center: coords(src, &key("centre_crack.center"), &c.center)?,
                     a: c.half_length,
@@ -115,7 +115,7 @@ impl Field {
     /// Traction on the face with outward unit normal `n` at `x`, or None where the field
     /// is singular (a tip, a crack face).
     fn traction(&self, x: [f64; 3], n: [f64; 3]) -> Option<[f64; 3]> {
-        if let Field::Pressure(p) = self {
+        if let StressField::Pressure(p) = self {
             return Some(n.map(|c| -p * c));
         }
         let [sxx, syy, sxy] = self.plane_stress([x[0], x[1]])?;
@@ -130,13 +130,13 @@ impl Field {
             [cs * d[0] + sn * d[1], -sn * d[0] + cs * d[1]]
         };
         match self {
-            Field::Williams { k, tip, angle } => {
+            StressField::Williams { k, tip, angle } => {
                 let [xl, yl] = local(tip, *angle);
                 let r = xl.hypot(yl);
                 (r > 0.0)
                     .then(|| rotate_stress(near_tip::stress(k[0], k[1], r, yl.atan2(xl)), *angle))
             }
-            Field::CentreCrack {
+            StressField::CentreCrack {
                 remote,
                 center,
                 a,
@@ -145,7 +145,7 @@ impl Field {
                 let [xl, yl] = local(center, *angle);
                 centre_crack_stress(*remote, *a, xl, yl).map(|s| rotate_stress(s, *angle))
             }
-            Field::Pressure(_) => unreachable!("a pressure has no plane stress"),
+            StressField::Pressure(_) => unreachable!("a pressure has no plane stress"),
         }
     }
 }
@@ -270,7 +270,7 @@ impl<'a> Face<'a> {
 pub(super) fn tractions<D: Dim>(
     src: &Source,
     face: &Face,
-    field: &Field,
+    field: &StressField,
     sel: &[u32],
     particles: &Particles<D>,
     ppc: &[f64],

@@ -4,7 +4,7 @@
 //!
 //! The store keeps three kinds of data apart: the [`Topology`] (vertex lists, elements,
 //! fronts; changes only when a crack grows, with a version number), the per-step
-//! [`Geometry`] of the vertices, and the systems' [`Scratch`] (the extra velocity fields
+//! [`Positions`] of the vertices, and the systems' [`Scratch`] (the extra velocity fields
 //! and what classification and contact keep between steps).
 
 mod bins;
@@ -31,7 +31,7 @@ pub const MAX_CRACKS: usize = u16::MAX as usize;
 
 /// Where each crack vertex is (struct of arrays, one entry per vertex).
 #[derive(Clone, Debug)]
-pub struct Geometry<D: Dim> {
+pub struct Positions<D: Dim> {
     /// Crack-plane position of each vertex (m); moves with the centre-of-mass field.
     pub x: Vec<D::Vec>,
     /// Top-surface position (m); moves with the field above the crack.
@@ -40,7 +40,7 @@ pub struct Geometry<D: Dim> {
     pub bottom: Vec<D::Vec>,
 }
 
-impl<D: Dim> Geometry<D> {
+impl<D: Dim> Positions<D> {
     /// A new vertex (the next index) where vertex `v` is, with its surfaces, and `v` moved
     /// to `to` with both surfaces closed on it: how a tip or front vertex advances.
     fn leave_behind(&mut self, v: usize, to: D::Vec) {
@@ -53,9 +53,9 @@ impl<D: Dim> Geometry<D> {
     }
 }
 
-impl<D: Dim> Default for Geometry<D> {
+impl<D: Dim> Default for Positions<D> {
     fn default() -> Self {
-        Geometry {
+        Positions {
             x: Vec::new(),
             top: Vec::new(),
             bottom: Vec::new(),
@@ -69,7 +69,7 @@ pub struct Cracks<D: Dim> {
     /// What is connected to what.
     pub topology: Topology<D>,
     /// Where the vertices are.
-    pub geometry: Geometry<D>,
+    pub geometry: Positions<D>,
     /// What each front's tip has grown (one per front, in the topology's order).
     pub tips: Vec<TipState>,
     /// Rebuilt or kept by the systems; not part of a snapshot.
