@@ -11,7 +11,7 @@
 
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
-use crate::base::geometry::Element;
+use crate::base::geometry::{Aabb, Element};
 use crate::physics::shape::{ShapeKind, Stencil, StencilCache};
 use crate::store::crack::{self, Classified, Cracks, Fields, side_bit};
 use crate::store::grid::GridGeom;
@@ -21,39 +21,6 @@ use crate::with_shape;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
-/// Axis-aligned box (min, max).
-type Aabb<D> = (<D as Dim>::Vec, <D as Dim>::Vec);
-
-fn overlaps<D: Dim>(a: &Aabb<D>, b: &Aabb<D>) -> bool {
-    (0..D::D).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
-}
-
-fn span<D: Dim>(a: D::Vec, b: D::Vec) -> Aabb<D> {
-    let (mut lo, mut hi) = (a, a);
-    for k in 0..D::D {
-        lo[k] = a[k].min(b[k]);
-        hi[k] = a[k].max(b[k]);
-    }
-    (lo, hi)
-}
-
-/// Squared distance between two boxes (zero where they meet): at most that between any
-/// point or segment in one and any element in the other.
-fn gap_sq<D: Dim>(a: &Aabb<D>, b: &Aabb<D>) -> f64 {
-    (0..D::D)
-        .map(|k| (a.0[k] - b.1[k]).max(b.0[k] - a.1[k]).max(0.0).powi(2))
-        .sum()
-}
-
-fn grow<D: Dim>(b: &Aabb<D>, by: f64) -> Aabb<D> {
-    let (mut lo, mut hi) = *b;
-    for k in 0..D::D {
-        lo[k] -= by;
-        hi[k] += by;
-    }
-    (lo, hi)
-}
-
 /// The crack elements with their boxes, sorted along the axis in which the cracks spread
 /// most, so the elements a box can meet are one run of the list.
 struct Elements<'a, D: Dim> {
@@ -62,7 +29,7 @@ struct Elements<'a, D: Dim> {
     elem_crack: &'a [u16],
     /// Each crack's colour: the pair of mask bits its crossings set.
     color: &'a [u8],
-    boxes: Vec<Aabb<D>>,
+    boxes: Vec<Aabb<D::Vec>>,
     order: Vec<u32>,
     axis: usize,
     widest: f64,
@@ -70,7 +37,7 @@ struct Elements<'a, D: Dim> {
     /// a crossing through it is parity-safe ([`Dim::SHARED_FEATURE_SAFE`]), else `NONE`.
     neighbour: &'a [[u32; 3]],
     /// Box of all the elements (None without elements).
-    all: Option<Aabb<D>>,
+    all: Option<Aabb<D::Vec>>,
 }
 
 /// No element.
@@ -84,28 +51,17 @@ impl<'a, D: Dim> Elements<'a, D> {
         color: &'a [u8],
         neighbour: &'a [[u32; 3]],
     ) -> Self {
-        let boxes: Vec<Aabb<D>> = elems
-            .iter()
-            .map(|e| {
-                let v = e.vertices();
-                let first = span::<D>(x[v[0] as usize], x[v[1] as usize]);
-                v[2..].iter().fold(first, |(lo, hi), &k| {
-                    let y = x[k as usize];
-                    (span::<D>(lo, y).0, span::<D>(hi, y).1)
-                })
-            })
-            .collect();
-        let all =
-            (boxes.iter().copied()).reduce(|a, b| (span::<D>(a.0, b.0).0, span::<D>(a.1, b.1).1));
-        let extent = |k: usize| all.map_or(0.0, |b| b.1[k] - b.0[k]);
+        let boxes: Vec<Aabb<D::Vec>> = elems.iter().map(|e| e.bounds(x)).collect();
+        let all = (boxes.iter().copied()).reduce(|a, b| a.union(&b));
+        let extent = |k: usize| all.map_or(0.0, |b| b.hi[k] - b.lo[k]);
         let axis = (0..D::D)
             .max_by(|&a, &b| extent(a).total_cmp(&extent(b)))
             .unwrap_or(0);
         let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
-        order.sort_by(|&a, &b| boxes[a as usize].0[axis].total_cmp(&boxes[b as usize].0[axis]));
+        order.sort_by(|&a, &b| boxes[a as usize].lo[axis].total_cmp(&boxes[b as usize].lo[axis]));
         let widest = boxes
             .iter()
-            .map(|b| b.1[axis] - b.0[axis])
+            .map(|b| b.hi[axis] - b.lo[axis])
             .fold(0.0, f64::max);
         Elements {
             x,
@@ -122,26 +78,26 @@ impl<'a, D: Dim> Elements<'a, D> {
     }
 
     /// The run of `order` whose boxes can meet `b` along the sorting axis.
-    fn run(&self, b: &Aabb<D>) -> &[u32] {
+    fn run(&self, b: &Aabb<D::Vec>) -> &[u32] {
         let (ax, boxes) = (self.axis, &self.boxes);
         let first = self
             .order
-            .partition_point(|&e| boxes[e as usize].0[ax] < b.0[ax] - self.widest);
+            .partition_point(|&e| boxes[e as usize].lo[ax] < b.lo[ax] - self.widest);
         let last = self
             .order
-            .partition_point(|&e| boxes[e as usize].0[ax] <= b.1[ax]);
+            .partition_point(|&e| boxes[e as usize].lo[ax] <= b.hi[ax]);
         &self.order[first..last.max(first)]
     }
 
     /// Whether some element's box meets `b`.
-    fn any_meeting(&self, b: &Aabb<D>) -> bool {
-        (self.run(b).iter()).any(|&e| overlaps::<D>(b, &self.boxes[e as usize]))
+    fn any_meeting(&self, b: &Aabb<D::Vec>) -> bool {
+        (self.run(b).iter()).any(|&e| b.overlaps(&self.boxes[e as usize]))
     }
 
     /// Replaces `out` with the elements whose boxes meet `b`, in increasing element order.
-    fn meeting(&self, b: &Aabb<D>, out: &mut Vec<u32>) {
+    fn meeting(&self, b: &Aabb<D::Vec>, out: &mut Vec<u32>) {
         out.clear();
-        out.extend((self.run(b).iter()).filter(|&&e| overlaps::<D>(b, &self.boxes[e as usize])));
+        out.extend((self.run(b).iter()).filter(|&&e| b.overlaps(&self.boxes[e as usize])));
         out.sort_unstable();
     }
 
@@ -149,11 +105,11 @@ impl<'a, D: Dim> Elements<'a, D> {
     /// of `xp` to each), taken in increasing element order so the result never depends on
     /// how the elements were found.
     fn mask(&self, xp: D::Vec, xn: D::Vec, near: &[(u32, i8)]) -> u64 {
-        let line = span::<D>(xp, xn);
+        let line = Aabb::span(xp, xn);
         let (mut odd, mut above) = (0u32, 0u32);
         for &(e, sp) in near {
             let e = e as usize;
-            if !overlaps::<D>(&line, &self.boxes[e]) {
+            if !line.overlaps(&self.boxes[e]) {
                 continue;
             }
             let s = self.elems[e].crossing_from(xp, sp, xn, self.x);
@@ -276,9 +232,12 @@ impl<D: Dim> Pass<'_, D> {
             }
         }
         let corners = &corners[..1 << D::D];
-        let node_box = (corners[0], corners[corners.len() - 1]);
+        let node_box = Aabb {
+            lo: corners[0],
+            hi: corners[corners.len() - 1],
+        };
         let reach = if clear { self.skin } else { 0.0 };
-        elements.meeting(&grow::<D>(&node_box, reach), &mut s.close);
+        elements.meeting(&node_box.grown(reach), &mut s.close);
         // Node positions in the stencil's order (x fastest, then y, then z), from the base
         // rather than `node_position` (which divides), when some element is close.
         s.nodes.clear();
@@ -309,7 +268,7 @@ impl<D: Dim> Pass<'_, D> {
         for &e in &s.close {
             let el = elements.elems[e as usize];
             let sp = el.side(xp, x);
-            if overlaps::<D>(&node_box, &elements.boxes[e as usize])
+            if node_box.overlaps(&elements.boxes[e as usize])
                 && corners.iter().any(|&c| el.side(c, x) != sp)
             {
                 s.near.push((e, sp));
@@ -340,11 +299,11 @@ impl<D: Dim> Pass<'_, D> {
             let bx = &elements.boxes[e as usize];
             for &xn in &s.nodes {
                 let from = if any_open {
-                    span::<D>(xp, xn)
+                    Aabb::span(xp, xn)
                 } else {
-                    (xn, xn)
+                    Aabb::at(xn)
                 };
-                if gap_sq::<D>(&from, bx) > clearance * clearance * (1.0 + 1e-9) {
+                if from.gap_sq(bx) > clearance * clearance * (1.0 + 1e-9) {
                     continue;
                 }
                 let mut c = el.distance(xn, x);
@@ -431,8 +390,8 @@ impl<D: Dim> Pass<'_, D> {
             let mut t_hi = [0usize; 3];
             for k in 0..D::D {
                 let cell = |x: f64| ((x - geom.origin[k]) * geom.inv_h[k]).max(0.0) as usize;
-                t_lo[k] = (cell(all.0[k] - reach[k]) / tiles.size).min(tiles.counts[k] - 1);
-                t_hi[k] = (cell(all.1[k] + reach[k]) / tiles.size).min(tiles.counts[k] - 1);
+                t_lo[k] = (cell(all.lo[k] - reach[k]) / tiles.size).min(tiles.counts[k] - 1);
+                t_hi[k] = (cell(all.hi[k] + reach[k]) / tiles.size).min(tiles.counts[k] - 1);
             }
             for tk in t_lo[2]..=t_hi[2] {
                 for tj in t_lo[1]..=t_hi[1] {
@@ -441,7 +400,10 @@ impl<D: Dim> Pass<'_, D> {
                         rec.watched
                             .extend(tiles.particles(t as u32).iter().filter(|&&i| {
                                 let xp = xs[i as usize];
-                                self.elements.any_meeting(&(xp - reach, xp + reach))
+                                self.elements.any_meeting(&Aabb {
+                                    lo: xp - reach,
+                                    hi: xp + reach,
+                                })
                             }));
                     }
                 }

@@ -3,7 +3,7 @@
 //! element type fixes its vector type, so code written for one shape of element does not
 //! compile for the other.
 
-use super::{Bounds, Point, point_segment, point_segment_sq, point_triangle, segment_segment};
+use super::{Aabb, Point, point_segment, point_segment_sq, point_triangle, segment_segment};
 use glam::{DVec2, DVec3};
 use std::fmt::Debug;
 
@@ -59,15 +59,13 @@ pub trait Element: Copy + Debug + PartialEq + Send + Sync + 'static {
     /// Distance from feature `k` of the element to the segment `p`-`q` (m).
     fn feature_distance(&self, p: Self::Vec, q: Self::Vec, v: &[Self::Vec], k: usize) -> f64;
     /// The element's axis-aligned box.
-    fn bounds(&self, v: &[Self::Vec]) -> Bounds {
-        let mut b = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for &k in self.vertices() {
-            for (a, x) in v[k as usize].xyz().into_iter().enumerate() {
-                b.0[a] = b.0[a].min(x);
-                b.1[a] = b.1[a].max(x);
-            }
-        }
-        b
+    fn bounds(&self, v: &[Self::Vec]) -> Aabb<Self::Vec> {
+        let [first, rest @ ..] = self.vertices() else {
+            unreachable!("an element has vertices")
+        };
+        (rest.iter()).fold(Aabb::at(v[*first as usize]), |b, &k| {
+            b.union(&Aabb::at(v[k as usize]))
+        })
     }
 }
 

@@ -7,7 +7,7 @@ mod distance;
 mod element;
 mod point;
 
-pub use bounds::{Bounds, meeting_pairs, overlap};
+pub use bounds::{Aabb, meeting_pairs};
 pub use distance::{point_segment, point_segment_sq, point_triangle, segment_segment};
 pub use element::{Element, NUDGE, Segment, Triangle};
 pub use point::Point;

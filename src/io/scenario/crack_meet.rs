@@ -3,7 +3,7 @@
 //! meet a node's fields would be ambiguous.
 
 use crate::base::dim::Dim;
-use crate::base::geometry::{Bounds, Element, meeting_pairs, overlap};
+use crate::base::geometry::{Aabb, Element, meeting_pairs};
 use crate::store::crack::Cracks;
 
 /// The edges of a crack element as vertex pairs: the segment itself in 2D, the three
@@ -48,11 +48,11 @@ pub(super) fn meets<D: Dim>(
 ) -> Option<(usize, usize, usize)> {
     let topo = &store.topology;
     let vx = &store.geometry.x;
-    let mine: Vec<Bounds> = elems.iter().map(|e| e.bounds(points)).collect();
+    let mine: Vec<Aabb<D::Vec>> = elems.iter().map(|e| e.bounds(points)).collect();
     for c in 0..topo.cracks().len() {
         // The other crack's elements sorted by the low x of their boxes, so that only those
         // whose box can reach a new element's are tried.
-        let theirs: Vec<(Bounds, usize, D::Elem)> = (topo.elems().iter())
+        let theirs: Vec<(Aabb<D::Vec>, usize, D::Elem)> = (topo.elems().iter())
             .zip(topo.elem_crack())
             .filter(|(_, k)| **k as usize == c)
             .enumerate()
@@ -60,18 +60,18 @@ pub(super) fn meets<D: Dim>(
             .collect();
         let widest = theirs
             .iter()
-            .map(|(b, _, _)| b.1[0] - b.0[0])
+            .map(|(b, _, _)| b.hi[0] - b.lo[0])
             .fold(0.0, f64::max);
         let mut order: Vec<usize> = (0..theirs.len()).collect();
-        order.sort_by(|&i, &j| theirs[i].0.0[0].total_cmp(&theirs[j].0.0[0]));
-        let low: Vec<f64> = order.iter().map(|&i| theirs[i].0.0[0]).collect();
+        order.sort_by(|&i, &j| theirs[i].0.lo[0].total_cmp(&theirs[j].0.lo[0]));
+        let low: Vec<f64> = order.iter().map(|&i| theirs[i].0.lo[0]).collect();
         let mut found: Option<(usize, usize)> = None;
         for (ia, (ea, ba)) in elems.iter().zip(&mine).enumerate() {
-            let from = low.partition_point(|&x| x < ba.0[0] - widest);
-            let to = low.partition_point(|&x| x <= ba.1[0]);
+            let from = low.partition_point(|&x| x < ba.lo[0] - widest);
+            let to = low.partition_point(|&x| x <= ba.hi[0]);
             for &j in &order[from..to] {
                 let (bb, ib, eb) = &theirs[j];
-                if overlap(ba, bb)
+                if ba.overlaps(bb)
                     && (edge_crosses::<D>(points, ea, vx, *eb)
                         || edge_crosses::<D>(vx, eb, points, *ea)
                         || touches::<D>(points, ea, vx, *eb, tol)
@@ -100,7 +100,7 @@ pub(super) fn self_meets<D: Dim>(
     elems: &[D::Elem],
     tol: f64,
 ) -> Option<(usize, usize)> {
-    let boxes: Vec<Bounds> = elems.iter().map(|e| e.bounds(points)).collect();
+    let boxes: Vec<Aabb<D::Vec>> = elems.iter().map(|e| e.bounds(points)).collect();
     let mut found: Option<(usize, usize)> = None;
     meeting_pairs(&boxes, |i, j| {
         let (a, b) = (&elems[i], elems[j]);

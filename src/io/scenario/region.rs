@@ -6,8 +6,9 @@ use super::check::{R, vec3};
 use super::schema::RegionSpec;
 use super::source::Source;
 use crate::base::dim::Dim;
-use crate::base::geometry::{Bounds, meeting_pairs};
+use crate::base::geometry::{Aabb, meeting_pairs};
 use crate::store::particles::Particles;
+use glam::DVec2;
 
 /// Most vertices a region polygon may have (its self-crossing check is quadratic).
 const MAX_POLYGON: usize = 1000;
@@ -276,12 +277,8 @@ pub(super) fn simple_polygon(src: &Source, key: &str, p: &[[f64; 2]]) -> R<()> {
     if area == 0.0 || !area.is_finite() {
         return Err(src.error(key, "the polygon is degenerate (zero area)"));
     }
-    let boxes: Vec<Bounds> = (0..n)
-        .map(|i| {
-            let (a, b) = (p[i], p[(i + 1) % n]);
-            let lo = [a[0].min(b[0]), a[1].min(b[1]), 0.0];
-            (lo, [a[0].max(b[0]), a[1].max(b[1]), 0.0])
-        })
+    let boxes: Vec<Aabb<DVec2>> = (0..n)
+        .map(|i| Aabb::span(DVec2::from(p[i]), DVec2::from(p[(i + 1) % n])))
         .collect();
     let mut first: Option<(usize, usize)> = None;
     meeting_pairs(&boxes, |i, j| {

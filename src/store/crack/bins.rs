@@ -3,7 +3,8 @@
 //! every node with a crack field, twice a step).
 
 use crate::base::dim::Dim;
-use crate::base::geometry::{Bounds, Element};
+use crate::base::geometry::{Aabb, Element};
+use glam::DVec3;
 
 /// One crack's elements on a lattice of bins (compressed rows: the elements of bin `b` are
 /// `items[start[b]..start[b + 1]]`, in increasing element order).
@@ -15,7 +16,7 @@ pub struct ElementBins {
     items: Vec<u32>,
     /// Each element's box (indexed by element; meaningful for the binned ones), a cheap
     /// lower bound on its distance that spares most exact ones.
-    boxes: Vec<Bounds>,
+    boxes: Vec<Aabb<DVec3>>,
 }
 
 impl ElementBins {
@@ -29,20 +30,20 @@ impl ElementBins {
         margin: usize,
     ) -> Self {
         let dims = D::D;
-        let boxes: Vec<(usize, [f64; 3], [f64; 3])> = (elems.iter().enumerate())
+        let boxes: Vec<(usize, Aabb<DVec3>)> = (elems.iter().enumerate())
             .filter(|&(e, _)| keep(e))
-            .map(|(e, el)| {
-                let (lo, hi) = el.bounds(x);
-                (e, lo, hi)
-            })
+            .map(|(e, el)| (e, el.bounds(x).padded()))
             .collect();
         let (mut origin, mut counts) = ([0.0; 3], [1usize; 3]);
         if !boxes.is_empty() {
             for k in 0..dims {
-                let lo = boxes.iter().map(|b| b.1[k]).fold(f64::INFINITY, f64::min);
+                let lo = boxes
+                    .iter()
+                    .map(|b| b.1.lo[k])
+                    .fold(f64::INFINITY, f64::min);
                 let hi = boxes
                     .iter()
-                    .map(|b| b.2[k])
+                    .map(|b| b.1.hi[k])
                     .fold(f64::NEG_INFINITY, f64::max);
                 origin[k] = lo - margin as f64 * size[k];
                 counts[k] = ((hi - origin[k]) / size[k]) as usize + margin + 1;
@@ -54,36 +55,36 @@ impl ElementBins {
             counts,
             start: Vec::new(),
             items: Vec::new(),
-            boxes: vec![([0.0; 3], [0.0; 3]); elems.len()],
+            boxes: vec![Aabb::at(DVec3::ZERO); elems.len()],
         };
         // Each element goes into every bin its box meets, the box widened by a millionth of
         // a bin so that rounding in the bin index never leaves an element out of one.
-        let range = |b: &ElementBins, lo: &[f64; 3], hi: &[f64; 3]| {
+        let range = |b: &ElementBins, bx: &Aabb<DVec3>| {
             let mut r = [(0usize, 0usize); 3];
-            for k in 0..dims {
+            for (k, r) in r.iter_mut().enumerate().take(dims) {
                 let slack = 1e-6 * b.size[k];
-                r[k] = (b.index(k, lo[k] - slack), b.index(k, hi[k] + slack));
+                *r = (b.index(k, bx.lo[k] - slack), b.index(k, bx.hi[k] + slack));
             }
             r
         };
         let total = counts.iter().product::<usize>();
         let mut count = vec![0u32; total + 1];
-        for (_, lo, hi) in &boxes {
-            bins.for_each_bin(range(&bins, lo, hi), |b| count[b + 1] += 1);
+        for (_, bx) in &boxes {
+            bins.for_each_bin(range(&bins, bx), |b| count[b + 1] += 1);
         }
         for b in 0..total {
             count[b + 1] += count[b];
         }
         let mut fill = count.clone();
         let mut items = vec![0u32; count[total] as usize];
-        for (e, lo, hi) in &boxes {
-            bins.for_each_bin(range(&bins, lo, hi), |b| {
+        for (e, bx) in &boxes {
+            bins.for_each_bin(range(&bins, bx), |b| {
                 items[fill[b] as usize] = *e as u32;
                 fill[b] += 1;
             });
         }
-        for (e, lo, hi) in boxes {
-            bins.boxes[e] = (lo, hi);
+        for (e, bx) in boxes {
+            bins.boxes[e] = bx;
         }
         bins.start = count;
         bins.items = items;
@@ -123,9 +124,9 @@ impl ElementBins {
         let mut best: Option<(f64, u32)> = None;
         let consider = |best: &mut Option<(f64, u32)>, e: u32| {
             if let Some((bd, _)) = *best {
-                let (lo, hi) = &self.boxes[e as usize];
+                let bx = &self.boxes[e as usize];
                 let gap = (0..dims)
-                    .map(|k| (lo[k] - p[k]).max(p[k] - hi[k]).max(0.0).powi(2))
+                    .map(|k| (bx.lo[k] - p[k]).max(p[k] - bx.hi[k]).max(0.0).powi(2))
                     .sum::<f64>();
                 // Strictly farther than the best even at its box: not a candidate.
                 if gap > bd * (1.0 + 1e-12) {

@@ -4,7 +4,8 @@
 
 use super::Topology;
 use crate::base::dim::Dim;
-use crate::base::geometry::{Bounds, Element, meeting_pairs};
+use crate::base::geometry::{Aabb, Element, meeting_pairs};
+use glam::DVec3;
 
 /// Colours a mask has room for (two bits each in a `u64`).
 pub const COLORS: usize = 32;
@@ -35,14 +36,18 @@ pub fn colors<D: Dim>(topology: &Topology<D>, x: &[D::Vec], cell: f64) -> Result
     }
     let grow = REACH_CELLS * cell;
     // Each crack's box, widened along the scene's axes.
-    let mut boxes: Vec<Bounds> = vec![([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]); n];
+    let empty = Aabb {
+        lo: DVec3::INFINITY,
+        hi: DVec3::NEG_INFINITY,
+    };
+    let mut boxes: Vec<Aabb<DVec3>> = vec![empty; n];
     for (el, &c) in topology.elems().iter().zip(topology.elem_crack()) {
-        let (lo, hi) = el.bounds(x);
+        let e = el.bounds(x).padded();
         let b = &mut boxes[c as usize];
         for k in 0..3 {
             let g = if k < D::D { grow } else { 0.0 };
-            b.0[k] = b.0[k].min(lo[k] - g);
-            b.1[k] = b.1[k].max(hi[k] + g);
+            b.lo[k] = b.lo[k].min(e.lo[k] - g);
+            b.hi[k] = b.hi[k].max(e.hi[k] + g);
         }
     }
     // Each crack's earlier (lower-index) neighbours: the widened boxes that meet its own.
