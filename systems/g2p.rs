@@ -27,13 +27,9 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         .enumerate()
         .map(|(c, (x, v))| {
             let mut fastest = 0.0f64;
-            with_shape!(shape, S, N => for k in 0..x.len() {
-                let i = c * CHUNK + k;
-                // Particles near a crack move afterwards.
-                if fields.is_some_and(|f| f.is_coded(i)) {
-                    continue;
-                }
-                let st = Stencil::<N>::cached::<D>(S, stencils, i);
+            let chunk = c * CHUNK..c * CHUNK + x.len();
+            for_each_free_particle!(D, shape, stencils, fields, chunk, |i, st| {
+                let k = i - c * CHUNK;
                 let (dv, vn) = gather::<D, N>(&st, &st.rows::<D>(&grid.geom.stride), nodal);
                 v[k] = flip::<D>(v[k], dv, vn, dt, alpha);
                 x[k] += vn * dt;
@@ -74,13 +70,8 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
     let stride = &grid.geom.stride;
     let fastest = tiles.max_coloured(|t| {
         let mut fastest = 0.0f64;
-        with_shape!(shape, S, N => for &i in tiles.particles(t) {
-            let i = i as usize;
-            // Particles near a crack move, and are scattered field by field, afterwards.
-            if fields.is_some_and(|f| f.is_coded(i)) {
-                continue;
-            }
-            let st = Stencil::<N>::cached::<D>(S, &tiles.stencils, i);
+        let free = tiles.particles(t).iter().map(|&i| i as usize);
+        for_each_free_particle!(D, shape, &tiles.stencils, fields, free, |i, st| {
             let rows = st.rows::<D>(stride);
             let (dv, vn) = gather::<D, N>(&st, &rows, nodal);
             // SAFETY: every particle is in exactly one tile and each tile is handled by one

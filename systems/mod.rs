@@ -2,6 +2,23 @@
 //! runs them in; `bin` and `stress_bin` also open and close the step). Each is a plain
 //! function over the World.
 
+/// The loop the particle systems run over a list of particles (`usize` indices): for each
+/// particle not coded near a crack (`$fields`; those are handled field by field
+/// afterwards), `$body` with `$i` its index and `$st` its cached stencil of `N` nodes per
+/// axis in dimension `$d`. `N` is a constant in `$body` (bound by `with_shape!` outside
+/// the loop), so stencil loops unroll and no particle matches on the shape.
+macro_rules! for_each_free_particle {
+    ($d:ty, $shape:expr, $stencils:expr, $fields:expr, $particles:expr, |$i:ident, $st:ident| $body:block) => {
+        $crate::with_shape!($shape, S, N => for $i in $particles {
+            if $fields.is_some_and(|f| f.is_coded($i)) {
+                continue;
+            }
+            let $st = $crate::physics::shape::Stencil::<N>::cached::<$d>(S, $stencils, $i);
+            $body
+        })
+    };
+}
+
 pub mod bin;
 pub mod classify;
 pub mod contact;

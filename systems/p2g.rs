@@ -50,14 +50,10 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
     let shape = world.settings.shape;
     let geom = &grid.geom;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
-    world.tiles.for_each_coloured(|t| {
-        with_shape!(shape, S, N => for &i in world.tiles.particles(t) {
-            let i = i as usize;
-            // Particles near a crack are scattered field by field afterwards.
-            if fields.is_some_and(|f| f.is_coded(i)) {
-                continue;
-            }
-            let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
+    let tiles = &world.tiles;
+    tiles.for_each_coloured(|t| {
+        let free = tiles.particles(t).iter().map(|&i| i as usize);
+        for_each_free_particle!(D, shape, &tiles.stencils, fields, free, |i, st| {
             let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
             let rows = st.rows::<D>(&geom.stride);
             // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
@@ -68,7 +64,9 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
             }
             if FORCE {
                 // SAFETY: as above.
-                unsafe { add_internal_force::<D, N>(&st, &rows, &p.stress[i], p.volume[i], &force_w) };
+                unsafe {
+                    add_internal_force::<D, N>(&st, &rows, &p.stress[i], p.volume[i], &force_w)
+                };
             }
         })
     });

@@ -29,12 +29,8 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let (columns, material) = StressColumns::of(&mut world.particles);
     let stride = &grid.geom.stride;
     (0..n.div_ceil(CHUNK)).into_par_iter().for_each(|c| {
-        with_shape!(shape, S, N => for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
-            // Particles near a crack are updated from their fields' entries afterwards.
-            if fields.is_some_and(|f| f.is_coded(i)) {
-                continue;
-            }
-            let st = Stencil::<N>::cached::<D>(S, stencils, i);
+        let chunk = c * CHUNK..((c + 1) * CHUNK).min(n);
+        for_each_free_particle!(D, shape, stencils, fields, chunk, |i, st| {
             let l = velocity_gradient::<D, N>(&st, &st.rows::<D>(stride), &grid.velocity);
             let m = &materials[material[i] as usize];
             // SAFETY: the chunks partition the particles and each chunk is one task.

@@ -3,14 +3,12 @@
 //! read once (the particles near a crack afterwards, field by field).
 
 use crate::base::dim::Dim;
-use crate::physics::shape::Stencil;
 use crate::store::disjoint::Disjoint;
 use crate::store::grid::Grid;
 use crate::store::particles::Particles;
 use crate::store::world::World;
 use crate::systems::p2g::{add_internal_force, scatter_coded};
 use crate::systems::stress::{StressColumns, node_velocities, update_coded, velocity_gradient};
-use crate::with_shape;
 
 /// Updates every particle's stress over `fraction` of the step from grad v gathered off
 /// p/m (as [`stress::run`](crate::systems::stress::run)), then adds its internal force
@@ -42,13 +40,8 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     let (tiles, materials) = (&world.tiles, &world.materials);
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     tiles.for_each_coloured(|t| {
-        with_shape!(shape, S, N => for &i in tiles.particles(t) {
-            let i = i as usize;
-            // Particles near a crack are updated and scattered field by field afterwards.
-            if fields.is_some_and(|f| f.is_coded(i)) {
-                continue;
-            }
-            let st = Stencil::<N>::cached::<D>(S, &tiles.stencils, i);
+        let free = tiles.particles(t).iter().map(|&i| i as usize);
+        for_each_free_particle!(D, shape, &tiles.stencils, fields, free, |i, st| {
             let rows = st.rows::<D>(stride);
             let l = velocity_gradient::<D, N>(&st, &rows, velocity);
             let m = &materials[material[i] as usize];
