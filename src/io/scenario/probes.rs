@@ -58,7 +58,7 @@ pub(super) fn probes<D: Dim>(
                 ));
             }
             match region::<D>(src, &key("region"), &p.region)? {
-                Region::Round { center, .. } => centre = center,
+                Region::Round { center, .. } => centre = center.to_array(),
                 _ => {
                     return Err(src.error(
                         &key("region"),

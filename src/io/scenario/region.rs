@@ -8,7 +8,7 @@ use super::source::Source;
 use crate::base::dim::Dim;
 use crate::base::geometry::{Aabb, meeting_pairs};
 use crate::store::particles::Particles;
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 /// Most vertices a region polygon may have (its self-crossing check is quadratic).
 const MAX_POLYGON: usize = 1000;
@@ -22,27 +22,21 @@ pub(super) enum Region {
     Polygon(Vec<[f64; 2]>),
     /// Box of half-sizes `half` along the orthonormal `axes` about `center`.
     Oriented {
-        center: [f64; 3],
-        axes: [[f64; 3]; 3],
+        center: DVec3,
+        axes: [DVec3; 3],
         half: [f64; 3],
     },
     /// The points within `radius` of `center` (a disc in 2D, a ball in 3D).
-    Round { center: [f64; 3], radius: f64 },
+    Round { center: DVec3, radius: f64 },
     /// The points on the side of the plane through `point` that the unit `normal` points to.
-    HalfSpace { point: [f64; 3], normal: [f64; 3] },
+    HalfSpace { point: DVec3, normal: DVec3 },
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
-    let n = dot(v, v).sqrt();
-    (n > 0.0 && n.is_finite()).then(|| v.map(|c| c / n))
+/// `v` scaled to unit length; None for a zero or non-finite one.
+fn unit(v: [f64; 3]) -> Option<DVec3> {
+    let v = DVec3::from(v);
+    let n = v.length();
+    (n > 0.0 && n.is_finite()).then(|| v / n)
 }
 
 impl Region {
@@ -54,14 +48,11 @@ impl Region {
                 in_polygon(p, [x[0], x[1]]) || edge_distance(p, [x[0], x[1]]) <= tol
             }
             Region::Oriented { center, axes, half } => {
-                let d = sub(x, *center);
-                (0..dims).all(|a| dot(d, axes[a]).abs() <= half[a] + tol)
+                let d = DVec3::from(x) - *center;
+                (0..dims).all(|a| d.dot(axes[a]).abs() <= half[a] + tol)
             }
-            Region::Round { center, radius } => {
-                let d = sub(x, *center);
-                dot(d, d).sqrt() <= radius + tol
-            }
-            Region::HalfSpace { point, normal } => dot(sub(x, *point), *normal) >= -tol,
+            Region::Round { center, radius } => (DVec3::from(x) - *center).length() <= radius + tol,
+            Region::HalfSpace { point, normal } => (DVec3::from(x) - *point).dot(*normal) >= -tol,
         }
     }
 }
@@ -171,7 +162,7 @@ pub(super) fn region<D: Dim>(src: &Source, key: &str, r: &RegionSpec) -> R<Regio
         return polygon::<D>(src, &k("polygon"), points);
     }
     if let Some(c) = &r.center {
-        let center = vec3::<D>(src, &k("center"), c)?;
+        let center = DVec3::from(vec3::<D>(src, &k("center"), c)?);
         if let Some(radius) = r.radius {
             if r.half.is_some() || r.angle.is_some() || r.axes.is_some() {
                 return Err(src.error(
@@ -201,7 +192,7 @@ pub(super) fn region<D: Dim>(src: &Source, key: &str, r: &RegionSpec) -> R<Regio
         let axes = match (D::D, r.angle, &r.axes) {
             (2, Some(angle), None) if angle.is_finite() => {
                 let (s, c) = angle.to_radians().sin_cos();
-                [[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]
+                [DVec3::new(c, s, 0.0), DVec3::new(-s, c, 0.0), DVec3::Z]
             }
             (2, _, _) => {
                 return Err(src.error(
@@ -215,15 +206,10 @@ pub(super) fn region<D: Dim>(src: &Source, key: &str, r: &RegionSpec) -> R<Regio
                 let (Some(a), Some(b)) = (a, b) else {
                     return Err(src.error(&k("axes"), "the axes must have non-zero length"));
                 };
-                if dot(a, b).abs() > 1e-9 {
+                if a.dot(b).abs() > 1e-9 {
                     return Err(src.error(&k("axes"), "the two axes must be perpendicular"));
                 }
-                let c = [
-                    a[1] * b[2] - a[2] * b[1],
-                    a[2] * b[0] - a[0] * b[2],
-                    a[0] * b[1] - a[1] * b[0],
-                ];
-                [a, b, c]
+                [a, b, a.cross(b)]
             }
             _ => {
                 return Err(src.error(
@@ -234,7 +220,11 @@ pub(super) fn region<D: Dim>(src: &Source, key: &str, r: &RegionSpec) -> R<Regio
         };
         return Ok(Region::Oriented { center, axes, half });
     }
-    let point = vec3::<D>(src, &k("point"), r.point.as_deref().unwrap_or_default())?;
+    let point = DVec3::from(vec3::<D>(
+        src,
+        &k("point"),
+        r.point.as_deref().unwrap_or_default(),
+    )?);
     let n = r.normal.as_deref().ok_or_else(|| {
         src.error(
             &k("normal"),
@@ -317,8 +307,8 @@ mod tests {
             corner(-1.0, 1.0),
         ]);
         let boxed = Region::Oriented {
-            center: [0.0; 3],
-            axes: [[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]],
+            center: DVec3::ZERO,
+            axes: [DVec3::new(c, s, 0.0), DVec3::new(-s, c, 0.0), DVec3::Z],
             half: [1.0, 1.0, 1.0],
         };
         for (u, v, want) in [
@@ -335,8 +325,8 @@ mod tests {
         let edge = corner(1.0, 0.3);
         assert!(poly.contains([edge[0] + 1e-9, edge[1], 0.0], 2, 1e-6));
         let half = Region::HalfSpace {
-            point: [1.0, 0.0, 0.0],
-            normal: [1.0, 0.0, 0.0],
+            point: DVec3::X,
+            normal: DVec3::X,
         };
         assert!(half.contains([1.5, -3.0, 0.0], 2, 0.0) && !half.contains([0.5, 3.0, 0.0], 2, 0.0));
     }
