@@ -214,11 +214,19 @@ fn report(e: anyhow::Error) -> ExitCode {
         return bad_input(s);
     }
     eprintln!("error: {e:#}");
-    if e.downcast_ref::<SnapshotError>().is_some() || e.downcast_ref::<UsageError>().is_some() {
+    if is_bad_input(&e) {
         ExitCode::from(BAD_INPUT)
     } else {
         ExitCode::FAILURE
     }
+}
+
+/// Whether an error is the input's (a scenario, snapshot or usage problem) rather than the
+/// run's (an instability, a failed output).
+fn is_bad_input(e: &anyhow::Error) -> bool {
+    e.downcast_ref::<ScenarioError>().is_some()
+        || e.downcast_ref::<SnapshotError>().is_some()
+        || e.downcast_ref::<UsageError>().is_some()
 }
 
 /// A flag set by Ctrl-C or SIGTERM, so the run stops cleanly after the current step (or
@@ -526,8 +534,7 @@ fn cmd_validate(
         eprintln!("error: no scenario (*.toml) in {}", list.join(", "));
         return ExitCode::from(BAD_INPUT);
     }
-    let mut failed = 0usize;
-    let mut passed = 0usize;
+    let (mut failed, mut passed, mut refused) = (0usize, 0usize, 0usize);
     println!(
         "{:<28} {:<24} {:>13} {:>13} {:>10} {:>9} {:<5} {:>9}",
         "scenario", "quantity", "reference", "obtained", "error", "tolerance", "pass", "wall (s)"
@@ -538,7 +545,7 @@ fn cmd_validate(
             Ok(s) => s,
             Err(e) => {
                 println!("{:<28} error: {e}", file.display());
-                failed += 1;
+                refused += 1;
                 continue;
             }
         };
@@ -580,9 +587,17 @@ fn cmd_validate(
             }
             Err(e) => {
                 println!("{:<28} error: {e:#}", src.name());
-                failed += 1;
+                if is_bad_input(&e) {
+                    refused += 1;
+                } else {
+                    failed += 1;
+                }
             }
         }
+    }
+    if refused > 0 {
+        println!("{passed} passed, {failed} failed, {refused} refused as bad input");
+        return ExitCode::from(BAD_INPUT);
     }
     println!("{passed} passed, {failed} failed");
     if failed == 0 {

@@ -669,6 +669,7 @@ fn accepted_but_wrong_inputs_are_refused() {
         ("", "must not be empty"),
         ("..", "`..`"),
         ("a\\u0007b", "control characters"),
+        (&"n".repeat(300), "at most 200 bytes"),
     ] {
         let text = GOOD.replace("name = \"good\"", &format!("name = \"{name}\""));
         let e = match Source::parse("bad.toml", &text, &[]) {
@@ -739,6 +740,22 @@ fn unusable_command_line_values_exit_with_code_2() {
         stdout.contains("good") && stdout.contains("no [[expect]] to check"),
         "{stdout}"
     );
+    // A missing path, a file that is not TOML and a scenario the builder refuses are bad
+    // input beside a good scenario too: they exit 2, saying how many were refused.
+    let not_toml = dir.join("notes.txt");
+    std::fs::write(&not_toml, "not a scenario").unwrap();
+    let refused = dir.join("refused.toml");
+    std::fs::write(&refused, GOOD.replace("cfl = 0.5", "cfl = 2.0")).unwrap();
+    let missing = dir.join("missing.toml");
+    for bad in [&missing, &not_toml, &refused] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+            .args(["validate", f, bad.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(out.status.code(), Some(2), "{}: {stdout}", bad.display());
+        assert!(stdout.contains("1 refused as bad input"), "{stdout}");
+    }
     std::fs::remove_dir_all(dir).ok();
 }
 

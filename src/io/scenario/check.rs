@@ -70,10 +70,17 @@ pub(super) fn box_corners<D: Dim>(src: &Source, key: &str, b: &BoxSpec) -> R<([f
     Ok((lo, hi))
 }
 
+/// Longest scenario name (bytes): the output folder's name, with room for a sweep's
+/// `-sweep` under the 255 bytes a file name may have.
+const MAX_NAME: usize = 200;
+
 /// A scenario name becomes the output folder's name: it must be one plain path component.
 pub(super) fn check_name(src: &Source, name: &str) -> R<()> {
+    let long = format!("must be at most {MAX_NAME} bytes long");
     let bad = if name.is_empty() {
         Some("must not be empty")
+    } else if name.len() > MAX_NAME {
+        Some(long.as_str())
     } else if name.contains(['/', '\\']) {
         Some("must not contain a path separator")
     } else if name == "." || name == ".." {
