@@ -658,6 +658,26 @@ fn bad_front_expects_name_the_key() {
     assert_error(&e, "expect[0].near", None, "applies to KI_front");
 }
 
+/// Non-finite numbers that used to pass `check` and fail only during the run: a body's spin,
+/// a time function's start, a crack expect's reference (TOML's `inf` and `nan`).
+#[test]
+fn non_finite_numbers_are_refused_at_check() {
+    let spin = GOOD.replace("box = { min", "angular_velocity = [inf]\nbox = { min");
+    assert_error(&refused(&spin), "body[0].angular_velocity", None, "finite");
+    let load = "[[load]]\nregion = { min = [0.004, 0.004], max = [0.006, 0.016] }\n\
+                force = [1.0, 0.0]\ntime = { kind = \"step\", start = nan }\n";
+    assert_error(&error_with_text(load), "load[0].time", None, "start time");
+    let crack = "[[crack]]\npoints = [[0.0, 0.01], [0.01, 0.01]]\n[fracture]\ncontour = 2\n\
+                 [[expect]]\nquantity = \"KI\"\ncrack = \"crack0\"\nreference = inf\n\
+                 source = \"s\"\ntolerance = 0.1\n";
+    assert_error(
+        &error_with_text(crack),
+        "expect[0].reference",
+        None,
+        "finite",
+    );
+}
+
 /// Inputs that used to be accepted although wrong: a name that is not one folder name, two
 /// time-step settings, a modulus whose derived quantities overflow, two cracks of one
 /// name, a crack that folds back on itself.

@@ -63,6 +63,11 @@ impl TimeFn {
     /// A problem with the parameters, if any.
     pub fn check(&self) -> Option<&'static str> {
         match *self {
+            TimeFn::Step { start } | TimeFn::Ramp { start, .. } | TimeFn::Pulse { start, .. }
+                if !start.is_finite() =>
+            {
+                Some("the start time must be a finite number (s)")
+            }
             TimeFn::Ramp { rise, .. } if !rise.is_finite() || rise <= 0.0 => {
                 Some("ramp rise time must be > 0 s")
             }

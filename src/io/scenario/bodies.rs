@@ -292,6 +292,12 @@ fn add_body<D: Dim>(
     };
     let omega = match &body.angular_velocity {
         None => [0.0; 3],
+        Some(w) if w.iter().any(|c| !c.is_finite()) => {
+            return Err(src.error(
+                &key("angular_velocity"),
+                "components must be finite numbers (rad/s)",
+            ));
+        }
         Some(w) if D::D == 2 && w.len() == 1 => [0.0, 0.0, w[0]],
         Some(w) if D::D == 3 && w.len() == 3 => [w[0], w[1], w[2]],
         Some(_) => {

@@ -23,6 +23,9 @@ pub(super) fn expects<D: Dim>(
     let mut expects = Vec::new();
     for (i, e) in sc.expects.iter().enumerate() {
         let key = |k: &str| format!("expect[{i}].{k}");
+        if !e.reference.is_finite() {
+            return Err(src.error(&key("reference"), "must be a finite number"));
+        }
         let mut ids = Vec::new();
         for name in &e.probes {
             let id = probes
@@ -246,9 +249,6 @@ fn history_expect(src: &Source, i: usize, e: &ExpectSpec, ids: &[usize]) -> R<Ex
         }
         _ => Measure::AngularMomentumDrift,
     };
-    if !e.reference.is_finite() {
-        return Err(src.error(&key("reference"), "must be a finite number"));
-    }
     positive(
         src,
         &key("tolerance"),
