@@ -678,6 +678,23 @@ fn non_finite_numbers_are_refused_at_check() {
     );
 }
 
+/// A key a time function does not take is refused in every kind, the constant one too (it
+/// used to ignore `rise`).
+#[test]
+fn a_stray_key_in_a_time_function_is_refused() {
+    for time in [
+        "{ kind = \"constant\", rise = 1.0 }",
+        "{ kind = \"step\", rise = 1.0 }",
+    ] {
+        let load = format!(
+            "[[load]]\nregion = {{ min = [0.004, 0.004], max = [0.006, 0.016] }}\n\
+             force = [1.0, 0.0]\ntime = {time}\n"
+        );
+        let e = error_with_text(&load);
+        assert_error(&e, "load[0].time", None, "unknown field `rise`");
+    }
+}
+
 /// Inputs that used to be accepted although wrong: a name that is not one folder name, two
 /// time-step settings, a modulus whose derived quantities overflow, two cracks of one
 /// name, a crack that folds back on itself.

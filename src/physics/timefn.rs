@@ -3,12 +3,12 @@
 use serde::{Deserialize, Serialize};
 
 /// A dimensionless multiplier f(t) applied to a load or a prescribed velocity.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
 pub enum TimeFn {
-    /// f = 1 at all times.
-    #[default]
-    Constant,
+    /// f = 1 at all times (a struct variant, so that a stray key beside it is refused as
+    /// in the other kinds).
+    Constant {},
     /// Heaviside step: f = 0 before `start` (s), 1 after.
     Step {
         /// Switch-on time (s).
@@ -40,11 +40,17 @@ pub enum TimeFn {
     },
 }
 
+impl Default for TimeFn {
+    fn default() -> Self {
+        TimeFn::Constant {}
+    }
+}
+
 impl TimeFn {
     /// Value at time `t` (s).
     pub fn at(&self, t: f64) -> f64 {
         match *self {
-            TimeFn::Constant => 1.0,
+            TimeFn::Constant {} => 1.0,
             TimeFn::Step { start } => (t >= start) as u8 as f64,
             TimeFn::Ramp { start, rise } => ((t - start) / rise).clamp(0.0, 1.0),
             TimeFn::Pulse { start, width } => (t >= start && t < start + width) as u8 as f64,
