@@ -678,6 +678,20 @@ fn non_finite_numbers_are_refused_at_check() {
     );
 }
 
+/// A `--set` that brings in a key the format does not have names the `--set`, not a line
+/// past the end of the file (where the override was appended).
+#[test]
+fn an_unknown_key_from_set_names_the_set() {
+    let e = error_with(&["nosuch.key=1"]);
+    assert_error(
+        &e,
+        "nosuch",
+        None,
+        "(the value comes from --set nosuch.key=1)",
+    );
+    assert_eq!(e.line, None, "{e}");
+}
+
 /// A key a time function does not take is refused in every kind, the constant one too (it
 /// used to ignore `rise`).
 #[test]

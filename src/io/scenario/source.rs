@@ -41,7 +41,9 @@ impl Source {
                 Some((canonical(&split_path(path.trim())), arg.clone()))
             })
             .collect();
-        let err = |line, key: Option<String>, message: String| match set_by(&set, key.as_deref()) {
+        let err = |line, key: Option<String>, message: String| match set_by(&set, key.as_deref())
+            .or_else(|| unknown_from_set(&set, key.as_deref(), &message))
+        {
             Some(arg) => ScenarioError {
                 file: file.to_string(),
                 line: None,
@@ -167,6 +169,22 @@ fn set_by<'a>(set: &'a [(String, String)], key: Option<&str>) -> Option<&'a str>
             key == *path
                 || key.starts_with(&format!("{path}."))
                 || key.starts_with(&format!("{path}["))
+        })
+        .map(|(_, arg)| arg.as_str())
+}
+
+/// The `--set` argument that brought in the unknown key `key` (a path under a key the
+/// scenario does not have, e.g. `--set nosuch.key=1`), for a message that says so.
+fn unknown_from_set<'a>(
+    set: &'a [(String, String)],
+    key: Option<&str>,
+    message: &str,
+) -> Option<&'a str> {
+    let key = canonical(&split_path(key?));
+    (message.starts_with("unknown field")).then_some(())?;
+    set.iter()
+        .find(|(path, _)| {
+            path.starts_with(&format!("{key}.")) || path.starts_with(&format!("{key}["))
         })
         .map(|(_, arg)| arg.as_str())
 }
