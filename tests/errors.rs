@@ -1153,3 +1153,55 @@ fn bad_reactions_and_eta_estimates_name_the_key() {
     let e = expect("quantity = \"KI\"\nprobes = [\"d\"]\n");
     assert_error(&e, "expect[0].probes", None, "takes no probes");
 }
+
+/// What is not a scenario file is refused before it is read: a FIFO (whose open would
+/// block), a device (whose read never ends), a file too large to be a scenario; and a
+/// scenario without `name` whose file stem is not a folder name (`..toml`) is refused as a
+/// bad name would be. `check` and `resume` of a FIFO answer at once with exit code 2.
+#[test]
+fn files_that_are_not_scenarios_are_refused_before_reading() {
+    let dir = std::env::temp_dir().join(format!("fissure-files-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let load = |p: &std::path::Path| match Source::load(p, &[]) {
+        Ok(_) => panic!("{} was read as a scenario", p.display()),
+        Err(e) => e.to_string(),
+    };
+    let e = load(std::path::Path::new("/dev/zero"));
+    assert!(e.contains("not a regular file"), "{e}");
+    let big = dir.join("big.toml");
+    std::fs::write(&big, " ".repeat(17 << 20)).unwrap();
+    let e = load(&big);
+    assert!(e.contains("at most 16777216"), "{e}");
+    let dots = dir.join("..toml");
+    std::fs::write(&dots, GOOD.replace("name = \"good\"\n", "")).unwrap();
+    let e = match build::<D2>(&Source::load(&dots, &[]).unwrap()) {
+        Ok(_) => panic!("a stem of `.` names no folder"),
+        Err(e) => e,
+    };
+    assert!(e.to_string().contains("file's stem `.`"), "{e}");
+    let fifo = dir.join("fifo.toml");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|s| s.success()) {
+        for verb in ["check", "resume"] {
+            let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+                .args([verb, fifo.to_str().unwrap()])
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap();
+            let t0 = std::time::Instant::now();
+            let status = loop {
+                if let Some(s) = child.try_wait().unwrap() {
+                    break Some(s);
+                }
+                if t0.elapsed().as_secs() > 20 {
+                    child.kill().ok();
+                    break None;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            };
+            let status = status.unwrap_or_else(|| panic!("`{verb}` of a FIFO blocked"));
+            assert_eq!(status.code(), Some(2), "{verb}");
+        }
+    }
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -74,8 +74,10 @@ pub(super) fn box_corners<D: Dim>(src: &Source, key: &str, b: &BoxSpec) -> R<([f
 /// `-sweep` under the 255 bytes a file name may have.
 const MAX_NAME: usize = 200;
 
-/// A scenario name becomes the output folder's name: it must be one plain path component.
-pub(super) fn check_name(src: &Source, name: &str) -> R<()> {
+/// A scenario name (its `name`, else its file's stem) becomes the output folder's name: it
+/// must be one plain path component.
+pub(super) fn check_name(src: &Source) -> R<()> {
+    let name = src.name();
     let long = format!("must be at most {MAX_NAME} bytes long");
     let bad = if name.is_empty() {
         Some("must not be empty")
@@ -90,10 +92,17 @@ pub(super) fn check_name(src: &Source, name: &str) -> R<()> {
     } else {
         None
     };
+    let what = match src.scenario.name {
+        Some(_) => "the name".to_string(),
+        None => format!(
+            "without a `name`, the file's stem `{}`",
+            name.escape_debug()
+        ),
+    };
     match bad {
         Some(why) => Err(src.error(
             "name",
-            format!("the name names the output folder under the output directory: it {why}"),
+            format!("{what} names the output folder under the output directory: it {why}"),
         )),
         None => Ok(()),
     }

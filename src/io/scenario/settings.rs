@@ -34,9 +34,7 @@ pub(super) struct Simulation {
 pub(super) fn simulation<D: Dim>(src: &Source) -> R<Simulation> {
     let sc = &src.scenario;
     let sim = &sc.simulation;
-    if let Some(name) = &sc.name {
-        super::check::check_name(src, name)?;
-    }
+    super::check::check_name(src)?;
     if sim.dimension as usize != D::D {
         return Err(src.error("simulation.dimension", "must be 2 or 3"));
     }

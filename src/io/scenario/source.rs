@@ -5,6 +5,10 @@ use crate::base::error::ScenarioError;
 use std::path::Path;
 use toml_edit::{DocumentMut, Item};
 
+/// Largest scenario file read (bytes): mesh lists included, a scenario is text of a few
+/// megabytes at most, and a larger file is more likely a mistake than a scene.
+const MAX_SCENARIO_BYTES: u64 = 16 << 20;
+
 /// A parsed scenario with the text it came from, for locating errors.
 #[derive(Debug, Clone)]
 pub struct Source {
@@ -22,12 +26,29 @@ impl Source {
     /// Reads `path`, applies `overrides` (`path.to.key=value`) and parses.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Self, ScenarioError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+        let refuse = |message: String| ScenarioError {
             file: file.clone(),
             line: None,
             key: None,
-            message: format!("cannot read the scenario: {e}"),
-        })?;
+            message,
+        };
+        // Checked before opening: a FIFO would block the open, a device never end.
+        let meta = std::fs::metadata(path)
+            .map_err(|e| refuse(format!("cannot read the scenario: {e}")))?;
+        if !meta.is_file() {
+            return Err(refuse(
+                "cannot read the scenario: not a regular file".into(),
+            ));
+        }
+        if meta.len() > MAX_SCENARIO_BYTES {
+            return Err(refuse(format!(
+                "the scenario is {} bytes; a scenario file may have at most {MAX_SCENARIO_BYTES} \
+                 (16 MiB)",
+                meta.len()
+            )));
+        }
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| refuse(format!("cannot read the scenario: {e}")))?;
         Self::parse(&file, &text, overrides)
     }
 

@@ -205,6 +205,11 @@ impl Reader {
             path: path.to_path_buf(),
             message,
         };
+        // A FIFO or a device would block or never end: only regular files are read (the
+        // check comes before opening, which blocks on a FIFO).
+        if !std::fs::metadata(path).map_err(io)?.is_file() {
+            return Err(bad("not a regular file".into()));
+        }
         let mut file = File::open(path).map_err(io)?;
         let size = file.metadata().map_err(io)?.len();
         let mut pre = [0u8; PREAMBLE as usize];
