@@ -182,16 +182,17 @@ fn canonical(parts: &[PathPart]) -> String {
     out
 }
 
+/// Whether key path `inner` is `outer` or lies under it (`outer.x`, `outer[i]`).
+fn within(inner: &str, outer: &str) -> bool {
+    inner
+        .strip_prefix(outer)
+        .is_some_and(|rest| rest.is_empty() || rest.starts_with(['.', '[']))
+}
+
 /// The `--set` argument that set `key` or a table holding it, if any.
 fn set_by<'a>(set: &'a [(String, String)], key: Option<&str>) -> Option<&'a str> {
     let key = canonical(&split_path(key?));
-    set.iter()
-        .find(|(path, _)| {
-            key == *path
-                || key.starts_with(&format!("{path}."))
-                || key.starts_with(&format!("{path}["))
-        })
-        .map(|(_, arg)| arg.as_str())
+    (set.iter().find(|(path, _)| within(&key, path))).map(|(_, arg)| arg.as_str())
 }
 
 /// The `--set` argument that brought in the unknown key `key` (a path under a key the
@@ -203,11 +204,7 @@ fn unknown_from_set<'a>(
 ) -> Option<&'a str> {
     let key = canonical(&split_path(key?));
     (message.starts_with("unknown field")).then_some(())?;
-    set.iter()
-        .find(|(path, _)| {
-            path.starts_with(&format!("{key}.")) || path.starts_with(&format!("{key}["))
-        })
-        .map(|(_, arg)| arg.as_str())
+    (set.iter().find(|(path, _)| within(path, &key))).map(|(_, arg)| arg.as_str())
 }
 
 /// Line of the deepest existing item on `path` in `text`.
