@@ -41,13 +41,13 @@ impl Nodal {
     }
 
     /// The integrand F_m of Eq. 13 for outward normal `n`, m = x and y.
-    fn integrand(&self, n: [f64; 2]) -> [f64; 2] {
+    fn integrand(&self, n: DVec2) -> [f64; 2] {
         let [sxx, syy, sxy] = self.s;
-        let t = [sxx * n[0] + sxy * n[1], sxy * n[0] + syy * n[1]];
+        let t = [sxx * n.x + sxy * n.y, sxy * n.x + syy * n.y];
         let e = self.w + self.k;
         [
-            e * n[0] - (t[0] * self.gu[0] + t[1] * self.gu[2]),
-            e * n[1] - (t[0] * self.gu[1] + t[1] * self.gu[3]),
+            e * n.x - (t[0] * self.gu[0] + t[1] * self.gu[2]),
+            e * n.y - (t[0] * self.gu[1] + t[1] * self.gu[3]),
         ]
     }
 }
@@ -79,25 +79,16 @@ fn contour(i0: usize, j0: usize, n: usize) -> Vec<[usize; 2]> {
     p
 }
 
-fn xy(v: DVec2) -> [f64; 2] {
-    v.to_array()
-}
-
-fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
-}
-
 /// Where segment a-b meets segment c-d: the parameter along a-b, if they properly cross.
-fn intersect(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> Option<f64> {
-    let r = [b[0] - a[0], b[1] - a[1]];
-    let s = [d[0] - c[0], d[1] - c[1]];
-    let den = r[0] * s[1] - r[1] * s[0];
+fn intersect(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> Option<f64> {
+    let (r, s) = (b - a, d - c);
+    let den = r.perp_dot(s);
     if den == 0.0 {
         return None;
     }
-    let q = [c[0] - a[0], c[1] - a[1]];
-    let t = (q[0] * s[1] - q[1] * s[0]) / den;
-    let u = (q[0] * r[1] - q[1] * r[0]) / den;
+    let q = c - a;
+    let t = q.perp_dot(s) / den;
+    let u = q.perp_dot(r) / den;
     ((0.0..1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
 }
 
@@ -129,7 +120,7 @@ pub(crate) fn tip(
     // A tip running at a set speed (not one that extends by a segment now and then).
     let set_speed = topo.cracks()[c].growth.is_some_and(|g| g.speed.is_some());
     let running = state.filter(|s| set_speed && s.speed > 0.0);
-    let xt = xy(cracks.geometry.x[kt]);
+    let xt = cracks.geometry.x[kt];
     let mut res = TipResult {
         step: world.step,
         time: world.time,
@@ -143,7 +134,7 @@ pub(crate) fn tip(
         domain: 0.0,
         length: path
             .windows(2)
-            .map(|w| dist(xy(cracks.geometry.x[w[0]]), xy(cracks.geometry.x[w[1]])))
+            .map(|w| cracks.geometry.x[w[0]].distance(cracks.geometry.x[w[1]]))
             .sum(),
         speed,
     };
@@ -181,10 +172,9 @@ pub(crate) fn tip(
     };
 
     // G along the tip direction (Eq. 10), split by the opening behind the tip (Eqs. 14-22).
-    let xp = xy(cracks.geometry.x[kp]);
-    let len = ((xt[0] - xp[0]).powi(2) + (xt[1] - xp[1]).powi(2)).sqrt();
-    let dir = [(xt[0] - xp[0]) / len, (xt[1] - xp[1]) / len];
-    let gr = j[0] * dir[0] + j[1] * dir[1];
+    let xp = cracks.geometry.x[kp];
+    let dir = (xt - xp) / (xt - xp).length();
+    let gr = DVec2::from(j).dot(dir);
     let h = geom.h[0].max(geom.h[1]);
     // With a tip at each end, the fit stays in this tip's half of the crack.
     let mut window = plan.opening * h;
@@ -264,7 +254,7 @@ fn contour_j(
     cracks: &Cracks<D2>,
     c: usize,
     path: &[usize],
-    xt: [f64; 2],
+    xt: DVec2,
     n: usize,
     area_term: bool,
 ) -> Option<ContourJ> {
@@ -308,8 +298,8 @@ struct Contour<'a> {
     /// Its nodes in order, the first repeated at the end.
     ring: Vec<[usize; 2]>,
     /// Its lower-left and upper-right corners (m).
-    lo: [f64; 2],
-    hi: [f64; 2],
+    lo: DVec2,
+    hi: DVec2,
     /// The edge the crack crosses (from ring[edge] to ring[edge + 1]) and where along it.
     edge: usize,
     s: f64,
@@ -325,7 +315,7 @@ impl<'a> Contour<'a> {
         geom: &'a GridGeom<D2>,
         cracks: &Cracks<D2>,
         path: &[usize],
-        xt: [f64; 2],
+        xt: DVec2,
         n: usize,
     ) -> Option<Self> {
         let node = |a: usize| ((xt[a] - geom.origin[a]) * geom.inv_h[a]).round().max(0.0) as usize;
@@ -341,8 +331,8 @@ impl<'a> Contour<'a> {
         let mut k = Contour {
             geom,
             ring: contour(i0, j0, n),
-            lo: [0.0; 2],
-            hi: [0.0; 2],
+            lo: DVec2::ZERO,
+            hi: DVec2::ZERO,
             edge: 0,
             s: 0.0,
             first: 1,
@@ -353,7 +343,7 @@ impl<'a> Contour<'a> {
         'find: for e in 0..k.ring.len() - 1 {
             let (a, b) = (k.pos(k.ring[e]), k.pos(k.ring[e + 1]));
             for w in path.windows(2) {
-                let (ca, cb) = (xy(cracks.geometry.x[w[0]]), xy(cracks.geometry.x[w[1]]));
+                let (ca, cb) = (cracks.geometry.x[w[0]], cracks.geometry.x[w[1]]);
                 if let Some(s) = intersect(a, b, ca, cb) {
                     cut = Some((e, s, (ca, cb)));
                     break 'find;
@@ -363,19 +353,19 @@ impl<'a> Contour<'a> {
         let (e, s, (ca, cb)) = cut?;
         // The path starts on the side of the crack that ring[e + 1] is on and ends on the other.
         let after = k.pos(k.ring[e + 1]);
-        let orient = (cb[0] - ca[0]) * (after[1] - ca[1]) - (cb[1] - ca[1]) * (after[0] - ca[0]);
+        let orient = (cb - ca).perp_dot(after - ca);
         k.first = if orient >= 0.0 { 1 } else { -1 };
         (k.edge, k.s) = (e, s);
         Some(k)
     }
 
     /// Position of grid node `q` (m).
-    fn pos(&self, q: [usize; 2]) -> [f64; 2] {
+    fn pos(&self, q: [usize; 2]) -> DVec2 {
         let geom = self.geom;
-        [
+        DVec2::new(
             geom.origin[0] + q[0] as f64 * geom.h[0],
             geom.origin[1] + q[1] as f64 * geom.h[1],
-        ]
+        )
     }
 
     /// Linear index of grid node `q`.
@@ -392,7 +382,7 @@ impl<'a> Contour<'a> {
         let order: Vec<usize> = (1..=m).map(|q| (e + q) % m).collect();
         let cross = {
             let (a, b) = (self.pos(ring[e]), self.pos(ring[e + 1]));
-            [a[0] + (b[0] - a[0]) * s, a[1] + (b[1] - a[1]) * s]
+            a + (b - a) * s
         };
         let mut pts = vec![cross];
         let mut vals = vec![Nodal::lerp(&at(e, first), &at(e + 1, first), s)];
@@ -405,12 +395,13 @@ impl<'a> Contour<'a> {
         vals.push(Nodal::lerp(&at(e, -first), &at(e + 1, -first), s));
         let mut j = [0.0; 2];
         for q in 0..pts.len() - 1 {
-            let (a, b) = (pts[q], pts[q + 1]);
-            let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+            let d = pts[q + 1] - pts[q];
+            let len = d.length();
             if len == 0.0 {
                 continue;
             }
-            let normal = [(b[1] - a[1]) / len, -(b[0] - a[0]) / len];
+            // Outward: the contour runs counterclockwise.
+            let normal = DVec2::new(d.y, -d.x) / len;
             let (fa, fb) = (vals[q].integrand(normal), vals[q + 1].integrand(normal));
             for (mm, jm) in j.iter_mut().enumerate() {
                 *jm += 0.5 * (fa[mm] + fb[mm]) * len;
@@ -429,7 +420,7 @@ fn gather(
     world: &World<D2>,
     cracks: &Cracks<D2>,
     k: &Contour,
-    xt: [f64; 2],
+    xt: DVec2,
     area_term: bool,
     acc: &mut HashMap<usize, [f64; 10]>,
 ) -> ContourJ {
@@ -443,25 +434,18 @@ fn gather(
     let mut area = [0.0; 2];
     let mut nearest = (f64::INFINITY, 0usize);
     let mut plastic = false;
-    let half = 0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    let centre = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-    for i in near(world, DVec2::from(centre), half + reach) {
-        let x = xy(p.x[i]);
-        if x[0] < lo[0] - reach
-            || x[0] > hi[0] + reach
-            || x[1] < lo[1] - reach
-            || x[1] > hi[1] + reach
-        {
+    let half = 0.5 * (hi - lo).max_element();
+    let centre = 0.5 * (lo + hi);
+    for i in near(world, centre, half + reach) {
+        let x = p.x[i];
+        if x.cmplt(lo - reach).any() || x.cmpgt(hi + reach).any() {
             continue;
         }
-        let d2 = (x[0] - xt[0]).powi(2) + (x[1] - xt[1]).powi(2);
+        let d2 = x.distance_squared(xt);
         if d2 < nearest.0 {
             nearest = (d2, i);
         }
-        let well_inside = x[0] > lo[0] + reach
-            && x[0] < hi[0] - reach
-            && x[1] > lo[1] + reach
-            && x[1] < hi[1] - reach;
+        let well_inside = x.cmpgt(lo + reach).all() && x.cmplt(hi - reach).all();
         plastic |= !well_inside && p.hardened.get(i).is_some_and(|h| h.equivalent > 0.0);
         let m = p.mass[i];
         let mat = &world.materials[p.material[i] as usize];
@@ -473,7 +457,7 @@ fn gather(
             D2::entry(&gu, 1, 0),
             D2::entry(&gu, 1, 1),
         ];
-        let v = xy(p.v[i]);
+        let v = p.v[i];
         let f = [
             m,
             m * st.xx,
@@ -484,12 +468,12 @@ fn gather(
             m * gu[2],
             m * gu[3],
             m * (mat.energy_density(&st) + p.plastic_work(i)),
-            m * 0.5 * (m / p.volume[i]) * (v[0] * v[0] + v[1] * v[1]),
+            m * 0.5 * (m / p.volume[i]) * v.length_squared(),
         ];
         let targets = fields.targets_of(i);
         // Only the area term needs the particles inside the contour.
-        let inside = area_term && x[0] > lo[0] && x[0] < hi[0] && x[1] > lo[1] && x[1] < hi[1];
-        let mut accel = [0.0; 2];
+        let inside = area_term && x.cmpgt(lo).all() && x.cmplt(hi).all();
+        let mut accel = DVec2::ZERO;
         with_shape!(shape, S, N => {
             let st = Stencil::<N>::cached::<D2>(S, &world.tiles.stencils, i);
             let mut visit = |entry: usize, w: f64| {
@@ -499,8 +483,7 @@ fn gather(
                     }
                 }
                 if inside {
-                    accel[0] += g.accel[entry][0] * w;
-                    accel[1] += g.accel[entry][1] * w;
+                    accel += g.accel[entry] * w;
                 }
             };
             match targets {
@@ -514,12 +497,12 @@ fn gather(
             let gv = p.grad_v[i];
             let scale = m / world.settings.thickness;
             for (mm, a) in area.iter_mut().enumerate() {
-                let du = [
+                let du = DVec2::new(
                     D2::entry(&p.grad_u[i], 0, mm),
                     D2::entry(&p.grad_u[i], 1, mm),
-                ];
-                let dv = [D2::entry(&gv, 0, mm), D2::entry(&gv, 1, mm)];
-                *a += scale * (accel[0] * du[0] + accel[1] * du[1] - v[0] * dv[0] - v[1] * dv[1]);
+                );
+                let dv = DVec2::new(D2::entry(&gv, 0, mm), D2::entry(&gv, 1, mm));
+                *a += scale * (accel.dot(du) - v.x * dv.x - v.y * dv.y);
             }
         }
     }
@@ -542,14 +525,14 @@ fn opening_amplitudes(
     cracks: &Cracks<D2>,
     walk: &[usize],
     end: usize,
-    xt: [f64; 2],
-    dir: [f64; 2],
+    xt: DVec2,
+    dir: DVec2,
     h: f64,
     window: f64,
 ) -> [f64; 2] {
     let mut samples: Vec<(f64, [f64; 2])> = Vec::new();
     for &k in walk.iter().skip(1) {
-        let r = dist(xy(cracks.geometry.x[k]), xt);
+        let r = cracks.geometry.x[k].distance(xt);
         if r > window {
             break;
         }
@@ -563,9 +546,8 @@ fn opening_amplitudes(
         } else {
             (cracks.geometry.bottom[k], cracks.geometry.top[k])
         };
-        let d = xy(upper - lower);
-        let d_i = -d[0] * dir[1] + d[1] * dir[0];
-        let d_ii = d[0] * dir[0] + d[1] * dir[1];
+        let d = upper - lower;
+        let (d_i, d_ii) = (dir.perp_dot(d), d.dot(dir));
         samples.push((r, [d_i, d_ii]));
     }
     match samples.len() {

@@ -3,14 +3,14 @@
 //! function over the World.
 
 /// The loop the particle systems run over a list of particles (`usize` indices): for each
-/// particle not coded near a crack (`$fields`; those are handled field by field
-/// afterwards), `$body` with `$i` its index and `$st` its cached stencil of `N` nodes per
-/// axis in dimension `$d`. `N` is a constant in `$body` (bound by `with_shape!` outside
-/// the loop), so stencil loops unroll and no particle matches on the shape.
+/// [free](is_free) particle, `$body` with `$i` its index and `$st` its cached stencil of `N`
+/// nodes per axis in dimension `$d`. `N` is a constant in `$body` (bound by `with_shape!`
+/// outside the loop), so stencil loops unroll and no particle matches on the shape.
+/// `stress_bin` alone runs its particles inside the binning pass, with the same test.
 macro_rules! for_each_free_particle {
     ($d:ty, $shape:expr, $stencils:expr, $fields:expr, $particles:expr, |$i:ident, $st:ident| $body:block) => {
         $crate::with_shape!($shape, S, N => for $i in $particles {
-            if $fields.is_some_and(|f| f.is_coded($i)) {
+            if !$crate::systems::is_free($fields, $i) {
                 continue;
             }
             let $st = $crate::physics::shape::Stencil::<N>::cached::<$d>(S, $stencils, $i);
@@ -38,7 +38,16 @@ use crate::base::dim::{D2, D3, Dim};
 use crate::base::error::Unstable;
 use crate::fracture::plan::{FracturePlan, Measured};
 use crate::physics::growth::GrowthRow;
+use crate::store::crack::Fields;
 use crate::store::world::World;
+
+/// Whether particle `i` sees no crack (`fields`, the crack store's per-particle fields, when
+/// the scene has cracks): the particle systems handle it in their common loop, the coded
+/// ones field by field afterwards.
+#[inline(always)]
+pub(crate) fn is_free(fields: Option<&Fields>, i: usize) -> bool {
+    !fields.is_some_and(|f| f.is_coded(i))
+}
 
 /// The systems whose algorithm differs by dimension: J and K at crack tips in 2D and at
 /// every front vertex in 3D, and the growth of tips or fronts. Each returns what it

@@ -11,6 +11,7 @@ use crate::store::crack::Fields;
 use crate::store::particles::Particles;
 use crate::store::world::World;
 use crate::systems::bin::{BeforeBin, outside, place};
+use crate::systems::is_free;
 use crate::systems::stress::{StressColumns, node_velocities, update_coded, velocity_gradient};
 
 /// Updates every particle's stress over `fraction` of the step (as
@@ -72,7 +73,7 @@ impl<D: Dim> BeforeBin for ClosingStress<'_, D> {
     #[inline(always)]
     fn before<const N: usize>(&self, s: ShapeKind, i: usize, first: u32, params: &[f64]) {
         // Particles near a crack were updated from their fields' entries already.
-        if self.fields.is_some_and(|f| f.is_coded(i)) {
+        if !is_free(self.fields, i) {
             return;
         }
         let st = Stencil::<N>::from_cache::<D>(s, first, params, &self.inv_h);

@@ -5,7 +5,7 @@
 
 use crate::base::dim::D3;
 use crate::store::crack::{Cracks, Front};
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use std::collections::HashMap;
 
 /// One front vertex with its frame.
@@ -22,25 +22,25 @@ pub struct FrontFrame {
 
 impl FrontFrame {
     /// Components of the global vector `v` in front axes (Eq. 28).
-    pub fn local(&self, v: DVec3) -> [f64; 3] {
+    pub fn local(&self, v: DVec3) -> DVec3 {
         to_local(&self.e, v)
     }
 
-    /// The global tensor `m` (`m[i][j]`, row i) in front axes (Eqs. 29-30).
-    pub fn local_tensor(&self, m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    /// The global tensor `m` in front axes (Eqs. 29-30).
+    pub fn local_tensor(&self, m: &DMat3) -> DMat3 {
         tensor_to_local(&self.e, m)
     }
 }
 
 /// Components of the global vector `v` along the unit axes `e`.
-pub fn to_local(e: &[DVec3; 3], v: DVec3) -> [f64; 3] {
-    e.map(|a| a.dot(v))
+pub fn to_local(e: &[DVec3; 3], v: DVec3) -> DVec3 {
+    DVec3::new(e[0].dot(v), e[1].dot(v), e[2].dot(v))
 }
 
-/// The global tensor `m` (`m[i][j]`, row i) in the unit axes `e`: e_a . (m e_b).
-pub fn tensor_to_local(e: &[DVec3; 3], m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let rows = m.map(DVec3::from);
-    e.map(|a| e.map(|b| a.dot(DVec3::new(rows[0].dot(b), rows[1].dot(b), rows[2].dot(b)))))
+/// The global tensor `m` in the unit axes `e`: entry (a, b) is e_a . (m e_b).
+pub fn tensor_to_local(e: &[DVec3; 3], m: &DMat3) -> DMat3 {
+    let column = |b: DVec3| to_local(e, *m * b);
+    DMat3::from_cols(column(e[0]), column(e[1]), column(e[2]))
 }
 
 /// The frames at the vertices of a front, in its order, and whether the front is closed.

@@ -23,17 +23,25 @@
 //! K_I = E' I_I / 2, K_II = E' I_II / 2 (E' = E / (1 - nu^2)) and K_III = mu I_III, from
 //! G = (K_I^2 + K_II^2) / E' + K_III^2 / (2 mu).
 
-use crate::base::dim::{D3, Dim};
+use crate::base::dim::D3;
 use crate::base::sym::SymTensor;
 use crate::fracture::front::{FrontFrame, FrontLine, tensor_to_local, to_local};
 use crate::fracture::interaction::{accel, near};
 use crate::physics::near_tip;
 use crate::store::crack::Cracks;
 use crate::store::world::World;
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use std::f64::consts::PI;
 
-type M3 = [[f64; 3]; 3];
+/// The 3x3 matrix whose rows are `m`'s.
+fn from_rows(m: [[f64; 3]; 3]) -> DMat3 {
+    DMat3::from_cols_array_2d(&m).transpose()
+}
+
+/// sigma : g, the double contraction of two tensors (row by row).
+fn contract(a: &DMat3, b: &DMat3) -> f64 {
+    (0..3).map(|i| a.row(i).dot(b.row(i))).sum()
+}
 
 /// Smallest fraction of the tube's weighted volume that particles must fill; below it the
 /// tube reaches past the body's edge and is shrunk.
@@ -95,36 +103,40 @@ impl Elastic3 {
     /// The auxiliary fields of the three modes at unit K at polar position (r, theta) in the
     /// x1-x2 plane: plane strain for modes I and II (s_33 = nu (s_11 + s_22)), anti-plane
     /// shear for mode III.
-    fn aux(&self, r: f64, theta: f64) -> ([M3; 3], [M3; 3]) {
+    fn aux(&self, r: f64, theta: f64) -> ([DMat3; 3], [DMat3; 3]) {
         let (s2, g2) = near_tip::unit_fields(r, theta, 3.0 - 4.0 * self.nu, self.mu);
         let (_, g3, s3) = near_tip::antiplane(1.0, r, theta, self.mu);
         let plane = |m: usize| {
             let [xx, yy, xy] = s2[m];
             let g = g2[m];
             (
-                [
+                from_rows([
                     [xx, xy, 0.0],
                     [xy, yy, 0.0],
                     [0.0, 0.0, self.nu * (xx + yy)],
-                ],
-                [[g[0][0], g[0][1], 0.0], [g[1][0], g[1][1], 0.0], [0.0; 3]],
+                ]),
+                from_rows([[g[0][0], g[0][1], 0.0], [g[1][0], g[1][1], 0.0], [0.0; 3]]),
             )
         };
         let (s1, g1) = plane(0);
         let (s2m, g2m) = plane(1);
-        let s3m = [[0.0, 0.0, s3[0]], [0.0, 0.0, s3[1]], [s3[0], s3[1], 0.0]];
-        let g3m = [[0.0; 3], [0.0; 3], [g3[0], g3[1], 0.0]];
+        let s3m = from_rows([[0.0, 0.0, s3[0]], [0.0, 0.0, s3[1]], [s3[0], s3[1], 0.0]]);
+        let g3m = from_rows([[0.0; 3], [0.0; 3], [g3[0], g3[1], 0.0]]);
         ([s1, s2m, s3m], [g1, g2m, g3m])
     }
 
     /// The auxiliary displacements of the three modes at unit K at (r, theta), in front
     /// axes.
-    fn aux_displacement(&self, r: f64, theta: f64) -> [[f64; 3]; 3] {
+    fn aux_displacement(&self, r: f64, theta: f64) -> [DVec3; 3] {
         let kap = 3.0 - 4.0 * self.nu;
         let u1 = near_tip::displacement(1.0, 0.0, r, theta, kap, self.mu);
         let u2 = near_tip::displacement(0.0, 1.0, r, theta, kap, self.mu);
         let u3 = near_tip::antiplane(1.0, r, theta, self.mu).0;
-        [[u1[0], u1[1], 0.0], [u2[0], u2[1], 0.0], [0.0, 0.0, u3]]
+        [
+            DVec3::new(u1[0], u1[1], 0.0),
+            DVec3::new(u2[0], u2[1], 0.0),
+            DVec3::new(0.0, 0.0, u3),
+        ]
     }
 
     /// kappa + 1 = 4 (1 - nu) of plane strain: the crack opens by (kappa + 1) K_I / mu
@@ -161,7 +173,7 @@ struct Place {
     /// Rotation into the frame at the nearest front point (rows e1, e2, e3).
     e: [DVec3; 3],
     /// d e1 / ds there, in that frame (1/m).
-    de1: [f64; 3],
+    de1: DVec3,
     /// +1 where s grows along e3, -1 where it grows against it: grad s = along e3.
     along: f64,
     /// Position in the normal plane (m) and arc length from the vertex (m).
@@ -192,12 +204,12 @@ struct Sample {
 #[derive(Clone, Copy, Debug)]
 struct Fields {
     /// Stress (Pa), displacement gradient du_i/dx_j and velocity gradient dv_i/dx_j (1/s).
-    s: M3,
-    gu: M3,
-    gv: M3,
+    s: DMat3,
+    gu: DMat3,
+    gv: DMat3,
     /// Velocity (m/s) and acceleration (m/s^2).
-    v: [f64; 3],
-    a: [f64; 3],
+    v: DVec3,
+    a: DVec3,
     /// Volume (m^3) and mass (kg).
     vol: f64,
     mass: f64,
@@ -211,39 +223,28 @@ struct Fields {
     material: u16,
 }
 
-fn mv(m: &M3, v: [f64; 3]) -> [f64; 3] {
-    m.map(|row| row[0] * v[0] + row[1] * v[1] + row[2] * v[2])
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn contract(a: &M3, b: &M3) -> f64 {
-    (0..3).map(|i| dot(a[i], b[i])).sum()
-}
-
 impl Sample {
     /// The particle with fields `f` at `place`, with the auxiliary fields of `el`.
     fn new(place: &Place, f: &Fields, el: &Elastic3) -> Sample {
         let r = place.x1.hypot(place.x2);
         let theta = place.x2.atan2(place.x1);
-        let radial = [place.x1 / r, place.x2 / r, 0.0];
-        let (e1, e3, de1) = ([1.0, 0.0, 0.0], [0.0, 0.0, place.along], place.de1);
+        let radial = DVec3::new(place.x1 / r, place.x2 / r, 0.0);
+        let (e1, e3, de1) = (DVec3::X, DVec3::new(0.0, 0.0, place.along), place.de1);
         // u^T P v for P = g1^T s1 + g2^T s2 - w I: (g1 u).(s1 v) + (g2 u).(s2 v) - w u.v.
-        let p = |g1: &M3, s1: &M3, g2: &M3, s2: &M3, w: f64, u, v| {
-            dot(mv(g1, u), mv(s1, v)) + dot(mv(g2, u), mv(s2, v)) - w * dot(u, v)
+        let p = |g1: &DMat3, s1: &DMat3, g2: &DMat3, s2: &DMat3, w: f64, u: DVec3, v: DVec3| {
+            (*g1 * u).dot(*s1 * v) + (*g2 * u).dot(*s2 * v) - w * u.dot(v)
         };
-        let zero = [[0.0; 3]; 3];
-        let coeffs = |g1: &M3, s1: &M3, g2: &M3, s2: &M3, w: f64, inertia: f64| {
+        let zero = DMat3::ZERO;
+        let coeffs = |g1: &DMat3, s1: &DMat3, g2: &DMat3, s2: &DMat3, w: f64, inertia: f64| {
             [
                 f.vol * p(g1, s1, g2, s2, w, e1, radial),
                 f.vol * p(g1, s1, g2, s2, w, e1, e3),
                 f.vol * p(g1, s1, g2, s2, w, de1, e3) + inertia,
             ]
         };
-        let w = 0.5 * contract(&f.s, &f.gu) + f.plastic + 0.5 * f.mass / f.vol * dot(f.v, f.v);
-        let col1 = |g: &M3| [g[0][0], g[1][0], g[2][0]];
+        let w = 0.5 * contract(&f.s, &f.gu) + f.plastic + 0.5 * f.mass / f.vol * f.v.dot(f.v);
+        // The first column of a gradient: its derivative along x1.
+        let col1 = |g: &DMat3| g.x_axis;
         let mut c = [[0.0; 3]; 4];
         c[0] = coeffs(
             &f.gu,
@@ -251,7 +252,7 @@ impl Sample {
             &zero,
             &zero,
             w,
-            f.mass * (dot(f.a, col1(&f.gu)) - dot(f.v, col1(&f.gv))),
+            f.mass * (f.a.dot(col1(&f.gu)) - f.v.dot(col1(&f.gv))),
         );
         let (aux_s, aux_g) = el.aux(r, theta);
         let aux_u = el.aux_displacement(r, theta);
@@ -259,7 +260,7 @@ impl Sample {
             let (sa, ga) = (&aux_s[m], &aux_g[m]);
             let w_int = contract(&f.s, ga);
             let (g_full, residual) = curved(place, &f.s, &f.gu, sa, ga, aux_u[m]);
-            let mut cm = coeffs(&g_full, &f.s, &f.gu, sa, w_int, f.mass * dot(f.a, col1(ga)));
+            let mut cm = coeffs(&g_full, &f.s, &f.gu, sa, w_int, f.mass * f.a.dot(col1(ga)));
             cm[2] += f.vol * residual;
             c[m + 1] = cm;
         }
@@ -282,30 +283,25 @@ impl Sample {
 /// sigma_ij (u^a_i,kj - eps^a_ij,k) Q_k + sigma^a_ij,j u_i,k Q_k (the terms by which the
 /// auxiliary field fails compatibility and equilibrium, Gosz & Moran 2002). Returns the
 /// full gradient and that residual per unit weight q, both in the frame at the particle.
-fn curved(place: &Place, s: &M3, gu: &M3, sa: &M3, ga: &M3, ua: [f64; 3]) -> (M3, f64) {
+fn curved(place: &Place, s: &DMat3, gu: &DMat3, sa: &DMat3, ga: &DMat3, ua: DVec3) -> (DMat3, f64) {
     let (de1, along) = (place.de1, place.along);
-    let kappa = de1[2];
+    let kappa = de1.z;
     let h = 1.0 + along * kappa * place.x1;
-    // u_1 de_1/ds + u_3 de_3/ds and its derivative along x1.
-    let f = [
-        ua[0] * de1[0] - ua[2] * kappa,
-        ua[0] * de1[1],
-        ua[0] * de1[2],
-    ];
-    let df = [
-        ga[0][0] * de1[0] - ga[2][0] * kappa,
-        ga[0][0] * de1[1],
-        ga[0][0] * de1[2],
-    ];
+    // u_1 de_1/ds + u_3 de_3/ds and its derivative along x1 (the first column of ga).
+    let f = DVec3::new(ua.x * de1.x - ua.z * kappa, ua.x * de1.y, ua.x * de1.z);
+    let d1 = ga.x_axis;
+    let df = DVec3::new(d1.x * de1.x - d1.z * kappa, d1.x * de1.y, d1.x * de1.z);
+    // The third column gains the term along grad s; sigma_i3 weighs the compatibility.
     let mut g = *ga;
     let mut compat = 0.0;
     for i in 0..3 {
-        g[i][2] += along * f[i] / h;
+        g.z_axis[i] += along * f[i] / h;
         let d = along * (df[i] / h - f[i] * along * kappa / (h * h));
-        compat += s[i][2] * d;
+        compat += s.z_axis[i] * d;
     }
-    let div = [sa[0][0] - sa[2][2], sa[1][0], 2.0 * sa[0][2]].map(|v| along * kappa / h * v);
-    let equil = dot(div, [gu[0][0], gu[1][0], gu[2][0]]);
+    let div = DVec3::new(sa.x_axis.x - sa.z_axis.z, sa.x_axis.y, 2.0 * sa.z_axis.x)
+        .map(|v| along * kappa / h * v);
+    let equil = div.dot(gu.x_axis);
     (g, compat + equil)
 }
 
@@ -440,7 +436,7 @@ fn place(line: &FrontLine, idx: &[usize], arc: &[f64], p: DVec3) -> Place {
     let d = p - lerp(fa.x, fb.x);
     Place {
         e,
-        de1: e.map(|a| a.dot(de1)),
+        de1: to_local(&e, de1),
         along,
         x1: d.dot(e1),
         x2: d.dot(e2),
@@ -468,7 +464,7 @@ fn gather(
     // the vertex can be on the other face from where the sign of x2 puts it.
     let band = facets
         .iter()
-        .map(|f| frame.local(f.centroid - frame.x)[1].abs())
+        .map(|f| frame.local(f.centroid - frame.x).y.abs())
         .fold(0.0, f64::max)
         + h;
     let mut nearest = (f64::INFINITY, 0u16);
@@ -495,16 +491,15 @@ fn gather(
             }
         }
         let st = p.stress[i].to_sym3();
-        let s = [
+        let s = from_rows([
             [st.xx, st.xy, st.xz],
             [st.xy, st.yy, st.yz],
             [st.xz, st.yz, st.zz],
-        ];
-        let mat = |m: &<D3 as Dim>::Mat| [0, 1, 2].map(|r| [0, 1, 2].map(|c| D3::entry(m, r, c)));
+        ]);
         let fields = Fields {
-            s: tensor_to_local(&at.e, s),
-            gu: tensor_to_local(&at.e, mat(&p.grad_u[i])),
-            gv: tensor_to_local(&at.e, mat(&p.grad_v[i])),
+            s: tensor_to_local(&at.e, &s),
+            gu: tensor_to_local(&at.e, &p.grad_u[i]),
+            gv: tensor_to_local(&at.e, &p.grad_v[i]),
             v: to_local(&at.e, p.v[i]),
             a: to_local(&at.e, accel(world, cracks, i)),
             vol: p.volume[i],
@@ -569,16 +564,9 @@ mod tests {
         let el = Elastic3 { mu: MU, nu: NU };
         let lam = 2.0 * MU * NU / (1.0 - 2.0 * NU);
         let n = (half / h) as i64;
-        let e = frame.e.map(|v| v.to_array());
-        let global = |m: M3| {
-            [0, 1, 2].map(|i| {
-                [0, 1, 2].map(|j| {
-                    (0..3)
-                        .map(|p| (0..3).map(|q| e[p][i] * m[p][q] * e[q][j]).sum::<f64>())
-                        .sum()
-                })
-            })
-        };
+        // R^T m R, with R's rows the frame's axes: a tensor in front axes, in global axes.
+        let rt = DMat3::from_cols(frame.e[0], frame.e[1], frame.e[2]);
+        let global = |m: DMat3| rt * m * rt.transpose();
         let mut out = Vec::new();
         for a in -n..n {
             for b in -n..n {
@@ -600,18 +588,18 @@ mod tests {
                     });
                     let place = Place {
                         e: frame.e,
-                        de1: [0.0; 3],
+                        de1: DVec3::ZERO,
                         along: 1.0,
                         x1: x[0],
                         x2: x[1],
                         s: x[2],
                     };
                     let fields = Fields {
-                        s: frame.local_tensor(global(s)),
-                        gu: frame.local_tensor(global(gu)),
-                        gv: [[0.0; 3]; 3],
-                        v: [0.0; 3],
-                        a: [0.0; 3],
+                        s: frame.local_tensor(&global(from_rows(s))),
+                        gu: frame.local_tensor(&global(from_rows(gu))),
+                        gv: DMat3::ZERO,
+                        v: DVec3::ZERO,
+                        a: DVec3::ZERO,
                         vol: h * h * h,
                         mass: 0.0,
                         plastic: 0.0,
@@ -655,36 +643,27 @@ mod tests {
             let (phi, x1, x2) = coords(p);
             let (r, t) = polar(x1, x2);
             let sl = el.aux(r, t).0[m];
-            let e = axes(phi);
-            let mut g = [[0.0; 3]; 3];
-            for (a, row) in sl.iter().enumerate() {
-                for (b, v) in row.iter().enumerate() {
-                    for i in 0..3 {
-                        for j in 0..3 {
-                            g[i][j] += v * e[a][i] * e[b][j];
-                        }
-                    }
-                }
-            }
-            g
+            // R^T sl R, R's rows the frame's axes.
+            let [e1, e2, e3] = axes(phi);
+            let rt = DMat3::from_cols(e1, e2, e3);
+            rt * sl * rt.transpose()
         };
         let d = 1e-8;
         // Global gradient du_i/dx_j by central differences, in the frame at angle phi.
         let grad = |p: DVec3, m: usize, phi: f64| {
-            let mut g = [[0.0; 3]; 3];
-            for j in 0..3 {
+            let column = |j: usize| {
                 let mut dp = DVec3::ZERO;
                 dp[j] = d;
-                let du = (disp(p + dp, m) - disp(p - dp, m)) / (2.0 * d);
-                for i in 0..3 {
-                    g[i][j] = du[i];
-                }
-            }
-            tensor_to_local(&axes(phi), g)
+                (disp(p + dp, m) - disp(p - dp, m)) / (2.0 * d)
+            };
+            tensor_to_local(
+                &axes(phi),
+                &DMat3::from_cols(column(0), column(1), column(2)),
+            )
         };
-        let sym = |g: &M3| [0, 1, 2].map(|i| [0, 1, 2].map(|j| 0.5 * (g[i][j] + g[j][i])));
-        let s_act = [[3.0, 0.4, -0.7], [0.4, -1.2, 0.9], [-0.7, 0.9, 2.1]];
-        let gu_act = [[0.3, -0.2, 0.5], [0.8, 0.1, -0.4], [-0.6, 0.7, 0.2]];
+        let sym = |g: DMat3| 0.5 * (g + g.transpose());
+        let s_act = from_rows([[3.0, 0.4, -0.7], [0.4, -1.2, 0.9], [-0.7, 0.9, 2.1]]);
+        let gu_act = from_rows([[0.3, -0.2, 0.5], [0.8, 0.1, -0.4], [-0.6, 0.7, 0.2]]);
         for (phi, x1, x2) in [
             (0.3, 1.1e-3, 0.6e-3),
             (2.0, -0.9e-3, -0.4e-3),
@@ -695,7 +674,7 @@ mod tests {
             let (r, t) = polar(x1, x2);
             let place = Place {
                 e,
-                de1: [0.0, 0.0, 1.0 / rho],
+                de1: DVec3::new(0.0, 0.0, 1.0 / rho),
                 along: 1.0,
                 x1,
                 x2,
@@ -709,38 +688,29 @@ mod tests {
                 let scale = 1.0 / (2.0 * PI * r).sqrt();
                 for i in 0..3 {
                     for j in 0..3 {
+                        let (got, want) = (g.col(j)[i], fd.col(j)[i]);
                         assert!(
-                            (g[i][j] - fd[i][j]).abs() < 1e-5 * scale,
-                            "mode {m} G[{i}][{j}]: {} vs {}",
-                            g[i][j],
-                            fd[i][j]
+                            (got - want).abs() < 1e-5 * scale,
+                            "mode {m} G[{i}][{j}]: {got} vs {want}"
                         );
                     }
                 }
                 // sigma_ij d/dx1 (eps_full - eps_plane)_ij, and div sigma^a . (grad u e1).
                 let h = 1e-5;
                 let step = |sgn: f64| {
-                    let full = sym(&grad(p + e[0] * (sgn * h), m, phi));
+                    let full = sym(grad(p + e[0] * (sgn * h), m, phi));
                     let (rr, tt) = polar(x1 + sgn * h, x2);
-                    let plane = sym(&el.aux(rr, tt).1[m]);
-                    [0, 1, 2].map(|i| [0, 1, 2].map(|j| full[i][j] - plane[i][j]))
+                    full - sym(el.aux(rr, tt).1[m])
                 };
-                let (up, down) = (step(1.0), step(-1.0));
-                let compat: f64 = (0..3)
-                    .flat_map(|i| (0..3).map(move |j| (i, j)))
-                    .map(|(i, j)| s_act[i][j] * (up[i][j] - down[i][j]) / (2.0 * h))
-                    .sum();
+                let compat = contract(&s_act, &(step(1.0) - step(-1.0))) / (2.0 * h);
+                // The divergence sum_j d sigma_ij / dx_j, column by column.
                 let mut div = DVec3::ZERO;
                 for j in 0..3 {
                     let mut dp = DVec3::ZERO;
                     dp[j] = d;
-                    let (sp, sm) = (stress(p + dp, m), stress(p - dp, m));
-                    for i in 0..3 {
-                        div[i] += (sp[i][j] - sm[i][j]) / (2.0 * d);
-                    }
+                    div += (stress(p + dp, m) - stress(p - dp, m)).col(j) / (2.0 * d);
                 }
-                let div = to_local(&e, div);
-                let equil = dot(div, [gu_act[0][0], gu_act[1][0], gu_act[2][0]]);
+                let equil = to_local(&e, div).dot(gu_act.x_axis);
                 let want = compat + equil;
                 assert!(
                     (residual - want).abs() < 5e-4 * scale / rho,

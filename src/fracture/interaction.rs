@@ -40,9 +40,9 @@ pub struct Tip<'a> {
     /// The crack's polyline vertices, start to end.
     pub path: &'a [usize],
     /// Tip position (m).
-    pub x: [f64; 2],
+    pub x: DVec2,
     /// Unit direction of extension.
-    pub dir: [f64; 2],
+    pub dir: DVec2,
 }
 
 /// The interaction integral's K at one tip, with the domain it was taken over.
@@ -64,7 +64,7 @@ const FILLED: f64 = 0.98;
 /// One particle's data in tip axes.
 struct Sample {
     /// Position relative to the tip (m).
-    x: [f64; 2],
+    x: DVec2,
     /// Area (m^2) and mass per unit thickness (kg/m).
     area: f64,
     mass: f64,
@@ -73,7 +73,7 @@ struct Sample {
     /// du_i/dx_j.
     gu: [[f64; 2]; 2],
     /// Acceleration (m/s^2).
-    a: [f64; 2],
+    a: DVec2,
     /// Auxiliary stress and displacement gradient of modes I and II at unit K.
     aux_s: [[f64; 3]; 2],
     aux_g: [[[f64; 2]; 2]; 2],
@@ -83,15 +83,15 @@ impl Sample {
     /// A particle at `x` (tip axes) and polar angle `theta` with its `[area, mass]`, stress,
     /// displacement gradient and acceleration, and the auxiliary fields for `[kappa, mu]`.
     fn new(
-        x: [f64; 2],
+        x: DVec2,
         theta: f64,
         [area, mass]: [f64; 2],
         s: [f64; 3],
         gu: [[f64; 2]; 2],
-        a: [f64; 2],
+        a: DVec2,
         [kap, mu]: [f64; 2],
     ) -> Sample {
-        let (aux_s, aux_g) = near_tip::unit_fields(x[0].hypot(x[1]), theta, kap, mu);
+        let (aux_s, aux_g) = near_tip::unit_fields(x.x.hypot(x.y), theta, kap, mu);
         Sample {
             x,
             area,
@@ -141,7 +141,7 @@ pub fn interaction_k(
 
 /// Distance from the tip to the nearest segment of any other crack (m).
 fn other_crack_distance(cracks: &Cracks<D2>, tip: Tip) -> f64 {
-    let x = DVec2::from(tip.x);
+    let x = tip.x;
     let at = |k: u32| cracks.geometry.x[k as usize];
     cracks
         .topology
@@ -159,7 +159,7 @@ fn other_crack_distance(cracks: &Cracks<D2>, tip: Tip) -> f64 {
 /// that of a homogeneous body, so the domain stays in the tip's material.
 fn other_material_distance(world: &World<D2>, tip: Tip, reach: f64, mat: &Material) -> f64 {
     let p = &world.particles;
-    let x = DVec2::from(tip.x);
+    let x = tip.x;
     let foreign: Vec<bool> = (world.materials.iter())
         .map(|m| m.youngs != mat.youngs || m.poisson != mat.poisson)
         .collect();
@@ -179,14 +179,14 @@ fn integrate(samples: &[Sample], r_max: f64) -> Option<[f64; 2]> {
     let inv = 1.0 / (r_max * r_max);
     let (mut filled, mut i) = (0.0, [0.0; 2]);
     for p in samples {
-        let rr = (p.x[0] * p.x[0] + p.x[1] * p.x[1]) * inv;
+        let rr = p.x.length_squared() * inv;
         if rr >= 1.0 {
             continue;
         }
         let q = (1.0 - rr) * (1.0 - rr);
         let gq = [
-            -4.0 * (1.0 - rr) * p.x[0] * inv,
-            -4.0 * (1.0 - rr) * p.x[1] * inv,
+            -4.0 * (1.0 - rr) * p.x.x * inv,
+            -4.0 * (1.0 - rr) * p.x.y * inv,
         ];
         filled += p.area * q;
         let [sxx, syy, sxy] = p.s;
@@ -202,7 +202,7 @@ fn integrate(samples: &[Sample], r_max: f64) -> Option<[f64; 2]> {
                     f += (si[j] * g[ii][0] + sai[j] * p.gu[ii][0]) * gqj;
                 }
             }
-            *im += p.area * f + p.mass * (p.a[0] * g[0][0] + p.a[1] * g[1][0]) * q;
+            *im += p.area * f + p.mass * (p.a.x * g[0][0] + p.a.y * g[1][0]) * q;
         }
     }
     // The weight's integral over the disc is pi R^2 / 3.
@@ -222,8 +222,9 @@ fn gather(
     mu: f64,
 ) -> Vec<Sample> {
     let p = &world.particles;
-    let [c, s] = tip.dir;
-    let to_local = |v: [f64; 2]| [c * v[0] + s * v[1], -s * v[0] + c * v[1]];
+    let (c, s) = (tip.dir.x, tip.dir.y);
+    // Components along the tip direction and across it (to its left).
+    let to_local = |v: DVec2| DVec2::new(tip.dir.dot(v), tip.dir.perp_dot(v));
     let rot = |m: [[f64; 2]; 2]| {
         // R m R^T with R = [[c, s], [-s, c]].
         let rm = [
@@ -235,40 +236,38 @@ fn gather(
             [c * rm[1][0] + s * rm[1][1], -s * rm[1][0] + c * rm[1][1]],
         ]
     };
-    let vx = |k: usize| cracks.geometry.x[k].to_array();
+    let vx = |k: usize| cracks.geometry.x[k];
     // Segments that can be nearest to a particle in the disc, oriented start -> end.
-    let segs: Vec<([f64; 2], [f64; 2])> = (tip.path.windows(2))
+    let segs: Vec<(DVec2, DVec2)> = (tip.path.windows(2))
         .map(|w| (vx(w[0]), vx(w[1])))
-        .filter(|(a, b)| seg_distance(tip.x, *a, *b) < 2.0 * r_max)
+        .filter(|&(a, b)| point_segment(tip.x, a, b) < 2.0 * r_max)
         .collect();
     // Only a particle within a cell of the band the crack's vertices span about the tip's
     // line can be on the other side of the crack from where theta's sign puts it.
     let band = segs
         .iter()
         .flat_map(|(a, b)| [a, b])
-        .map(|v| to_local([v[0] - tip.x[0], v[1] - tip.x[1]])[1].abs())
+        .map(|&v| to_local(v - tip.x).y.abs())
         .fold(0.0, f64::max)
         + world.grid.geom.h[0].max(world.grid.geom.h[1]);
     // Left of the tip direction is left of the segments at an end tip, right at a start.
     let handed = if tip.end == 1 { 1.0 } else { -1.0 };
     let thickness = world.settings.thickness;
     let mut out = Vec::new();
-    for i in near(world, DVec2::from(tip.x), r_max) {
-        let d = [p.x[i][0] - tip.x[0], p.x[i][1] - tip.x[1]];
-        if d[0].abs() >= r_max || d[1].abs() >= r_max || d[0].hypot(d[1]) >= r_max {
+    for i in near(world, tip.x, r_max) {
+        let d = p.x[i] - tip.x;
+        if d.x.abs() >= r_max || d.y.abs() >= r_max || d.x.hypot(d.y) >= r_max {
             continue;
         }
         let x = to_local(d);
-        let mut theta = x[1].atan2(x[0]);
-        if x[0] < 0.0 && x[1].abs() <= band {
-            let pos = p.x[i].to_array();
+        let mut theta = x.y.atan2(x.x);
+        if x.x < 0.0 && x.y.abs() <= band {
+            let pos = p.x[i];
             let side = segs
                 .iter()
-                .map(|&(a, b)| (seg_distance(pos, a, b), (a, b)))
+                .map(|&(a, b)| (point_segment(pos, a, b), (a, b)))
                 .min_by(|u, v| u.0.total_cmp(&v.0))
-                .map(|(_, (a, b))| {
-                    handed * ((b[0] - a[0]) * (pos[1] - a[1]) - (b[1] - a[1]) * (pos[0] - a[0]))
-                });
+                .map(|(_, (a, b))| handed * (b - a).perp_dot(pos - a));
             if let Some(side) = side {
                 theta = theta.abs().copysign(side);
             }
@@ -286,7 +285,7 @@ fn gather(
             [p.volume[i] / thickness, p.mass[i] / thickness],
             [sl[0][0], sl[1][1], sl[0][1]],
             gu,
-            to_local(accel(world, cracks, i).to_array()),
+            to_local(accel(world, cracks, i)),
             [kap, mu],
         ));
     }
@@ -307,11 +306,6 @@ pub(crate) fn near<D: Dim>(world: &World<D>, x: D::Vec, reach: f64) -> Vec<usize
         Some(p) => p.into_iter().map(|i| i as usize).collect(),
         None => (0..n).collect(),
     }
-}
-
-/// Distance from `x` to the segment `a`-`b` in the plane (m).
-fn seg_distance(x: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    point_segment(DVec2::from(x), DVec2::from(a), DVec2::from(b))
 }
 
 /// Particle `i`'s acceleration interpolated from its grid entries (its own crack side's
@@ -359,8 +353,8 @@ mod tests {
         let mut out = Vec::new();
         for i in -n..n {
             for j in -n..n {
-                let x = [(i as f64 + 0.5) * h, (j as f64 + 0.5) * h];
-                let (r, t) = (x[0].hypot(x[1]), x[1].atan2(x[0]));
+                let x = DVec2::new(i as f64 + 0.5, j as f64 + 0.5) * h;
+                let (r, t) = (x.x.hypot(x.y), x.y.atan2(x.x));
                 let s = near_tip::stress(k[0], k[1], r, t);
                 let g = near_tip::displacement_gradient(k[0], k[1], r, t, kap, MU);
                 let gu = [
@@ -368,7 +362,15 @@ mod tests {
                     [g[1][0] + e0[2] + spin, g[1][1] + e0[1]],
                 ];
                 let s = [s[0] + s0[0], s[1] + s0[1], s[2] + s0[2]];
-                out.push(Sample::new(x, t, [h * h, 0.0], s, gu, [0.0; 2], [kap, MU]));
+                out.push(Sample::new(
+                    x,
+                    t,
+                    [h * h, 0.0],
+                    s,
+                    gu,
+                    DVec2::ZERO,
+                    [kap, MU],
+                ));
             }
         }
         out
@@ -429,7 +431,7 @@ mod tests {
     fn unfilled_domain_is_refused() {
         let samples: Vec<Sample> = lattice([1e6, 0.0], 1e-4, 2.2e-3, [0.0; 3], 0.0)
             .into_iter()
-            .filter(|s| s.x[1] < 1.0e-3)
+            .filter(|s| s.x.y < 1.0e-3)
             .collect();
         assert!(integrate(&samples, 0.8e-3).is_some());
         assert!(integrate(&samples, 1.5e-3).is_none());
