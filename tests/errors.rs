@@ -856,6 +856,30 @@ fn crack_vertex_counts_are_bounded_and_checked_fast() {
         "[[crack]]\nline = { start = [0.006, 0.01], end = [0.014, 0.01], spacing = 1e-12 }\n",
     );
     assert_error(&e, "crack[0].line.spacing", Some(19), "more than 100000");
+    // 3D surfaces are counted before they are meshed: a penny at 1e-9 m took 152 s and
+    // 1.6 GB to generate, the same at 1e-4 m is 600 triangles.
+    for (shape, key) in [
+        (
+            "penny = { center = [0.01, 0.01, 0.01], normal = [0.0, 0.0, 1.0], radius = 0.003",
+            "penny",
+        ),
+        (
+            "rectangle = { center = [0.01, 0.01, 0.01], axes = [[0.003, 0.0, 0.0], [0.0, 0.003, 0.0]]",
+            "rectangle",
+        ),
+        (
+            "ellipse = { center = [0.01, 0.01, 0.01], axes = [[0.003, 0.0, 0.0], [0.0, 0.002, 0.0]]",
+            "ellipse",
+        ),
+    ] {
+        let e = error_3d(&format!("[[crack]]\n{shape}, spacing = 1e-9 }}\n"));
+        assert_error(
+            &e,
+            &format!("crack[0].{key}.spacing"),
+            Some(19),
+            "more than 200000",
+        );
+    }
     // 40,000 points along a fine zigzag inside the body, then a last segment turned back
     // down across it: the first crossing in index order is with segment 39919, the first
     // zigzag segment the new one passes below (every pair of segments is 8e9 tests).

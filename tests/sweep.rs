@@ -95,8 +95,9 @@ fn every_combination_runs_once_and_a_stopped_sweep_resumes() {
     std::fs::remove_dir_all(dir).ok();
 }
 
-/// A bad key or value is named before any run (no sweep.csv), as are a repeated key and
-/// a sweep of more than 1,000 runs without `yes`; a malformed --vary is refused.
+/// A bad key or value is named before any run (no sweep.csv), as are a repeated key, a
+/// sweep of more than 1,000 runs without `yes` and one past 10,000 runs even with it; a
+/// malformed --vary is refused.
 #[test]
 fn bad_sweeps_are_refused_before_the_first_run() {
     let (dir, file) = setup("bad");
@@ -128,6 +129,18 @@ fn bad_sweeps_are_refused_before_the_first_run() {
     let big = vary(&[&format!("simulation.duration={}", many.join(","))]);
     let e = refused(&big, false);
     assert!(e.contains("1001 runs") && e.contains("--yes"), "{e}");
+    // Five keys of 100 values are 1e10 runs: counted, not built (that took over 2 GB and
+    // aborted), and refused even with --yes.
+    let hundred: Vec<String> = (0..100)
+        .map(|k| format!("{}", 0.1 + 1e-3 * k as f64))
+        .collect();
+    let keys = ["cfl", "damping", "duration", "thickness", "mass_tol"];
+    let huge: Vec<String> = (keys.iter())
+        .map(|k| format!("simulation.{k}={}", hundred.join(",")))
+        .collect();
+    let huge = vary(&huge.iter().map(String::as_str).collect::<Vec<_>>());
+    let e = refused(&huge, true);
+    assert!(e.contains("1.000e10 runs") && e.contains("10000"), "{e}");
     for bad in ["grid.cell", "grid.cell=", "grid.cell=[1e-3, 1e-3", "a=1,,2"] {
         assert!(Vary::parse(bad).is_err(), "{bad}");
     }

@@ -15,6 +15,10 @@ use std::path::Path;
 /// Most runs a sweep makes without being told `--yes`.
 pub const MAX_RUNS: usize = 1000;
 
+/// Most runs a sweep makes at all: every combination's scenario is loaded and kept before
+/// the first run, so that a bad value anywhere is refused up front.
+pub const MAX_RUNS_EVER: usize = 10_000;
+
 /// The run's columns of sweep.csv, after the varied keys and before the expects' value,
 /// error and pass.
 const RUN_COLUMNS: [&str; 7] = [
@@ -98,6 +102,13 @@ fn split_values(list: &str) -> Result<Vec<String>, String> {
     }
     out.push(cur.trim().to_string());
     Ok(out)
+}
+
+/// How many runs the sweep of `vary` has (the product of the value counts), None past
+/// `usize`.
+pub fn run_count(vary: &[Vary]) -> Option<usize> {
+    vary.iter()
+        .try_fold(1usize, |n, v| n.checked_mul(v.values.len()))
 }
 
 /// Every combination of the values, the first key varying slowest, as `--set` arguments.
@@ -254,14 +265,23 @@ pub fn sweep(
             return Err(UsageError(format!("--vary {} is given twice", v.key)).into());
         }
     }
-    let combos = combinations(vary);
-    if combos.len() > MAX_RUNS && !yes {
+    // Counted before the combinations are built: five keys of 100 values each are 1e10.
+    let runs = run_count(vary).filter(|&n| n <= MAX_RUNS_EVER);
+    let Some(runs) = runs else {
+        let n: f64 = vary.iter().map(|v| v.values.len() as f64).product();
         return Err(UsageError(format!(
-            "the sweep has {} runs, more than {MAX_RUNS}: add --yes to run them all",
-            combos.len()
+            "the sweep has {n:.3e} runs, more than the {MAX_RUNS_EVER} a sweep can hold: \
+             give fewer --vary values, or split it into several sweeps"
+        ))
+        .into());
+    };
+    if runs > MAX_RUNS && !yes {
+        return Err(UsageError(format!(
+            "the sweep has {runs} runs, more than {MAX_RUNS}: add --yes to run them all"
         ))
         .into());
     }
+    let combos = combinations(vary);
     let sources = (combos.iter())
         .map(|set| Source::load(file, set))
         .collect::<Result<Vec<_>, _>>()?;

@@ -16,6 +16,10 @@ type R<T> = Result<T, ScenarioError>;
 /// How far (cells) a half ellipse's straight edge is carried past the surface it lies on.
 const OVERHANG_CELLS: f64 = 1.5;
 
+/// Most triangles a generated crack surface may have: counted before it is generated, so a
+/// spacing of a nanometre is refused at once rather than meshed for minutes.
+const MAX_TRIANGLES: f64 = 200_000.0;
+
 /// A crack surface: vertices, counterclockwise triangles (seen from above) and its front.
 #[derive(Debug, Clone)]
 pub(super) struct Surface {
@@ -52,15 +56,17 @@ pub(super) fn surface(src: &Source, c: usize, spec: &CrackSpec, cell: f64) -> R<
         (Some(m), None, None, None) => (mesh(src, c, m)?, "mesh"),
         (None, Some(r), None, None) => {
             let h = spacing(r.spacing, "rectangle.spacing")?;
-            (rectangle(src, c, r, h)?, "rectangle")
+            let k = key("rectangle.spacing");
+            (rectangle(src, c, r, h, &k)?, "rectangle")
         }
         (None, None, Some(e), None) => {
             let h = spacing(e.spacing, "ellipse.spacing")?;
-            (ellipse(src, c, e, h, OVERHANG_CELLS * cell)?, "ellipse")
+            let k = key("ellipse.spacing");
+            (ellipse(src, c, e, h, OVERHANG_CELLS * cell, &k)?, "ellipse")
         }
         (None, None, None, Some(p)) => {
             let h = spacing(p.spacing, "penny.spacing")?;
-            (penny(src, c, p, h)?, "penny")
+            (penny(src, c, p, h, &key("penny.spacing"))?, "penny")
         }
         _ => {
             return Err(src.error(
@@ -71,6 +77,24 @@ pub(super) fn surface(src: &Source, c: usize, spec: &CrackSpec, cell: f64) -> R<
     };
     check(src, &key(what), &surface)?;
     Ok(surface)
+}
+
+/// Refuses the spacing `h` (under `key`; by default half the cell) when it would cut a
+/// surface into more than [`MAX_TRIANGLES`] triangles, `triangles` being that count.
+fn not_too_fine(src: &Source, key: &str, h: f64, triangles: f64) -> R<()> {
+    if triangles <= MAX_TRIANGLES {
+        return Ok(());
+    }
+    // The count goes as 1 / h^2.
+    let least = h * (triangles / MAX_TRIANGLES).sqrt();
+    Err(src.error(
+        key,
+        format!(
+            "a spacing of {h:e} m (half the cell when not given) cuts this surface into \
+             {triangles:.3e} triangles, more than {MAX_TRIANGLES}: give a spacing of at \
+             least about {least:.3e} m"
+        ),
+    ))
 }
 
 fn point(src: &Source, key: &str, v: &[f64]) -> R<DVec3> {
@@ -127,11 +151,12 @@ fn mesh(src: &Source, c: usize, m: &MeshSpec) -> R<Surface> {
     })
 }
 
-fn rectangle(src: &Source, c: usize, r: &PlanarSpec, h: f64) -> R<Surface> {
+fn rectangle(src: &Source, c: usize, r: &PlanarSpec, h: f64, spacing: &str) -> R<Surface> {
     let centre = point(src, &format!("crack[{c}].rectangle.center"), &r.center)?;
     let (u, v) = axes(src, &format!("crack[{c}].rectangle.axes"), &r.axes)?;
-    let n = |a: DVec3| (2.0 * a.length() / h).ceil().clamp(1.0, 2000.0) as u32;
-    let (nu, nv) = (n(u), n(v));
+    let n = |a: DVec3| (2.0 * a.length() / h).ceil().max(1.0);
+    not_too_fine(src, spacing, h, 2.0 * n(u) * n(v))?;
+    let (nu, nv) = (n(u) as u32, n(v) as u32);
     let mut vertices = Vec::new();
     for j in 0..=nv {
         for i in 0..=nu {
@@ -158,7 +183,7 @@ fn rectangle(src: &Source, c: usize, r: &PlanarSpec, h: f64) -> R<Surface> {
     })
 }
 
-fn penny(src: &Source, c: usize, p: &PennySpec, h: f64) -> R<Surface> {
+fn penny(src: &Source, c: usize, p: &PennySpec, h: f64, spacing: &str) -> R<Surface> {
     let key = |k: &str| format!("crack[{c}].penny.{k}");
     let centre = point(src, &key("center"), &p.center)?;
     let n = point(src, &key("normal"), &p.normal)?;
@@ -167,13 +192,31 @@ fn penny(src: &Source, c: usize, p: &PennySpec, h: f64) -> R<Surface> {
     }
     let r = positive(src, &key("radius"), p.radius, "m")?;
     let (u, v) = n.normalize().any_orthonormal_pair();
+    not_too_fine(src, spacing, h, disc_triangles(r, h, false))?;
     Ok(disc(centre, u * r, v * r, h, None))
 }
 
-fn ellipse(src: &Source, c: usize, e: &EllipseSpec, h: f64, overhang: f64) -> R<Surface> {
+fn ellipse(
+    src: &Source,
+    c: usize,
+    e: &EllipseSpec,
+    h: f64,
+    overhang: f64,
+    spacing: &str,
+) -> R<Surface> {
     let centre = point(src, &format!("crack[{c}].ellipse.center"), &e.center)?;
     let (a, b) = axes(src, &format!("crack[{c}].ellipse.axes"), &e.axes)?;
+    let size = a.length().max(b.length());
+    not_too_fine(src, spacing, h, disc_triangles(size, h, e.half))?;
     Ok(disc(centre, a, b, h, e.half.then_some(overhang)))
+}
+
+/// How many triangles [`disc`] makes of an ellipse of larger semi-axis `size` at spacing
+/// `h`: 6 n^2 for n rings, 3 n^2 for a half (a bound).
+fn disc_triangles(size: f64, h: f64, half: bool) -> f64 {
+    let rings = (size / h).ceil().max(1.0);
+    let per = if half { 3.0 } else { 6.0 };
+    per * rings * rings
 }
 
 /// The ellipse `centre + a cos(t) + b sin(t)` meshed in rings of about `h` spacing (ring k
@@ -181,7 +224,7 @@ fn ellipse(src: &Source, c: usize, e: &EllipseSpec, h: f64, overhang: f64) -> R<
 /// `half = Some(overhang)` only the half with a positive `b` component, its straight edge
 /// carried `overhang` (m) past the centre line, the front the outer half ring.
 fn disc(centre: DVec3, a: DVec3, b: DVec3, h: f64, half: Option<f64>) -> Surface {
-    let rings = ((a.length().max(b.length()) / h).ceil() as usize).clamp(1, 1000);
+    let rings = ((a.length().max(b.length()) / h).ceil() as usize).max(1);
     let span = if half.is_some() { PI } else { 2.0 * PI };
     let at = |r: f64, t: f64| centre + a * (r * t.cos()) + b * (r * t.sin());
     let mut vertices = vec![centre];
