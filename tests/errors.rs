@@ -286,6 +286,16 @@ fn bad_cracks_name_the_key() {
         "[[crack]]\npoints = [[0.006, 0.006], [0.014, 0.014], [0.014, 0.006], [0.006, 0.014]]\n",
     );
     assert_error(&e, "crack[0].points", Some(19), "crosses itself");
+    // Folded back 1e-10 m above itself: nothing crosses, but the faces would overlap.
+    let e = error_with_text(
+        "[[crack]]\npoints = [[0.006, 0.01], [0.014, 0.01], [0.006, 0.0100000001]]\n",
+    );
+    assert_error(
+        &e,
+        "crack[0].points",
+        Some(19),
+        "folds back on itself at point 1",
+    );
     let e = error_with_text(
         "[[crack]]\npoints = [[0.006, 0.01], [0.012, 0.01]]\ntips = [\"middle\"]\n",
     );
@@ -489,6 +499,38 @@ fn bad_crack_surfaces_name_the_problem() {
     assert_error(&e, "crack[0].mesh", Some(19), "oriented oppositely");
     let e = mesh(square, "[0, 1, 1]");
     assert_error(&e, "crack[0].mesh", Some(19), "degenerate");
+    // A front must walk the boundary (0-1-2-3 around the square): a repeated vertex and a
+    // skipped one (1 then 3, across the diagonal) were accepted and measured as NaN.
+    let fronted = |front: &str| {
+        error_3d(&format!(
+            "[[crack]]\nmesh = {{ vertices = [{square}], triangles = [[0, 1, 2], [0, 2, 3]], \
+             front = [{front}] }}\n"
+        ))
+    };
+    let e = fronted("0, 1, 1, 2");
+    assert_error(
+        &e,
+        "crack[0].mesh",
+        Some(19),
+        "front vertex 1 is listed twice",
+    );
+    let e = fronted("1, 3, 0, 2");
+    assert_error(
+        &e,
+        "crack[0].mesh",
+        Some(19),
+        "front vertices 1 and 3 follow each other",
+    );
+    // Folded flat along the edge 1-2: the second triangle lies back over the first.
+    let folded = "[0.006, 0.006, 0.01], [0.014, 0.006, 0.01], [0.006, 0.014, 0.01], \
+                  [0.009, 0.009, 0.0101]";
+    let e = mesh(folded, "[0, 1, 2], [2, 1, 3]");
+    assert_error(
+        &e,
+        "crack[0].mesh",
+        Some(19),
+        "fold over each other along edge 1-2",
+    );
     let e = mesh(
         "[0.006, 0.006, 0.01], [0.01, 0.006, 0.01], [0.014, 0.006, 0.01]",
         "[0, 1, 2]",
@@ -880,27 +922,30 @@ fn crack_vertex_counts_are_bounded_and_checked_fast() {
             "more than 200000",
         );
     }
-    // 40,000 points along a fine zigzag inside the body, then a last segment turned back
-    // down across it: the first crossing in index order is with segment 39919, the first
-    // zigzag segment the new one passes below (every pair of segments is 8e9 tests).
+    // 40,000 points along a fine zigzag inside the body (1e-7 m high, so no fold), then a
+    // turn down and a last segment back up across it: that segment passes through the
+    // zigzag's band between x = 9.9995 and 10.0003 mm, segments 19997 to 20001, and the
+    // first crossing in index order is with segment 19998 (every pair of segments is 8e9
+    // tests).
     let mut pts: Vec<String> = (0..40_000)
         .map(|k| {
             let x = 0.006 + 0.008 * k as f64 / 40_000.0;
-            let y = 0.01 + if k % 2 == 0 { 0.0 } else { 1e-6 };
+            let y = 0.01 + if k % 2 == 0 { 0.0 } else { 1e-7 };
             format!("[{x:e}, {y:e}]")
         })
         .collect();
     let fine = format!("[[crack]]\npoints = [{}]\n", pts.join(", "));
     let src = Source::parse("bad.toml", &format!("{GOOD}{fine}"), &[]).unwrap();
     assert!(build::<D2>(&src).is_ok(), "a long fine crack is accepted");
-    pts.push("[0.00600005, 0.0095]".into());
+    pts.push("[0.014, 0.0095]".into());
+    pts.push("[0.0060005, 0.0105]".into());
     let crossed = format!("[[crack]]\npoints = [{}]\n", pts.join(", "));
     let e = error_with_text(&crossed);
     assert_error(
         &e,
         "crack[0].points",
         Some(19),
-        "crosses itself (segments 39919 and 39999)",
+        "crosses itself (segments 19998 and 40000)",
     );
 }
 

@@ -134,3 +134,8 @@ pub(super) fn material_named(
     (materials.iter().position(|m| m.name == name))
         .ok_or_else(|| src.error(key, format!("no [[material]] named `{name}`")))
 }
+
+/// Smallest angle (degrees) between two segments of a 2D crack at their shared point, or
+/// between two triangles of a 3D crack along their shared edge: a sharper fold lays the
+/// crack's faces over each other.
+pub(super) const MIN_FOLD_ANGLE: f64 = 30.0;

@@ -1,6 +1,6 @@
 //! Building the crack store from `[[crack]]` tables, with every check a crack needs.
 
-use super::check::{positive, to_vec, vec3};
+use super::check::{MIN_FOLD_ANGLE, positive, to_vec, vec3};
 use super::schema::{AlongSpec, CrackSpec, ExpectSpec, FractureSpec};
 use super::source::Source;
 use super::surface;
@@ -383,6 +383,21 @@ fn vertices<D: Dim>(
     for (j, w) in points.windows(2).enumerate() {
         if w[0] == w[1] {
             return Err(src.error(&key("points"), format!("points {j} and {} coincide", j + 1)));
+        }
+    }
+    for (j, w) in points.windows(3).enumerate() {
+        let (back, on) = (w[0] - w[1], w[2] - w[1]);
+        let cos = D::dot(back, on) / (D::dot(back, back) * D::dot(on, on)).sqrt();
+        if cos > MIN_FOLD_ANGLE.to_radians().cos() {
+            return Err(src.error(
+                &key("points"),
+                format!(
+                    "the crack folds back on itself at point {}: its segments there meet at \
+                     {:.1} degrees (less than {MIN_FOLD_ANGLE}), so its faces would overlap",
+                    j + 1,
+                    cos.clamp(-1.0, 1.0).acos().to_degrees()
+                ),
+            ));
         }
     }
     Ok(points)

@@ -2,13 +2,13 @@
 //! rectangles, ellipses (whole or half) and pennies, with the checks a crack surface needs
 //! (indices in range, no degenerate triangle, a manifold surface oriented one way).
 
-use super::check::{positive, vec3};
+use super::check::{MIN_FOLD_ANGLE, positive, vec3};
 use super::schema::{CrackSpec, EllipseSpec, MeshSpec, PennySpec, PlanarSpec};
 use super::source::Source;
 use crate::base::dim::D3;
 use crate::base::error::ScenarioError;
 use glam::DVec3;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::f64::consts::PI;
 
 type R<T> = Result<T, ScenarioError>;
@@ -317,7 +317,8 @@ fn disc(centre: DVec3, a: DVec3, b: DVec3, h: f64, half: Option<f64>) -> Surface
 }
 
 /// Degenerate triangles, edges shared by more than two triangles or by two of opposite
-/// orientation, and front vertices off the surface's boundary are errors.
+/// orientation, and a front that is not a walk along the surface's boundary (a vertex off
+/// it, listed twice, or two in a row that no boundary edge joins) are errors.
 fn check(src: &Source, key: &str, s: &Surface) -> R<()> {
     let scale = s
         .triangles
@@ -350,6 +351,7 @@ fn check(src: &Source, key: &str, s: &Surface) -> R<()> {
         }
     }
     let mut boundary = vec![false; s.vertices.len()];
+    let mut boundary_edges = HashSet::new();
     let mut sorted: Vec<_> = edges.into_iter().collect();
     sorted.sort_unstable_by_key(|e| e.0);
     for (e, uses) in sorted {
@@ -357,6 +359,7 @@ fn check(src: &Source, key: &str, s: &Surface) -> R<()> {
             [_] => {
                 boundary[e[0] as usize] = true;
                 boundary[e[1] as usize] = true;
+                boundary_edges.insert(e);
             }
             [(t1, d1), (t2, d2)] if d1 == d2 => {
                 return Err(src.error(
@@ -369,7 +372,27 @@ fn check(src: &Source, key: &str, s: &Surface) -> R<()> {
                     ),
                 ));
             }
-            [_, _] => {}
+            [(t1, _), (t2, _)] => {
+                // Consistently oriented, the two normals point to one side: opposite normals
+                // are a surface folded flat over itself along this edge.
+                let normal = |t: usize| {
+                    let [a, b, c] = s.triangles[t].map(|i| s.vertices[i as usize]);
+                    (b - a).cross(c - a).normalize()
+                };
+                let cos = normal(t1).dot(normal(t2));
+                if cos < -MIN_FOLD_ANGLE.to_radians().cos() {
+                    return Err(src.error(
+                        key,
+                        format!(
+                            "triangles {t1} and {t2} fold over each other along edge {}-{}: \
+                             they meet at {:.1} degrees (less than {MIN_FOLD_ANGLE})",
+                            e[0],
+                            e[1],
+                            180.0 - cos.clamp(-1.0, 1.0).acos().to_degrees()
+                        ),
+                    ));
+                }
+            }
             _ => {
                 return Err(src.error(
                     key,
@@ -388,6 +411,33 @@ fn check(src: &Source, key: &str, s: &Surface) -> R<()> {
             key,
             format!("front vertex {v} is not on the surface's boundary"),
         ));
+    }
+    check_front_walk(src, key, &s.front, &boundary_edges)
+}
+
+/// The front must walk the boundary: each vertex once, each one joined to the next by a
+/// boundary edge (a repeated or skipped vertex gave a front frame of NaN).
+fn check_front_walk(
+    src: &Source,
+    key: &str,
+    front: &[u32],
+    boundary_edges: &HashSet<[u32; 2]>,
+) -> R<()> {
+    let mut seen = HashSet::new();
+    if let Some(&v) = front.iter().find(|&&v| !seen.insert(v)) {
+        return Err(src.error(key, format!("front vertex {v} is listed twice")));
+    }
+    for w in front.windows(2) {
+        let (p, q) = (w[0], w[1]);
+        if !boundary_edges.contains(&[p.min(q), p.max(q)]) {
+            return Err(src.error(
+                key,
+                format!(
+                    "front vertices {p} and {q} follow each other but no boundary edge joins \
+                     them: list the front in order along the surface's boundary"
+                ),
+            ));
+        }
     }
     Ok(())
 }
