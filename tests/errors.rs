@@ -92,6 +92,32 @@ fn missing_material() {
 fn body_outside_the_grid() {
     let e = error_with(&["body[0].box.max=[0.03, 0.016]"]);
     assert_error(&e, "body[0]", None, "beyond the grid");
+    // A 2 m box in a 20 mm grid was cut to the grid in silence: both boxes are named.
+    let e = error_with(&["body[0].box.min=[-1.0, -1.0]", "body[0].box.max=[1.0, 1.0]"]);
+    assert_error(
+        &e,
+        "body[0]",
+        None,
+        "the body spans (-1.0000e0, -1.0000e0) to",
+    );
+    assert!(
+        e.to_string()
+            .contains("the grid (0.0000e0, 0.0000e0) to (2.0000e-2, 2.0000e-2) m"),
+        "{e}"
+    );
+    // A body the grid would cut is accepted when its clip or a hole keeps it inside.
+    let builds = |set: &[&str]| {
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        build::<D2>(&Source::parse("inside.toml", GOOD, &set).expect("parses")).is_ok()
+    };
+    assert!(builds(&[
+        "body[0].box.max=[0.03, 0.016]",
+        "body[0].clip={ min = [0.0, 0.0], max = [0.016, 0.016] }"
+    ]));
+    assert!(builds(&[
+        "body[0].box.max=[0.021, 0.016]",
+        "body[0].holes=[{ center = [0.021, 0.01], radius = 0.008 }]"
+    ]));
 }
 
 #[test]

@@ -168,14 +168,77 @@ pub fn fill(
     ppc: usize,
 ) -> Vec<[f64; 3]> {
     let (lo, hi) = geom.bounds();
-    let mut range = [(0usize, 1usize); 3];
+    let mut range = [(0i64, 1i64); 3];
     for a in 0..dims {
-        let first = ((lo[a] - origin[a]) / h[a]).floor().max(0.0) as usize;
-        let last = (((hi[a] - origin[a]) / h[a]).ceil().max(0.0) as usize).min(cells[a]);
+        let first = ((lo[a] - origin[a]) / h[a]).floor().max(0.0) as i64;
+        let last = (((hi[a] - origin[a]) / h[a]).ceil().max(0.0) as i64).min(cells[a] as i64);
         range[a] = (first.min(last), last);
     }
-    let sub = |a: usize| if a < dims { ppc } else { 1 };
     let mut out = Vec::new();
+    lattice(range, dims, origin, h, ppc, |x| {
+        if geom.contains(x) {
+            out.push(x);
+        }
+        false
+    });
+    out
+}
+
+/// The first point of the particle lattice in `geom` that `keep` accepts in the layer of
+/// cells just outside the grid (index -1 or `cells` on some axis), where the grid would
+/// cut the body; None when the body stays inside.
+pub fn first_outside(
+    geom: &Solid,
+    dims: usize,
+    origin: [f64; 3],
+    h: [f64; 3],
+    cells: [usize; 3],
+    ppc: usize,
+    keep: impl Fn([f64; 3]) -> bool,
+) -> Option<[f64; 3]> {
+    let (lo, hi) = geom.bounds();
+    let mut range = [(0i64, 1i64); 3];
+    for a in 0..dims {
+        let n = cells[a] as i64;
+        let first = (((lo[a] - origin[a]) / h[a]).floor().max(-1.0) as i64).min(n + 1);
+        let last = (((hi[a] - origin[a]) / h[a]).ceil().min(n as f64 + 1.0) as i64).max(-1);
+        range[a] = (first.min(last), last);
+    }
+    // The layer's slabs, one per axis and side that the body's box reaches.
+    let mut found = None;
+    for a in 0..dims {
+        for edge in [-1, cells[a] as i64] {
+            if !(range[a].0..range[a].1).contains(&edge) {
+                continue;
+            }
+            let mut slab = range;
+            slab[a] = (edge, edge + 1);
+            lattice(slab, dims, origin, h, ppc, |x| {
+                if geom.contains(x) && keep(x) {
+                    found = Some(x);
+                }
+                found.is_some()
+            });
+            if found.is_some() {
+                return found;
+            }
+        }
+    }
+    None
+}
+
+/// Visits the sub-cell centres (`ppc` per cell per axis) of the cells in `range` (cell
+/// indices per axis, end exclusive, negative for cells before the grid's origin) in
+/// order; stops when `visit` returns true.
+fn lattice(
+    range: [(i64, i64); 3],
+    dims: usize,
+    origin: [f64; 3],
+    h: [f64; 3],
+    ppc: usize,
+    mut visit: impl FnMut([f64; 3]) -> bool,
+) {
+    let sub = |a: usize| if a < dims { ppc } else { 1 };
     for k in range[2].0..range[2].1 {
         for j in range[1].0..range[1].1 {
             for i in range[0].0..range[0].1 {
@@ -189,8 +252,8 @@ pub fn fill(
                                 x[a] = origin[a]
                                     + (cell[a] as f64 + (s[a] as f64 + 0.5) / ppc as f64) * h[a];
                             }
-                            if geom.contains(x) {
-                                out.push(x);
+                            if visit(x) {
+                                return;
                             }
                         }
                     }
@@ -198,7 +261,6 @@ pub fn fill(
             }
         }
     }
-    out
 }
 
 #[cfg(test)]

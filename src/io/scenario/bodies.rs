@@ -7,7 +7,7 @@ use super::grid::GridPlan;
 use super::schema::{BodySpec, RoundSpec};
 use super::source::Source;
 use crate::base::dim::Dim;
-use crate::physics::bodies::{Solid, fill};
+use crate::physics::bodies::{Solid, fill, first_outside};
 use crate::physics::material::Material;
 use crate::physics::shape::ShapeKind;
 use crate::store::grid::GridGeom;
@@ -244,14 +244,10 @@ fn add_body<D: Dim>(
             "body would need more than 2e8 particles",
         ));
     }
-    let mut pts = fill(&g, D::D, origin, h, geom.cells, body.ppc);
     let clip = match &body.clip {
         Some(clip) => Some(super::region::region::<D>(src, &key("clip"), clip)?),
         None => None,
     };
-    if let Some(clip) = &clip {
-        pts.retain(|x| clip.contains(*x, D::D, 0.0));
-    }
     let mut holes = Vec::new();
     for (k, hole) in body.holes.iter().enumerate() {
         let key = key(&format!("holes[{k}]"));
@@ -263,9 +259,37 @@ fn add_body<D: Dim>(
                 "`inner_radius` does not apply to a hole",
             ));
         }
-        pts.retain(|x| (0..D::D).map(|a| (x[a] - center[a]).powi(2)).sum::<f64>() >= r * r);
         holes.push((center, r));
     }
+    // What the clip and the holes leave of the body's shape.
+    let kept = |x: &[f64; 3]| {
+        clip.as_ref().is_none_or(|c| c.contains(*x, D::D, 0.0))
+            && (holes.iter())
+                .all(|(c, r)| (0..D::D).map(|a| (x[a] - c[a]).powi(2)).sum::<f64>() >= r * r)
+    };
+    let cells = geom.cells;
+    if let Some(x) = first_outside(&g, D::D, origin, h, cells, body.ppc, |x| kept(&x)) {
+        let grid_hi = [0, 1, 2].map(|a| origin[a] + cells[a] as f64 * h[a]);
+        let at = |p: [f64; 3]| {
+            let c: Vec<String> = p[..D::D].iter().map(|c| format!("{c:.4e}")).collect();
+            format!("({})", c.join(", "))
+        };
+        return Err(src.error(
+            &format!("body[{b}]"),
+            format!(
+                "the body reaches beyond the grid, which would cut it: the body spans {} to {} \
+                 m, the grid {} to {} m (the body's point {} m lies outside); enlarge the grid \
+                 or clip the body with `clip`",
+                at(lo),
+                at(hi),
+                at(origin),
+                at(grid_hi),
+                at(x)
+            ),
+        ));
+    }
+    let mut pts = fill(&g, D::D, origin, h, cells, body.ppc);
+    pts.retain(kept);
     let earlier: Vec<&Claim> = (claims.iter())
         .filter(|c| c.reaches((lo, hi), D::D))
         .collect();

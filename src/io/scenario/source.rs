@@ -277,13 +277,16 @@ fn apply_overrides(file: &str, text: &str, overrides: &[String]) -> Result<Strin
                     .ok_or_else(|| fail(arg, format!("no element [{i}]")))?,
             };
         }
+        let path = path.trim();
         match last {
             PathPart::Key(k) => {
                 let table = item
                     .as_table_like_mut()
                     .ok_or_else(|| fail(arg, format!("cannot set `{k}`: parent is not a table")))?;
                 match table.get_mut(k) {
-                    Some(slot) => *slot = Item::Value(value.decorated(" ", "")),
+                    Some(slot) => {
+                        replace(slot, value.decorated(" ", ""), path).map_err(|m| fail(arg, m))?
+                    }
                     None => {
                         table.insert(k, Item::Value(value));
                     }
@@ -293,11 +296,32 @@ fn apply_overrides(file: &str, text: &str, overrides: &[String]) -> Result<Strin
                 let slot = item
                     .get_mut(*i)
                     .ok_or_else(|| fail(arg, format!("no element [{i}]")))?;
-                *slot = Item::Value(value);
+                replace(slot, value, path).map_err(|m| fail(arg, m))?;
             }
         }
     }
     Ok(doc.to_string())
+}
+
+/// Puts `value` in `slot` (the item at `path`): a table only by a table (an inline
+/// `{ ... }`), so that `--set material[0]=5` is refused rather than dropping the table.
+fn replace(slot: &mut Item, value: toml_edit::Value, path: &str) -> Result<(), String> {
+    match (&*slot, value) {
+        (Item::Table(_), toml_edit::Value::InlineTable(t)) => *slot = Item::Table(t.into_table()),
+        (Item::Table(_), _) => {
+            return Err(format!(
+                "`{path}` is a table: give a whole table `{{ key = value, ... }}` or set one of \
+                 its keys (`{path}.key=value`)"
+            ));
+        }
+        (Item::ArrayOfTables(_), _) => {
+            return Err(format!(
+                "`{path}` is a list of tables: set a key of one of them (`{path}[0].key=value`)"
+            ));
+        }
+        (_, value) => *slot = Item::Value(value),
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -317,5 +341,24 @@ mod tests {
         assert!(out.contains("E = 3e9"), "{out}");
         assert_eq!(find_line(&out, "material[0].E"), Some(6));
         assert_eq!(find_line(&out, "simulation.duration"), Some(2));
+    }
+
+    /// A table is replaced only by a table: `material[0]=5` dropped the material in
+    /// silence, and the error that followed named a missing material.
+    #[test]
+    fn set_refuses_a_value_in_place_of_a_table() {
+        let text = "[simulation]\nduration = 1.0\n\n[[material]]\nname = \"a\"\nE = 1.0\n";
+        let set = |arg: &str| apply_overrides("f.toml", text, &[arg.to_string()]);
+        let e = set("material[0]=5").unwrap_err().to_string();
+        assert!(e.contains("`material[0]` is a table"), "{e}");
+        let e = set("simulation=2").unwrap_err().to_string();
+        assert!(e.contains("`simulation` is a table"), "{e}");
+        let e = set("material=1").unwrap_err().to_string();
+        assert!(e.contains("`material` is a list of tables"), "{e}");
+        let out = set("material[0]={ name = \"b\", E = 2.0 }").unwrap();
+        assert!(
+            out.contains("name = \"b\"") && !out.contains("name = \"a\""),
+            "{out}"
+        );
     }
 }
