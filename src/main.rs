@@ -8,7 +8,7 @@ use fissure::app::sweep::{Vary, sweep};
 use fissure::base::dim::{D2, D3};
 use fissure::base::error::{ScenarioError, UsageError};
 use fissure::io::output::summary::{Status, Summary};
-use fissure::io::scenario::{Source, build};
+use fissure::io::scenario::{Source, build, folder_name_problem};
 use fissure::io::snapshot::{Reader, SnapshotError};
 use fissure::pipeline::schedule::Schedule;
 use fissure::record::expect::ExpectResult;
@@ -403,7 +403,20 @@ fn default_out(path: &Path) -> anyhow::Result<PathBuf> {
         .filter(|d| d.file_name() == Some("snapshots".as_ref()));
     match dir.and_then(|d| d.parent()) {
         Some(run) => Ok(run.to_path_buf()),
-        None => Ok(PathBuf::from("out").join(Reader::open(&file)?.header.scenario)),
+        None => {
+            // The name comes from the file: a damaged or crafted one must not lead out of out/.
+            let name = Reader::open(&file)?.header.scenario;
+            match folder_name_problem(&name) {
+                Some(why) => Err(UsageError(format!(
+                    "{}: the snapshot is not in a run's snapshots/ folder, and its scenario name \
+                     `{}` cannot name an output folder (it {why}): give --out DIR",
+                    file.display(),
+                    name.escape_debug()
+                ))
+                .into()),
+                None => Ok(PathBuf::from("out").join(name)),
+            }
+        }
     }
 }
 

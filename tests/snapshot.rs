@@ -803,3 +803,35 @@ fn two_signals_end_the_run_with_an_interrupted_summary() {
     );
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// A snapshot copied out of its run's snapshots/ folder resumes into out/<its scenario
+/// name>; a name that cannot be a folder there (here a path separator, in a header with
+/// its checksum made good) is refused with exit code 2 before anything is written.
+#[test]
+fn a_copied_snapshot_with_a_bad_name_is_refused() {
+    let (_, bytes) = sample();
+    let mut bytes = bytes.clone();
+    let head_len = u64::from_le_bytes(bytes[12..20].try_into().unwrap()) as usize;
+    let at = (20..20 + head_len)
+        .find(|&i| bytes[i..].starts_with(b"\x04test"))
+        .expect("the header names the scenario `test`");
+    bytes[at + 1..at + 5].copy_from_slice(b"a/..");
+    let sum = xxhash_rust::xxh3::xxh3_64(&bytes[..20 + head_len]);
+    let n = bytes.len();
+    bytes[n - 8..].copy_from_slice(&sum.to_le_bytes());
+    let dir = scratch("copied");
+    std::fs::write(dir.join("copied.fsnap"), &bytes).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+        .args(["resume", "copied.fsnap"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("`a/..` cannot name an output folder") && text.contains("--out"),
+        "{text}"
+    );
+    assert!(!dir.join("out").exists(), "nothing written");
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -74,24 +74,29 @@ pub(super) fn box_corners<D: Dim>(src: &Source, key: &str, b: &BoxSpec) -> R<([f
 /// `-sweep` under the 255 bytes a file name may have.
 const MAX_NAME: usize = 200;
 
+/// Why `name` cannot name an output folder under the output directory (empty, too long,
+/// a path separator, `.` or `..`, control characters), or None when it can.
+pub fn folder_name_problem(name: &str) -> Option<String> {
+    if name.is_empty() {
+        Some("must not be empty".into())
+    } else if name.len() > MAX_NAME {
+        Some(format!("must be at most {MAX_NAME} bytes long"))
+    } else if name.contains(['/', '\\']) {
+        Some("must not contain a path separator".into())
+    } else if name == "." || name == ".." {
+        Some("must not be `.` or `..`".into())
+    } else if name.chars().any(char::is_control) {
+        Some("must not contain control characters".into())
+    } else {
+        None
+    }
+}
+
 /// A scenario name (its `name`, else its file's stem) becomes the output folder's name: it
 /// must be one plain path component.
 pub(super) fn check_name(src: &Source) -> R<()> {
     let name = src.name();
-    let long = format!("must be at most {MAX_NAME} bytes long");
-    let bad = if name.is_empty() {
-        Some("must not be empty")
-    } else if name.len() > MAX_NAME {
-        Some(long.as_str())
-    } else if name.contains(['/', '\\']) {
-        Some("must not contain a path separator")
-    } else if name == "." || name == ".." {
-        Some("must not be `.` or `..`")
-    } else if name.chars().any(char::is_control) {
-        Some("must not contain control characters")
-    } else {
-        None
-    };
+    let bad = folder_name_problem(&name);
     let what = match src.scenario.name {
         Some(_) => "the name".to_string(),
         None => format!(

@@ -25,6 +25,7 @@ mod surface;
 mod traction;
 
 pub use build::{Scene, build};
+pub use check::folder_name_problem;
 pub use output::{CheckpointPlan, OutputPlan};
 pub use settings::MAX_STEPS;
 pub use source::Source;
