@@ -181,10 +181,25 @@ fn a_scene_too_large_for_memory_is_refused_at_once() {
     }
 }
 
-/// A body with no particle, also once clipped, and a tube or ring whose hole is not inside
-/// it.
+/// No body, a body with no particle, also once clipped, and a tube or ring whose hole is
+/// not inside it.
 #[test]
 fn empty_body() {
+    // No [[body]] at all: the file's last line, where one would go, is named.
+    let text = GOOD.split("[[body]]").next().unwrap();
+    let e = match Source::parse("bad.toml", text, &[]) {
+        Err(e) => e,
+        Ok(src) => match build::<D2>(&src) {
+            Ok(_) => panic!("a scenario without a body must be refused"),
+            Err(e) => e,
+        },
+    };
+    assert_error(
+        &e,
+        "body",
+        Some(text.lines().count()),
+        "has no [[body]]: add one",
+    );
     let e = error_with(&["body[0].box.max=[0.0045, 0.0045]"]);
     assert_error(&e, "body[0]", None, "no particle");
     let e = error_with(&["body[0].clip={ point = [0.0, 0.017], normal = [0.0, 1.0] }"]);

@@ -43,7 +43,11 @@ pub(super) fn bodies<D: Dim>(
     let sc = &src.scenario;
     let geom = &grid.geom;
     if sc.bodies.is_empty() {
-        return Err(src.error("body", "the scenario has no [[body]]"));
+        return Err(src.missing(
+            "body",
+            "the scenario has no [[body]]: add one after the last line (a `material` and a \
+             geometry such as `box = { min, max }`)",
+        ));
     }
     let h = D::to_xyz(geom.h);
     let mut most = 0.0;

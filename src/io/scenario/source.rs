@@ -98,6 +98,17 @@ impl Source {
         })
     }
 
+    /// An error about a table the file lacks: it names the file's last line, where the
+    /// table would go.
+    pub fn missing(&self, key: &str, message: impl Into<String>) -> ScenarioError {
+        ScenarioError {
+            file: self.file.clone(),
+            line: Some(self.text.lines().count().max(1)),
+            key: Some(key.to_string()),
+            message: message.into(),
+        }
+    }
+
     /// An error about `key` (dotted path with `[i]` indices), located on its line, or said
     /// to come from the `--set` that gave its value.
     pub fn error(&self, key: &str, message: impl Into<String>) -> ScenarioError {
