@@ -37,6 +37,10 @@ fn touches<D: Dim>(va: &[D::Vec], a: &D::Elem, vb: &[D::Vec], b: D::Elem, tol: f
         })
 }
 
+/// An element of a crack in the store near a new crack: its box, its index within its
+/// crack, and the element.
+type Near<D> = (Aabb<<D as Dim>::Vec>, usize, <D as Dim>::Elem);
+
 /// The first crack of `store` that the new crack of `points` and `elems` meets (crosses,
 /// or comes within `tol` m of), with the indices of the two elements that meet (the new
 /// crack's, then the other's within its crack), in index order.
@@ -49,15 +53,25 @@ pub(super) fn meets<D: Dim>(
     let topo = &store.topology;
     let vx = &store.geometry.x;
     let mine: Vec<Aabb<D::Vec>> = elems.iter().map(|e| e.bounds(points)).collect();
-    for c in 0..topo.cracks().len() {
+    let reach = mine.iter().copied().reduce(|a, b| a.union(&b))?.grown(tol);
+    // One pass over the store: the elements whose boxes reach the new crack's, by crack,
+    // each with its index within its crack (a pass per crack made `check` of thousands of
+    // cracks take minutes).
+    let mut near: Vec<Vec<Near<D>>> = vec![Vec::new(); topo.cracks().len()];
+    let mut count = vec![0usize; topo.cracks().len()];
+    for (e, &k) in topo.elems().iter().zip(topo.elem_crack()) {
+        let (k, b) = (k as usize, e.bounds(vx));
+        if b.overlaps(&reach) {
+            near[k].push((b, count[k], *e));
+        }
+        count[k] += 1;
+    }
+    for (c, theirs) in near.iter().enumerate() {
+        if theirs.is_empty() {
+            continue;
+        }
         // The other crack's elements sorted by the low x of their boxes, so that only those
         // whose box can reach a new element's are tried.
-        let theirs: Vec<(Aabb<D::Vec>, usize, D::Elem)> = (topo.elems().iter())
-            .zip(topo.elem_crack())
-            .filter(|(_, k)| **k as usize == c)
-            .enumerate()
-            .map(|(i, (e, _))| (e.bounds(vx), i, *e))
-            .collect();
         let widest = theirs
             .iter()
             .map(|(b, _, _)| b.hi[0] - b.lo[0])
