@@ -4,7 +4,7 @@ use clap::{Parser, Subcommand};
 use fissure::app::run::checkpoint::resolve;
 use fissure::app::run::stop::StopRequests;
 use fissure::app::run::{Outcome, RunOptions, resume, run};
-use fissure::app::sweep::{Vary, sweep};
+use fissure::app::sweep::{Swept, Vary, sweep};
 use fissure::base::dim::{D2, D3};
 use fissure::base::error::{ScenarioError, UsageError};
 use fissure::io::output::summary::{Status, Summary};
@@ -15,7 +15,7 @@ use fissure::record::expect::ExpectResult;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Dynamic fracture with the material point method.
@@ -167,7 +167,21 @@ fn cmd_sweep(
             .map_or("scenario".into(), |s| s.to_string_lossy());
         PathBuf::from("out").join(format!("{stem}-sweep"))
     });
-    let done = sweep(scenario, &vary, threads, &out, yes, |r| {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    let installed = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::SeqCst) {
+            std::process::exit(i32::from(INTERRUPTED));
+        }
+        eprintln!(
+            "\nstopping the sweep: the run under way stops at its next step and leaves no row \
+             (signal again to abort at once)"
+        );
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: no clean stop on Ctrl-C: {e}");
+    }
+    let done = sweep(scenario, &vary, threads, &out, yes, Some(stop), |r| {
         let (k, n) = r.index;
         let what = r.set.join(" ");
         match (r.summary, &r.error) {
@@ -189,9 +203,17 @@ fn cmd_sweep(
         }
     });
     match done {
-        Ok(()) => {
+        Ok(Swept::Complete) => {
             println!("sweep.csv in {}", out.display());
             ExitCode::SUCCESS
+        }
+        Ok(Swept::Stopped) => {
+            eprintln!(
+                "sweep stopped: the finished runs are in {}; sweep again with the same --vary \
+                 to run the rest",
+                out.join("sweep.csv").display()
+            );
+            ExitCode::from(INTERRUPTED)
         }
         Err(e) => report(e),
     }

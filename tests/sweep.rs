@@ -4,7 +4,7 @@
 
 mod common;
 
-use fissure::app::sweep::{Vary, sweep};
+use fissure::app::sweep::{Swept, Vary, sweep};
 use std::path::{Path, PathBuf};
 
 /// A fresh folder under the system temp folder, and a scenario file in it: the block of
@@ -33,10 +33,11 @@ fn vary(args: &[&str]) -> Vec<Vary> {
 /// Runs the sweep, returning the progress lines (index and whether it ran).
 fn go(file: &Path, v: &[Vary], out: &Path) -> Vec<(usize, bool)> {
     let mut seen = Vec::new();
-    sweep(file, v, 1, out, false, |r| {
+    let swept = sweep(file, v, 1, out, false, None, |r| {
         seen.push((r.index.0, r.summary.is_some()))
     })
     .unwrap_or_else(|e| panic!("{e:#}"));
+    assert_eq!(swept, Swept::Complete);
     seen
 }
 
@@ -95,6 +96,31 @@ fn every_combination_runs_once_and_a_stopped_sweep_resumes() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// A stop asked for while a sweep runs (here as its first run reports) ends it after that
+/// run: sweep.csv holds the header and that run's row, whole; the next run, which sees the
+/// stop at its start, leaves none; sweeping again runs only what is missing.
+#[test]
+fn a_stopped_sweep_keeps_whole_rows_and_resumes() {
+    let (dir, file) = setup("stop");
+    let out = dir.join("out");
+    let v = vary(&["simulation.shape=linear,ugimp,bspline"]);
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let flag = stop.clone();
+    let mut ran = Vec::new();
+    let swept = sweep(&file, &v, 1, &out, false, Some(stop), |r| {
+        ran.push(r.index.0);
+        flag.store(true, std::sync::atomic::Ordering::SeqCst);
+    })
+    .unwrap();
+    assert_eq!((swept, ran), (Swept::Stopped, vec![1]));
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 2, "{csv}");
+    assert!(csv.ends_with('\n') && csv.lines().nth(1).unwrap().starts_with("linear,completed"));
+    let seen = go(&file, &v, &out);
+    assert_eq!(seen, vec![(1, false), (2, true), (3, true)]);
+    std::fs::remove_dir_all(dir).ok();
+}
+
 /// A bad key or value is named before any run (no sweep.csv), as are a repeated key, a
 /// sweep of more than 1,000 runs without `yes` and one past 10,000 runs even with it; a
 /// malformed --vary is refused.
@@ -103,7 +129,7 @@ fn bad_sweeps_are_refused_before_the_first_run() {
     let (dir, file) = setup("bad");
     let out = dir.join("out");
     let refused = |v: &[Vary], yes: bool| -> String {
-        let e = sweep(&file, v, 1, &out, yes, |_| panic!("no run may start"))
+        let e = sweep(&file, v, 1, &out, yes, None, |_| panic!("no run may start"))
             .expect_err("must be refused");
         assert!(!out.join("sweep.csv").exists());
         format!("{e:#}")

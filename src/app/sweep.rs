@@ -6,11 +6,24 @@
 use crate::app::run::{RunOptions, run};
 use crate::base::error::UsageError;
 use crate::io::output::plot::{self, Series};
+use crate::io::output::summary::Status;
 use crate::io::output::summary::Summary;
 use crate::io::scenario::Source;
 use anyhow::Context;
 use std::io::Write;
 use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// How a sweep ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Swept {
+    /// Every combination has its row in sweep.csv.
+    Complete,
+    /// A stop was asked for: the rows of the runs that finished are in sweep.csv, the run
+    /// that was stopped has none, and sweeping again runs what is missing.
+    Stopped,
+}
 
 /// Most runs a sweep makes without being told `--yes`.
 pub const MAX_RUNS: usize = 1000;
@@ -248,15 +261,17 @@ pub struct Ran<'a> {
 /// Runs `file` over every combination of `vary` on `threads` threads, appending a row per
 /// run to `<out>/sweep.csv` and telling `progress` about each. Every combination is loaded
 /// (so a bad key or value is refused) before the first run; more than [`MAX_RUNS`] runs
-/// need `yes`.
+/// need `yes`. Setting `stop` stops the run under way at its next step and the sweep after
+/// it, that run leaving no row.
 pub fn sweep(
     file: &Path,
     vary: &[Vary],
     threads: usize,
     out: &Path,
     yes: bool,
+    stop: Option<Arc<AtomicBool>>,
     mut progress: impl FnMut(&Ran),
-) -> anyhow::Result<()> {
+) -> anyhow::Result<Swept> {
     if vary.is_empty() {
         return Err(UsageError("give at least one --vary KEY=V1,V2,...".into()).into());
     }
@@ -321,7 +336,13 @@ pub fn sweep(
         writeln!(file, "{head}").map_err(named)?;
     }
     let n = combos.len();
+    let stopped = || stop.as_ref().is_some_and(|s| s.load(Ordering::SeqCst));
+    let mut swept = Swept::Complete;
     for (k, (set, src)) in combos.iter().zip(sources).enumerate() {
+        if stopped() {
+            swept = Swept::Stopped;
+            break;
+        }
         let values: Vec<String> = (set.iter())
             .map(|a| a.split_once('=').map_or("", |(_, v)| v).to_string())
             .collect();
@@ -337,11 +358,18 @@ pub fn sweep(
         }
         let opts = RunOptions {
             threads,
+            stop: stop.clone(),
             ..RunOptions::default()
         };
         match run(&src, &opts) {
+            Ok(o) if o.summary.status == Status::Interrupted => {
+                swept = Swept::Stopped;
+                break;
+            }
             Ok(o) => {
-                writeln!(file, "{}", row(&values, &o.summary)).map_err(named)?;
+                // One write per row, so that a kill leaves whole lines.
+                let line = format!("{}\n", row(&values, &o.summary));
+                file.write_all(line.as_bytes()).map_err(named)?;
                 progress(&Ran {
                     index,
                     set,
@@ -355,7 +383,8 @@ pub fn sweep(
                 } else {
                     "error"
                 };
-                writeln!(file, "{}", failed_row(&values, status, expects.len())).map_err(named)?;
+                let line = format!("{}\n", failed_row(&values, status, expects.len()));
+                file.write_all(line.as_bytes()).map_err(named)?;
                 progress(&Ran {
                     index,
                     set,
@@ -366,7 +395,8 @@ pub fn sweep(
         }
         file.flush().map_err(named)?;
     }
-    plots(&csv, vary, &expects, out)
+    plots(&csv, vary, &expects, out)?;
+    Ok(swept)
 }
 
 /// sweep_<k>.png for expect k: its error against wall time on log-log axes, every row of
