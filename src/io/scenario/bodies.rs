@@ -210,6 +210,59 @@ fn hole(src: &Source, key: &str, round: &RoundSpec) -> R<f64> {
     }
 }
 
+/// The round holes of body `b`: centre and radius (m).
+fn holes<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Vec<([f64; 3], f64)>> {
+    let mut holes = Vec::new();
+    for (k, hole) in body.holes.iter().enumerate() {
+        let key = format!("body[{b}].holes[{k}]");
+        let center = vec3::<D>(src, &format!("{key}.center"), &hole.center)?;
+        let r = positive(src, &format!("{key}.radius"), hole.radius, "m")?;
+        if hole.inner_radius != 0.0 {
+            return Err(src.error(
+                &format!("{key}.inner_radius"),
+                "`inner_radius` does not apply to a hole",
+            ));
+        }
+        holes.push((center, r));
+    }
+    Ok(holes)
+}
+
+/// Refuses body `b` (shape `g`, what `kept` accepts of it) when the grid would cut it,
+/// naming both boxes and a point of the body outside the grid.
+fn inside_grid<D: Dim>(
+    src: &Source,
+    b: usize,
+    g: &Solid,
+    geom: &GridGeom<D>,
+    ppc: usize,
+    kept: impl Fn([f64; 3]) -> bool,
+) -> R<()> {
+    let (origin, h, cells) = (D::to_xyz(geom.origin), D::to_xyz(geom.h), geom.cells);
+    let Some(x) = first_outside(g, D::D, origin, h, cells, ppc, kept) else {
+        return Ok(());
+    };
+    let (lo, hi) = g.bounds();
+    let grid_hi = [0, 1, 2].map(|a| origin[a] + cells[a] as f64 * h[a]);
+    let at = |p: [f64; 3]| {
+        let c: Vec<String> = p[..D::D].iter().map(|c| format!("{c:.4e}")).collect();
+        format!("({})", c.join(", "))
+    };
+    Err(src.error(
+        &format!("body[{b}]"),
+        format!(
+            "the body reaches beyond the grid, which would cut it: the body spans {} to {} m, \
+             the grid {} to {} m (the body's point {} m lies outside); enlarge the grid or \
+             clip the body with `clip`",
+            at(lo),
+            at(hi),
+            at(origin),
+            at(grid_hi),
+            at(x)
+        ),
+    ))
+}
+
 /// Fills body `b` with particles, less the points of the bodies before it (`claims`, to
 /// which it adds its own), and appends them to the store.
 #[allow(clippy::too_many_arguments)]
@@ -252,19 +305,7 @@ fn add_body<D: Dim>(
         Some(clip) => Some(super::region::region::<D>(src, &key("clip"), clip)?),
         None => None,
     };
-    let mut holes = Vec::new();
-    for (k, hole) in body.holes.iter().enumerate() {
-        let key = key(&format!("holes[{k}]"));
-        let center = vec3::<D>(src, &format!("{key}.center"), &hole.center)?;
-        let r = positive(src, &format!("{key}.radius"), hole.radius, "m")?;
-        if hole.inner_radius != 0.0 {
-            return Err(src.error(
-                &format!("{key}.inner_radius"),
-                "`inner_radius` does not apply to a hole",
-            ));
-        }
-        holes.push((center, r));
-    }
+    let holes = holes::<D>(src, b, body)?;
     // What the clip and the holes leave of the body's shape.
     let kept = |x: &[f64; 3]| {
         clip.as_ref().is_none_or(|c| c.contains(*x, D::D, 0.0))
@@ -272,26 +313,7 @@ fn add_body<D: Dim>(
                 .all(|(c, r)| (0..D::D).map(|a| (x[a] - c[a]).powi(2)).sum::<f64>() >= r * r)
     };
     let cells = geom.cells;
-    if let Some(x) = first_outside(&g, D::D, origin, h, cells, body.ppc, |x| kept(&x)) {
-        let grid_hi = [0, 1, 2].map(|a| origin[a] + cells[a] as f64 * h[a]);
-        let at = |p: [f64; 3]| {
-            let c: Vec<String> = p[..D::D].iter().map(|c| format!("{c:.4e}")).collect();
-            format!("({})", c.join(", "))
-        };
-        return Err(src.error(
-            &format!("body[{b}]"),
-            format!(
-                "the body reaches beyond the grid, which would cut it: the body spans {} to {} \
-                 m, the grid {} to {} m (the body's point {} m lies outside); enlarge the grid \
-                 or clip the body with `clip`",
-                at(lo),
-                at(hi),
-                at(origin),
-                at(grid_hi),
-                at(x)
-            ),
-        ));
-    }
+    inside_grid::<D>(src, b, &g, geom, body.ppc, |x| kept(&x))?;
     let mut pts = fill(&g, D::D, origin, h, cells, body.ppc);
     pts.retain(kept);
     let earlier: Vec<&Claim> = (claims.iter())
