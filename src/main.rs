@@ -15,7 +15,7 @@ use fissure::record::expect::ExpectResult;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 /// Dynamic fracture with the material point method.
@@ -167,20 +167,10 @@ fn cmd_sweep(
             .map_or("scenario".into(), |s| s.to_string_lossy());
         PathBuf::from("out").join(format!("{stem}-sweep"))
     });
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    let installed = ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::SeqCst) {
-            std::process::exit(i32::from(INTERRUPTED));
-        }
-        eprintln!(
-            "\nstopping the sweep: the run under way stops at its next step and leaves no row \
-             (signal again to abort at once)"
-        );
-    });
-    if let Err(e) = installed {
-        eprintln!("warning: no clean stop on Ctrl-C: {e}");
-    }
+    let stop = stop_flag(
+        StopRequests::without_summary(),
+        "stopping the sweep: the run under way stops at its next step and leaves no row",
+    );
     let done = sweep(scenario, &vary, threads, &out, yes, Some(stop), |r| {
         let (k, n) = r.index;
         let what = r.set.join(" ");
@@ -227,6 +217,9 @@ fn bad_input(e: &ScenarioError) -> ExitCode {
     ExitCode::from(BAD_INPUT)
 }
 
+/// What a run says on the first stop signal.
+const AFTER_THIS_STEP: &str = "stopping after this step";
+
 /// Exit code of a run stopped on request (128 + SIGINT, as shells report it).
 const INTERRUPTED: u8 = 130;
 
@@ -251,17 +244,16 @@ fn is_bad_input(e: &anyhow::Error) -> bool {
         || e.downcast_ref::<UsageError>().is_some()
 }
 
-/// A flag set by Ctrl-C or SIGTERM, so the run stops cleanly after the current step (or
-/// before the first, during set-up) and writes a snapshot; a second signal exits at once,
-/// leaving a summary.json in `out` that says so.
-fn stop_flag(out: &Path) -> Arc<AtomicBool> {
-    let requests = StopRequests::new(out);
+/// A flag set by Ctrl-C or SIGTERM, so a run stops cleanly after the current step (or
+/// before the first, during set-up) and writes a snapshot; `first` is said on the first
+/// signal; a second exits at once (leaving, for a run, a summary.json that says so).
+fn stop_flag(requests: StopRequests, first: &'static str) -> Arc<AtomicBool> {
     let flag = requests.flag();
     let installed = ctrlc::set_handler(move || {
         if requests.request() {
             std::process::exit(i32::from(INTERRUPTED));
         }
-        eprintln!("\nstopping after this step (signal again to abort at once)");
+        eprintln!("\n{first} (signal again to abort at once)");
     });
     if let Err(e) = installed {
         eprintln!("warning: no clean stop on Ctrl-C: {e}");
@@ -386,7 +378,7 @@ fn cmd_run(
         progress: true,
         until,
         pause_after: None,
-        stop: Some(stop_flag(&out)),
+        stop: Some(stop_flag(StopRequests::new(&out), AFTER_THIS_STEP)),
     };
     match run(&src, &opts) {
         Ok(o) => finish(&o, &out),
@@ -408,7 +400,7 @@ fn cmd_resume(path: &Path, out: Option<PathBuf>, threads: usize, until: Option<f
         progress: true,
         until,
         pause_after: None,
-        stop: Some(stop_flag(&out)),
+        stop: Some(stop_flag(StopRequests::new(&out), AFTER_THIS_STEP)),
     };
     match resume(path, &opts) {
         Ok(o) => finish(&o, &out),

@@ -167,13 +167,7 @@ pub fn fill(
     cells: [usize; 3],
     ppc: usize,
 ) -> Vec<[f64; 3]> {
-    let (lo, hi) = geom.bounds();
-    let mut range = [(0i64, 1i64); 3];
-    for a in 0..dims {
-        let first = ((lo[a] - origin[a]) / h[a]).floor().max(0.0) as i64;
-        let last = (((hi[a] - origin[a]) / h[a]).ceil().max(0.0) as i64).min(cells[a] as i64);
-        range[a] = (first.min(last), last);
-    }
+    let range = covered(geom, dims, origin, h, |a| (0.0, cells[a] as f64));
     let mut out = Vec::new();
     lattice(range, dims, origin, h, ppc, |x| {
         if geom.contains(x) {
@@ -196,14 +190,7 @@ pub fn first_outside(
     ppc: usize,
     keep: impl Fn([f64; 3]) -> bool,
 ) -> Option<[f64; 3]> {
-    let (lo, hi) = geom.bounds();
-    let mut range = [(0i64, 1i64); 3];
-    for a in 0..dims {
-        let n = cells[a] as i64;
-        let first = (((lo[a] - origin[a]) / h[a]).floor().max(-1.0) as i64).min(n + 1);
-        let last = (((hi[a] - origin[a]) / h[a]).ceil().min(n as f64 + 1.0) as i64).max(-1);
-        range[a] = (first.min(last), last);
-    }
+    let range = covered(geom, dims, origin, h, |a| (-1.0, cells[a] as f64 + 1.0));
     // The layer's slabs, one per axis and side that the body's box reaches.
     let mut found = None;
     for a in 0..dims {
@@ -225,6 +212,26 @@ pub fn first_outside(
         }
     }
     None
+}
+
+/// The cells `geom`'s box covers, as a cell index range per axis (end exclusive), kept
+/// within `limit(axis)` (lowest index, end) on each of the `dims` axes used.
+fn covered(
+    geom: &Solid,
+    dims: usize,
+    origin: [f64; 3],
+    h: [f64; 3],
+    limit: impl Fn(usize) -> (f64, f64),
+) -> [(i64, i64); 3] {
+    let (lo, hi) = geom.bounds();
+    let mut range = [(0i64, 1i64); 3];
+    for a in 0..dims {
+        let (from, to) = limit(a);
+        let first = ((lo[a] - origin[a]) / h[a]).floor().clamp(from, to) as i64;
+        let last = ((hi[a] - origin[a]) / h[a]).ceil().clamp(from, to) as i64;
+        range[a] = (first.min(last), last);
+    }
+    range
 }
 
 /// Visits the sub-cell centres (`ppc` per cell per axis) of the cells in `range` (cell

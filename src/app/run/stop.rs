@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 #[derive(Clone, Debug)]
 pub struct StopRequests {
     flag: Arc<AtomicBool>,
-    summary: PathBuf,
+    summary: Option<PathBuf>,
 }
 
 /// The summary an abort leaves: the run had no chance to write its own.
@@ -23,7 +23,16 @@ impl StopRequests {
     pub fn new(out: &Path) -> Self {
         Self {
             flag: Arc::new(AtomicBool::new(false)),
-            summary: out.join("summary.json"),
+            summary: Some(out.join("summary.json")),
+        }
+    }
+
+    /// Requests for work that writes no summary of its own (a sweep's runs): an abort
+    /// leaves none either.
+    pub fn without_summary() -> Self {
+        Self {
+            flag: Arc::new(AtomicBool::new(false)),
+            summary: None,
         }
     }
 
@@ -38,8 +47,12 @@ impl StopRequests {
         if !self.flag.swap(true, Ordering::SeqCst) {
             return false;
         }
-        if self.summary.parent().is_some_and(Path::is_dir) {
-            std::fs::write(&self.summary, ABORT_SUMMARY).ok();
+        if let Some(summary) = self
+            .summary
+            .as_ref()
+            .filter(|s| s.parent().is_some_and(Path::is_dir))
+        {
+            std::fs::write(summary, ABORT_SUMMARY).ok();
         }
         true
     }

@@ -7,6 +7,7 @@ use super::schema::{CrackSpec, EllipseSpec, MeshSpec, PennySpec, PlanarSpec};
 use super::source::Source;
 use crate::base::dim::D3;
 use crate::base::error::ScenarioError;
+use crate::base::geometry::Element;
 use glam::DVec3;
 use std::collections::{HashMap, HashSet};
 use std::f64::consts::PI;
@@ -375,10 +376,7 @@ fn check(src: &Source, key: &str, s: &Surface) -> R<()> {
             [(t1, _), (t2, _)] => {
                 // Consistently oriented, the two normals point to one side: opposite normals
                 // are a surface folded flat over itself along this edge.
-                let normal = |t: usize| {
-                    let [a, b, c] = s.triangles[t].map(|i| s.vertices[i as usize]);
-                    (b - a).cross(c - a).normalize()
-                };
+                let normal = |t: usize| s.triangles[t].normal(&s.vertices);
                 let cos = normal(t1).dot(normal(t2));
                 if cos < -MIN_FOLD_ANGLE.to_radians().cos() {
                     return Err(src.error(
