@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use fissure::app::run::checkpoint::resolve;
-use fissure::app::run::stop::StopRequests;
+use fissure::app::run::stop::{Request, StopFlag, StopRequests};
 use fissure::app::run::{Outcome, RunOptions, resume, run};
 use fissure::app::sweep::{Swept, Vary, sweep};
 use fissure::base::dim::{D2, D3};
@@ -14,8 +14,6 @@ use fissure::pipeline::schedule::Schedule;
 use fissure::record::expect::ExpectResult;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 /// Dynamic fracture with the material point method.
@@ -244,16 +242,19 @@ fn is_bad_input(e: &anyhow::Error) -> bool {
         || e.downcast_ref::<UsageError>().is_some()
 }
 
-/// A flag set by Ctrl-C or SIGTERM, so a run stops cleanly after the current step (or
-/// before the first, during set-up) and writes a snapshot; `first` is said on the first
-/// signal; a second exits at once (leaving, for a run, a summary.json that says so).
-fn stop_flag(requests: StopRequests, first: &'static str) -> Arc<AtomicBool> {
+/// A flag set by Ctrl-C or SIGTERM. Before the run writes anything (building the scene), a
+/// signal exits at once; after, the first stops the run cleanly after the current step with
+/// a snapshot, saying `first`, and a second exits at once (leaving, for a run, a
+/// summary.json that says so).
+fn stop_flag(requests: StopRequests, first: &'static str) -> StopFlag {
     let flag = requests.flag();
-    let installed = ctrlc::set_handler(move || {
-        if requests.request() {
+    let installed = ctrlc::set_handler(move || match requests.request() {
+        Request::SetUp => {
+            eprintln!("\ninterrupted during set-up, before anything was written");
             std::process::exit(i32::from(INTERRUPTED));
         }
-        eprintln!("\n{first} (signal again to abort at once)");
+        Request::Stop => eprintln!("\n{first} (signal again to abort at once)"),
+        Request::Abort => std::process::exit(i32::from(INTERRUPTED)),
     });
     if let Err(e) = installed {
         eprintln!("warning: no clean stop on Ctrl-C: {e}");

@@ -8,7 +8,8 @@ use crate::base::dim::{D2, Dim};
 use crate::base::sym::SymTensor;
 use crate::fracture::interaction::{Tip, interaction_k, near};
 use crate::fracture::plan::{
-    FracturePlan, KMethod, Measured, PathResult, TipResult, k_from_g, k_from_mixity, k_from_opening,
+    FracturePlan, KMethod, Measured, PathResult, TipResult, k_from_g, k_from_mixity,
+    k_from_opening, lower_g,
 };
 use crate::physics::growth::TipState;
 use crate::physics::shape::Stencil;
@@ -214,15 +215,20 @@ pub(crate) fn tip(
         // discrete tip absorbs, and the interaction integral's auxiliary field is a tip's
         // at rest.
         _ if running.is_some() => res.k_opening,
+        KMethod::Opening => res.k_opening,
         // Where no interaction domain fits (another crack or the body's edge within two
         // cells of the tip), the opening split is all there is.
-        KMethod::Mixity | KMethod::Interaction if ik.radius == 0.0 => res.k_opening,
-        KMethod::Mixity => {
-            let [k1, k2] = k_from_mixity(mat, world.settings.plane, gr, ik.k);
-            [k1, k2, 0.0]
-        }
+        _ if ik.radius == 0.0 => res.k_opening,
         KMethod::Interaction => res.k_interaction,
-        KMethod::Opening => res.k_opening,
+        KMethod::Mixity | KMethod::LowerG => {
+            let [k1, k2] = k_from_mixity(mat, world.settings.plane, gr, ik.k);
+            let mixity = [k1, k2, 0.0];
+            if plan.k_method == KMethod::Mixity {
+                mixity
+            } else {
+                lower_g(res.k_interaction, mixity)
+            }
+        }
     };
     if main.plastic {
         // K comes from J only while the contour runs through elastic material.

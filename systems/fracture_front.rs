@@ -12,7 +12,7 @@ use crate::base::geometry::Element;
 use crate::base::geometry::point_triangle;
 use crate::fracture::front::{FrontFrame, front_line};
 use crate::fracture::front_integral::{Elastic3, Facet, FrontIntegrals, Tube, front_integrals};
-use crate::fracture::plan::{FracturePlan, KMethod, Measured, PathResult, TipResult};
+use crate::fracture::plan::{FracturePlan, KMethod, Measured, PathResult, TipResult, lower_g};
 use crate::store::crack::Cracks;
 use crate::store::world::World;
 use glam::DVec3;
@@ -134,6 +134,7 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                     k: match plan.k_method {
                         KMethod::Interaction => fi.k,
                         KMethod::Mixity => k_mixity,
+                        KMethod::LowerG => lower_g(fi.k, k_mixity),
                         KMethod::Opening => k_opening,
                     },
                     k_interaction: fi.k,

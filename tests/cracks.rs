@@ -441,6 +441,7 @@ history_interval = 1.0e-4
 /// homogeneous body, so its domain (6 cells asked) must shrink to stay in the steel: there
 /// it reads K_I within 1 % of sqrt(E' J) (0.4 %; 1.9 % high with the domain across the
 /// interfaces; at 0.25 mm cells both read 22.7 MPa sqrt(m), 0.4 % below this contour's).
+/// The reported K is the interaction integral's ratio at the lower G of it and J.
 #[test]
 fn interaction_domain_stays_in_the_tips_material() {
     let h = common::history(&sandwich());
@@ -465,6 +466,17 @@ fn interaction_domain_stays_in_the_tips_material() {
         "K_II {}",
         tip.k_interaction[1]
     );
+    // The default K (`lower_g`): the interaction integral's ratio at the lower of its G and
+    // the main contour's J (the tip points along +x, so G = J1), with the tip's E'.
+    let norm = |k: [f64; 3]| k[0].hypot(k[1]);
+    let lower = norm(tip.k_interaction).min((e_prime * tip.j[0]).sqrt());
+    assert!(
+        (norm(tip.k) / lower - 1.0).abs() < 1e-12,
+        "reported {:?}, lower |K| {lower}",
+        tip.k
+    );
+    let ratio = |k: [f64; 3]| k[1] / k[0];
+    assert!((ratio(tip.k) - ratio(tip.k_interaction)).abs() < 1e-12);
 }
 
 /// More cracks than a field's mask has colours: a 92 mm bar cut by 91 cracks into 92

@@ -1,20 +1,23 @@
-//! The scenario parser and builder never panic: on arbitrary bytes, and on the shipped
-//! scenarios with bytes deleted, replaced, inserted or lines repeated, they either build
-//! the scene or return an error. 64 cases each by default; PROPTEST_CASES=100000 for a
-//! longer fuzzing session.
+//! The scenario parser and builder never panic: on arbitrary bytes; on the shipped
+//! scenarios (the long ones too: 3D crack meshes, growth, fatigue, plasticity, regions)
+//! with bytes deleted, replaced, inserted or lines repeated; with numbers replaced by
+//! extreme ones (0, negative, tiny, huge, NaN, infinities); and under random `--set`
+//! overrides. They either build the scene or return an error. 64 cases each by default;
+//! PROPTEST_CASES=100000 for a longer fuzzing session.
 
 use fissure::base::dim::{D2, D3};
 use fissure::io::scenario::{Source, build};
 use proptest::prelude::*;
 use std::sync::OnceLock;
 
-/// The texts of the shipped scenarios (the fast ones, in `scenarios/`).
+/// The texts of the shipped scenarios, in `scenarios/` and `scenarios/long/`.
 fn shipped() -> &'static [String] {
     static TEXTS: OnceLock<Vec<String>> = OnceLock::new();
     TEXTS.get_or_init(|| {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
-        let mut paths: Vec<_> = std::fs::read_dir(dir)
-            .unwrap()
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+        let mut paths: Vec<_> = [root.clone(), root.join("long")]
+            .iter()
+            .flat_map(|dir| std::fs::read_dir(dir).unwrap())
             .map(|e| e.unwrap().path())
             .filter(|p| p.extension().is_some_and(|e| e == "toml"))
             .collect();
@@ -26,9 +29,10 @@ fn shipped() -> &'static [String] {
     })
 }
 
-/// Parses `text` and, when its grid is small enough to build in a moment, builds it.
-fn parse_and_build(text: &str) {
-    let Ok(src) = Source::parse("fuzz.toml", text, &[]) else {
+/// Parses `text` with `overrides` and, when its grid is small enough to build in a
+/// moment, builds it.
+fn parse_and_build(text: &str, overrides: &[String]) {
+    let Ok(src) = Source::parse("fuzz.toml", text, overrides) else {
         return;
     };
     let g = &src.scenario.grid;
@@ -45,6 +49,84 @@ fn parse_and_build(text: &str) {
         _ => build::<D2>(&src).map(|_| ()),
     };
 }
+
+/// Numbers a mutation puts in place of one in the text: the edges of what a key accepts.
+const EXTREMES: [&str; 12] = [
+    "0",
+    "-1",
+    "-0.0",
+    "1e-300",
+    "1e300",
+    "nan",
+    "inf",
+    "-inf",
+    "0.5",
+    "3",
+    "-1e-9",
+    "9007199254740993",
+];
+
+/// `text` with its `k`-th number (counted modulo how many there are) replaced by `by`.
+fn replace_number(text: &str, k: usize, by: &str) -> String {
+    let b = text.as_bytes();
+    let starts: Vec<usize> = (0..b.len())
+        .filter(|&i| {
+            b[i].is_ascii_digit()
+                && (i == 0
+                    || !(b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_' || b[i - 1] == b'.'))
+        })
+        .collect();
+    let Some(&i) = starts.get(k % starts.len().max(1)) else {
+        return text.to_string();
+    };
+    let end = (i..b.len())
+        .find(|&j| !(b[j].is_ascii_alphanumeric() || b"+-._".contains(&b[j])))
+        .unwrap_or(b.len());
+    format!("{}{by}{}", &text[..i], &text[end..])
+}
+
+/// Keys a `--set` override may name: the tables and keys of the scenario format, some
+/// misspelt, and array entries past the end.
+const KEYS: [&str; 20] = [
+    "simulation.dimension",
+    "simulation.duration",
+    "simulation.cfl",
+    "simulation.dt",
+    "simulation.damping",
+    "simulation.shape",
+    "grid.cell",
+    "grid.min",
+    "grid.max",
+    "material[0].E",
+    "material[0].nu",
+    "material[0].rho",
+    "body[0].material",
+    "crack[0].growth.paris.m",
+    "fracture.domain",
+    "fracture.k_from",
+    "output.interval",
+    "checkpoint.every_steps",
+    "material[7].E",
+    "simulaton.duration",
+];
+
+/// Values a `--set` override may give.
+const VALUES: [&str; 14] = [
+    "0",
+    "-1",
+    "1e300",
+    "nan",
+    "inf",
+    "\"ugimp\"",
+    "\"x\"",
+    "[0.001, 0.001]",
+    "[1, 2, 3]",
+    "{ kind = \"ramp\" }",
+    "true",
+    "[]",
+    "1e-9",
+    "",
+];
 
 /// One edit of `text` at the fraction `at` of its length: 0 deletes up to `len` bytes,
 /// 1 replaces one byte by `byte`, 2 inserts `chunk`, 3 repeats the line there.
@@ -87,7 +169,7 @@ proptest! {
 
     #[test]
     fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..2048)) {
-        parse_and_build(&String::from_utf8_lossy(&bytes));
+        parse_and_build(&String::from_utf8_lossy(&bytes), &[]);
     }
 
     #[test]
@@ -103,6 +185,32 @@ proptest! {
         for (op, at, len, byte, chunk) in &edits {
             text = mutate(&text, *op, *at, *len, *byte, chunk);
         }
-        parse_and_build(&text);
+        parse_and_build(&text, &[]);
+    }
+
+    #[test]
+    fn extreme_numbers_never_panic(
+        which in any::<usize>(),
+        edits in proptest::collection::vec((any::<usize>(), 0..EXTREMES.len()), 1..4),
+    ) {
+        let texts = shipped();
+        let mut text = texts[which % texts.len()].clone();
+        for (k, v) in &edits {
+            text = replace_number(&text, *k, EXTREMES[*v]);
+        }
+        parse_and_build(&text, &[]);
+    }
+
+    #[test]
+    fn random_overrides_never_panic(
+        which in any::<usize>(),
+        sets in proptest::collection::vec((0..KEYS.len(), 0..VALUES.len()), 1..4),
+    ) {
+        let texts = shipped();
+        let overrides: Vec<String> = sets
+            .iter()
+            .map(|&(k, v)| format!("{}={}", KEYS[k], VALUES[v]))
+            .collect();
+        parse_and_build(&texts[which % texts.len()], &overrides);
     }
 }

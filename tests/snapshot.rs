@@ -4,7 +4,7 @@
 
 mod common;
 use common::{mixed_scene, source};
-use fissure::app::run::stop::StopRequests;
+use fissure::app::run::stop::{Request, StopFlag, StopRequests};
 use fissure::app::run::{Outcome, RunOptions, resume, run};
 use fissure::base::dim::{D2, D3};
 use fissure::io::output::summary::Status;
@@ -632,7 +632,8 @@ fn inspect_reports_checksums_and_exit_codes() {
 #[test]
 fn a_stop_during_set_up_ends_the_run_before_its_first_step() {
     let dir = scratch("early");
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+    let stop = StopFlag::default();
+    stop.ask();
     let out = run(
         &source(&scene(2, "linear", "usf")),
         &RunOptions {
@@ -726,23 +727,88 @@ fn a_full_disk_during_a_snapshot_leaves_no_partial_file() {
     std::fs::remove_dir_all(dir).ok();
 }
 
-/// The first stop request only sets the run's flag; the second writes the abort summary
-/// and tells the caller to exit.
+/// A request before the run writes means "exit now" and records nothing; once it writes,
+/// the first request only sets the run's flag and the second writes the abort summary and
+/// tells the caller to exit.
 #[test]
-fn a_second_stop_request_writes_the_abort_summary() {
+fn stop_requests_follow_the_run() {
     let dir = scratch("requests");
     let requests = StopRequests::new(&dir);
     let flag = requests.flag();
-    assert!(!requests.request());
-    assert!(flag.load(std::sync::atomic::Ordering::SeqCst));
+    assert_eq!(requests.request(), Request::SetUp);
+    assert!(!flag.is_asked());
+    flag.set_writing(true);
+    assert_eq!(requests.request(), Request::Stop);
+    assert!(flag.is_asked());
     assert!(!dir.join("summary.json").exists());
-    assert!(requests.request());
+    assert_eq!(requests.request(), Request::Abort);
     let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
     assert!(
         summary.contains("\"interrupted\"")
             && (summary.contains("second signal") || summary.contains("stopped on request")),
         "{summary}"
     );
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// `fissure run FILE --out OUT` as a child process, its stdout discarded and its stderr
+/// sent to `stderr`.
+#[cfg(unix)]
+fn spawn_run(file: &Path, out: &Path, stderr: std::process::Stdio) -> std::process::Child {
+    std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
+        .args([
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(stderr)
+        .spawn()
+        .unwrap()
+}
+
+/// A signal while a large scene is being built (8 million particles, a few seconds of
+/// set-up) ends the process at once with exit code 130, before anything is written.
+#[cfg(unix)]
+#[test]
+fn a_signal_during_set_up_exits_before_writing() {
+    let dir = scratch("setup-signal");
+    let file = dir.join("big.toml");
+    std::fs::write(
+        &file,
+        r#"name = "big"
+[simulation]
+dimension = 2
+duration = 1.0
+[grid]
+min = [-0.0014, -0.0014]
+max = [1.4014, 1.4014]
+cell = [0.0007, 0.0007]
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 7800.0
+[[body]]
+material = "steel"
+box = { min = [0.0, 0.0], max = [1.4, 1.4] }
+"#,
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let child = spawn_run(&file, &out_dir, std::process::Stdio::piped());
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(err.contains("during set-up"), "{err}");
+    assert!(!out_dir.join("energy.csv").exists());
+    assert!(!out_dir.join("summary.json").exists());
     std::fs::remove_dir_all(dir).ok();
 }
 
@@ -760,17 +826,7 @@ fn two_signals_end_the_run_with_an_interrupted_summary() {
     )
     .unwrap();
     let out_dir = dir.join("out");
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_fissure"))
-        .args([
-            "run",
-            file.to_str().unwrap(),
-            "--out",
-            out_dir.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_run(&file, &out_dir, std::process::Stdio::null());
     // Wait until the run is stepping (its first frame is written).
     let started = std::time::Instant::now();
     while !out_dir.join("particles_00001.vtu").exists() {

@@ -104,12 +104,12 @@ fn a_stopped_sweep_keeps_whole_rows_and_resumes() {
     let (dir, file) = setup("stop");
     let out = dir.join("out");
     let v = vary(&["simulation.shape=linear,ugimp,bspline"]);
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let stop = fissure::app::run::stop::StopFlag::default();
     let flag = stop.clone();
     let mut ran = Vec::new();
     let swept = sweep(&file, &v, 1, &out, false, Some(stop), |r| {
         ran.push(r.index.0);
-        flag.store(true, std::sync::atomic::Ordering::SeqCst);
+        flag.ask();
     })
     .unwrap();
     assert_eq!((swept, ran), (Swept::Stopped, vec![1]));

@@ -3,6 +3,7 @@
 //! error can be read against cost. A sweep stopped part-way resumes: the rows already in
 //! sweep.csv are not run again.
 
+use crate::app::run::stop::StopFlag;
 use crate::app::run::{RunOptions, run};
 use crate::base::error::UsageError;
 use crate::io::output::plot::{self, Series};
@@ -12,8 +13,6 @@ use crate::io::scenario::Source;
 use anyhow::Context;
 use std::io::Write;
 use std::path::Path;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 /// How a sweep ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -269,7 +268,7 @@ pub fn sweep(
     threads: usize,
     out: &Path,
     yes: bool,
-    stop: Option<Arc<AtomicBool>>,
+    stop: Option<StopFlag>,
     mut progress: impl FnMut(&Ran),
 ) -> anyhow::Result<Swept> {
     if vary.is_empty() {
@@ -336,7 +335,7 @@ pub fn sweep(
         writeln!(file, "{head}").map_err(named)?;
     }
     let n = combos.len();
-    let stopped = || stop.as_ref().is_some_and(|s| s.load(Ordering::SeqCst));
+    let stopped = || stop.as_ref().is_some_and(StopFlag::is_asked);
     let mut swept = Swept::Complete;
     for (k, (set, src)) in combos.iter().zip(sources).enumerate() {
         if stopped() {

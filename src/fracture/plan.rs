@@ -31,6 +31,9 @@ pub struct FracturePlan {
 /// How the reported K_I and K_II are obtained.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum KMethod {
+    /// Of [`KMethod::Interaction`] and [`KMethod::Mixity`] (the same mode ratio), the one
+    /// with the lower G ([`lower_g`]): the default.
+    LowerG,
     /// sqrt(E' G) with G from J, split in the ratio K_II / K_I of the interaction integral
     /// ([`k_from_mixity`]).
     Mixity,
@@ -202,6 +205,16 @@ pub fn k_from_mixity(m: &Material, plane: Plane, g: f64, k: [f64; 2]) -> [f64; 2
     [k[0] * scale, k[1] * scale]
 }
 
+/// Of two K estimates in the same mode ratio, the one of lower energy release rate (the
+/// smaller norm); `a` where `b` is NaN. On the discrete crack each estimate errs high
+/// where it fails: the interaction integral in slender arms (its auxiliary field centred
+/// on the last crack vertex, not where the discrete crack acts as if it ends), J where the
+/// crack cuts the cells obliquely (docs/fracture.md, "Which K").
+pub fn lower_g<const N: usize>(a: [f64; N], b: [f64; N]) -> [f64; N] {
+    let norm = |k: &[f64; N]| k.iter().map(|v| v * v).sum::<f64>();
+    if norm(&b) < norm(&a) { b } else { a }
+}
+
 /// K_I and K_II from the energy release rate `g` of a tip at rest and the opening `d_i` and
 /// sliding `d_ii` displacements behind it: K = (delta / |delta|) sqrt(E' G) (Guo & Nairn
 /// 2D (2004) Eqs. 21-22, their Eqs. 14-15 at c = 0). NaN when the crack is closed (no
@@ -235,6 +248,16 @@ pub fn k_from_opening(m: &Material, plane: Plane, d_i: f64, d_ii: f64, c: f64) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The lower of two proportional estimates is kept, in any order; a NaN estimate (no J)
+    /// never replaces a measured one.
+    #[test]
+    fn lower_g_keeps_the_smaller_and_ignores_nan() {
+        let (a, b) = ([3.0e6, -1.0e6, 0.5e6], [2.7e6, -0.9e6, 0.45e6]);
+        assert_eq!(lower_g(a, b), b);
+        assert_eq!(lower_g(b, a), b);
+        assert_eq!(lower_g(a, [f64::NAN; 3]), a);
+    }
 
     /// Eqs. 21-22: K = (delta/|delta|) sqrt(G E'), so K_I^2 + K_II^2 = E' G.
     #[test]

@@ -24,9 +24,8 @@ use anyhow::Context;
 use driver::Run;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
+use stop::StopFlag;
 
 /// How to run a scenario.
 #[derive(Clone, Debug, Default)]
@@ -41,14 +40,22 @@ pub struct RunOptions {
     pub until: Option<f64>,
     /// Stop cleanly after this step, as on Ctrl-C.
     pub pause_after: Option<u64>,
-    /// When set (by a signal handler), stop cleanly after the current step.
-    pub stop: Option<Arc<AtomicBool>>,
+    /// Shared with a signal handler: a stop asked stops the run cleanly after the current
+    /// step; the run says when it begins to write.
+    pub stop: Option<StopFlag>,
 }
 
 impl RunOptions {
     /// Whether a signal has asked the run to stop.
     pub fn stop_requested(&self) -> bool {
-        (self.stop.as_ref()).is_some_and(|s| s.load(Ordering::Relaxed))
+        (self.stop.as_ref()).is_some_and(StopFlag::is_asked)
+    }
+
+    /// Tells a signal handler whether the run writes yet (see [`stop`]).
+    fn writing(&self, on: bool) {
+        if let Some(s) = &self.stop {
+            s.set_writing(on);
+        }
     }
 }
 
@@ -87,6 +94,7 @@ pub fn thread_count(asked: usize) -> usize {
 
 /// Runs `src` with `opts` in a thread pool of the requested size.
 pub fn run(src: &Source, opts: &RunOptions) -> anyhow::Result<Outcome> {
+    opts.writing(false);
     pool(opts)?.install(|| match src.scenario.simulation.dimension {
         2 => drive::<D2>(src, build::<D2>(src)?, None, opts),
         3 => drive::<D3>(src, build::<D3>(src)?, None, opts),
@@ -97,6 +105,7 @@ pub fn run(src: &Source, opts: &RunOptions) -> anyhow::Result<Outcome> {
 /// Continues the run stored in the snapshot at `path` (a file, or a run folder whose
 /// newest snapshot is taken).
 pub fn resume(path: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
+    opts.writing(false);
     let file = checkpoint::resolve(path)?;
     let mut reader = Reader::open(&file)?;
     fn go<D: DimSystems>(
@@ -173,6 +182,7 @@ fn drive<D: DimSystems>(
     resumed: Option<(RunState, PathBuf)>,
     opts: &RunOptions,
 ) -> anyhow::Result<Outcome> {
+    opts.writing(true);
     let mut run = Run::start(src, scene, resumed, opts)?;
     let bar = if opts.progress {
         let b = ProgressBar::new(run.steps);

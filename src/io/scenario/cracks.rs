@@ -665,18 +665,15 @@ pub(super) fn fracture_plan<D: Dim>(
         ));
     }
     let k_method = match f.k_from.as_deref() {
-        // In 3D the tube's J carries the front's curvature and the interaction integral
-        // does not (see `crate::fracture::front_integral`): by default G = J is split by the crack
-        // opening, the 3D paper's method.
-        None if D::D == 3 => KMethod::Opening,
-        None | Some("interaction") => KMethod::Interaction,
+        None | Some("lower_g") => KMethod::LowerG,
+        Some("interaction") => KMethod::Interaction,
         Some("mixity") => KMethod::Mixity,
         Some("opening") => KMethod::Opening,
         Some(other) => {
             return Err(src.error(
                 "fracture.k_from",
                 format!(
-                    "unknown method `{other}`: give \"interaction\", \"mixity\" or \"opening\""
+                    "unknown method `{other}`: give \"lower_g\", \"interaction\", \"mixity\" or \"opening\""
                 ),
             ));
         }

@@ -568,9 +568,10 @@ pub struct FractureSpec {
     /// `opening` cells behind the tip (default 8; on a crack with two tips, at most half its
     /// length).
     pub opening: Option<f64>,
-    /// Which K are reported in the KI, KII (, KIII) columns and expects: "interaction" (the
-    /// interaction integral; the 2D default), "mixity" (G from J split in the interaction
-    /// integral's ratios) or "opening" (G split by the crack opening; the 3D default).
+    /// Which K are reported in the KI, KII (, KIII) columns and expects: "lower_g" (the
+    /// default: of "interaction" and "mixity", the one of lower G), "interaction" (the
+    /// interaction integral), "mixity" (G from J split in the interaction integral's
+    /// ratios) or "opening" (G split by the crack opening).
     pub k_from: Option<String>,
     /// Radius of the interaction integral's domain around the tip, in cells (default 6 in
     /// 2D; in 3D the radius and half-length of the tube around the front, default 3).
