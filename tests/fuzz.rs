@@ -87,7 +87,7 @@ fn replace_number(text: &str, k: usize, by: &str) -> String {
 
 /// Keys a `--set` override may name: the tables and keys of the scenario format, some
 /// misspelt, and array entries past the end.
-const KEYS: [&str; 20] = [
+const KEYS: [&str; 21] = [
     "simulation.dimension",
     "simulation.duration",
     "simulation.cfl",
@@ -108,10 +108,11 @@ const KEYS: [&str; 20] = [
     "checkpoint.every_steps",
     "material[7].E",
     "simulaton.duration",
+    "body[0].mesh.file",
 ];
 
 /// Values a `--set` override may give.
-const VALUES: [&str; 14] = [
+const VALUES: [&str; 15] = [
     "0",
     "-1",
     "1e300",
@@ -126,6 +127,7 @@ const VALUES: [&str; 14] = [
     "[]",
     "1e-9",
     "",
+    "\"part.stl\"",
 ];
 
 /// One edit of `text` at the fraction `at` of its length: 0 deletes up to `len` bytes,

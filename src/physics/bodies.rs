@@ -1,5 +1,7 @@
 //! Body geometries and filling them with particles.
 
+use crate::base::geometry::ClosedSurface;
+
 /// A body's shape, in padded 3-component coordinates (z = 0 in 2D).
 #[derive(Clone, Debug)]
 pub enum Solid {
@@ -35,6 +37,8 @@ pub enum Solid {
         /// Length (m).
         length: f64,
     },
+    /// The inside of a closed triangulated surface (3D).
+    Mesh(std::sync::Arc<ClosedSurface>),
     /// Polygon in x-y, extruded over `z` in 3D.
     Polygon {
         /// Vertices (m).
@@ -73,6 +77,7 @@ impl Solid {
                     .sum();
                 (0.0..=*length).contains(&along) && r2 <= radius * radius && r2 >= inner * inner
             }
+            Solid::Mesh(surface) => surface.contains(x),
             Solid::Polygon { points, z } => {
                 if let Some([z0, z1]) = z
                     && !(x[2] >= *z0 && x[2] <= *z1)
@@ -121,6 +126,7 @@ impl Solid {
                 }
                 (lo, hi)
             }
+            Solid::Mesh(surface) => surface.bounds(),
             Solid::Polygon { points, z } => {
                 let mut lo = [f64::INFINITY, f64::INFINITY, 0.0];
                 let mut hi = [f64::NEG_INFINITY, f64::NEG_INFINITY, 0.0];

@@ -1,13 +1,15 @@
 //! Geometry below every store: points, distances, crack elements and their exact
-//! predicates, and axis-aligned boxes. A leaf of the module graph: it imports nothing of
+//! predicates, axis-aligned boxes and closed surfaces. A leaf of the module graph: it imports nothing of
 //! the crate, so the dimension, the crack store and the systems can all build on it.
 
 mod bounds;
+mod closed_surface;
 mod distance;
 mod element;
 mod point;
 
 pub use bounds::{Aabb, meeting_pairs};
+pub use closed_surface::{ClosedSurface, SurfaceDefect};
 pub use distance::{point_segment, point_segment_sq, point_triangle, segment_segment};
 pub use element::{Element, NUDGE, Segment, Triangle};
 pub use point::Point;

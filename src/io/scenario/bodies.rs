@@ -113,12 +113,20 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Solid> {
         body.sphere.is_some(),
         body.cylinder.is_some(),
         body.polygon.is_some(),
+        body.mesh.is_some(),
     ];
     if given.iter().filter(|g| **g).count() != 1 {
         return Err(src.error(
             &format!("body[{b}]"),
-            "give exactly one geometry: box, disc (2D), sphere (3D), cylinder (3D) or polygon",
+            "give exactly one geometry: box, disc (2D), sphere (3D), cylinder (3D), polygon or \
+             mesh (3D)",
         ));
+    }
+    if let Some(m) = &body.mesh {
+        if D::D != 3 {
+            return Err(src.error(&key("mesh"), "a mesh body is 3D; use polygon in 2D"));
+        }
+        return super::mesh_body::solid(src, &key("mesh"), m);
     }
     if let Some(bx) = &body.box_ {
         let (min, max) = box_corners::<D>(src, &key("box"), bx)?;

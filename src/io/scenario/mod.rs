@@ -15,6 +15,7 @@ mod growth;
 mod loads;
 mod material;
 mod memory;
+mod mesh_body;
 mod output;
 mod probes;
 mod region;

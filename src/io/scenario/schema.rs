@@ -182,6 +182,19 @@ pub struct RegionSpec {
     pub normal: Option<Vec<f64>>,
 }
 
+/// A body bounded by the closed surface in an STL file (ASCII or binary), placed by
+/// x = scale * x_file + translate.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshBodySpec {
+    /// The file, relative to the scenario file's folder.
+    pub file: String,
+    /// Factor from the file's units to metres (default 1; 1e-3 for a part in mm).
+    pub scale: Option<f64>,
+    /// Offset after scaling (m).
+    pub translate: Option<Vec<f64>>,
+}
+
 /// A disc (2D) or sphere (3D), or a ring or spherical shell when `inner_radius` is given.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -251,6 +264,8 @@ pub struct BodySpec {
     pub cylinder: Option<CylinderSpec>,
     /// Polygon geometry (2D, or extruded in 3D).
     pub polygon: Option<PolygonSpec>,
+    /// A closed triangulated surface read from a file (3D).
+    pub mesh: Option<MeshBodySpec>,
     /// Keep only the part of the geometry inside this region (e.g. the half-space on one
     /// side of a symmetry plane).
     pub clip: Option<RegionSpec>,

@@ -1,0 +1,280 @@
+//! Bodies read from STL files: they fill what their surface encloses, the same points as
+//! the built-in geometry where the two coincide, and bad files are refused by name.
+
+mod common;
+use common::source;
+use fissure::base::dim::D3;
+use fissure::base::geometry::ClosedSurface;
+use fissure::io::scenario::{Source, build};
+use std::path::{Path, PathBuf};
+
+/// A fresh folder for this test's files.
+fn folder(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("fissure-mesh-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A 3D scene in a 100 mm cube of 2 mm cells with one body, `body` its geometry.
+fn scene(body: &str) -> String {
+    format!(
+        r#"
+[simulation]
+dimension = 3
+duration = 1e-6
+[grid]
+min = [0.0, 0.0, 0.0]
+max = [0.1, 0.1, 0.1]
+cell = [0.002, 0.002, 0.002]
+[[material]]
+name = "m"
+E = 1e9
+nu = 0.3
+rho = 1000.0
+[[body]]
+material = "m"
+ppc = 2
+{body}
+"#
+    )
+}
+
+/// Writes `triangles` as a binary STL file.
+fn write_stl(path: &Path, triangles: &[[[f32; 3]; 3]]) {
+    let tris: Vec<stl_io::Triangle> = triangles
+        .iter()
+        .map(|t| stl_io::Triangle {
+            normal: stl_io::Normal::new([0.0; 3]),
+            vertices: t.map(stl_io::Vertex::new),
+        })
+        .collect();
+    let mut f = std::fs::File::create(path).unwrap();
+    stl_io::write_stl(&mut f, tris.iter()).unwrap();
+}
+
+/// The surface of a sphere of radius `r` about `c`: an icosahedron whose faces are split
+/// `levels` times, vertices pushed onto the sphere, faces outward.
+fn icosphere(c: [f64; 3], r: f64, levels: usize) -> Vec<[[f32; 3]; 3]> {
+    let g = (1.0 + 5f64.sqrt()) / 2.0;
+    let v = [
+        [-1.0, g, 0.0],
+        [1.0, g, 0.0],
+        [-1.0, -g, 0.0],
+        [1.0, -g, 0.0],
+        [0.0, -1.0, g],
+        [0.0, 1.0, g],
+        [0.0, -1.0, -g],
+        [0.0, 1.0, -g],
+        [g, 0.0, -1.0],
+        [g, 0.0, 1.0],
+        [-g, 0.0, -1.0],
+        [-g, 0.0, 1.0],
+    ];
+    let faces = [
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let unit = |p: [f64; 3]| {
+        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        p.map(|x| x / n)
+    };
+    let mut tris: Vec<[[f64; 3]; 3]> = faces.iter().map(|f| f.map(|i| unit(v[i]))).collect();
+    for _ in 0..levels {
+        let mid = |a: [f64; 3], b: [f64; 3]| unit([0, 1, 2].map(|k| a[k] + b[k]));
+        tris = tris
+            .iter()
+            .flat_map(|&[a, b, cc]| {
+                let (ab, bc, ca) = (mid(a, b), mid(b, cc), mid(cc, a));
+                [[a, ab, ca], [ab, b, bc], [ca, bc, cc], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    tris.iter()
+        .map(|t| t.map(|p| [0, 1, 2].map(|k| (c[k] + r * p[k]) as f32)))
+        .collect()
+}
+
+fn positions(text: &str) -> Vec<[u64; 3]> {
+    let w = build::<D3>(&source(text)).unwrap().world;
+    let mut out: Vec<[u64; 3]> = w
+        .particles
+        .x
+        .iter()
+        .map(|x| x.to_array().map(f64::to_bits))
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+/// An icosphere of radius 30 mm (1,280 triangles, written in mm and read with
+/// scale = 1e-3): the particles fill the polyhedron's volume within 1 % (2 mm cells, as
+/// the built-in sphere's test), and every one of them is also a particle of the built-in
+/// sphere of the same radius, which holds the inscribed polyhedron.
+#[test]
+fn icosphere_fills_its_polyhedron_inside_the_sphere() {
+    let dir = folder("sphere");
+    let file = dir.join("ball.stl");
+    let tris = icosphere([0.0; 3], 30.0, 3);
+    write_stl(&file, &tris);
+    let text = scene(&format!(
+        "mesh = {{ file = \"{}\", scale = 1e-3, translate = [0.05, 0.05, 0.05] }}",
+        file.display()
+    ));
+    let w = build::<D3>(&source(&text)).unwrap().world;
+    let vol: f64 = w.particles.volume.iter().sum();
+    let (v, t) = indexed(&tris, 1e-3, [0.05; 3]);
+    let want = ClosedSurface::new(v, t).unwrap().volume();
+    assert!((vol - want).abs() / want < 0.01, "{vol} vs {want}");
+    let sphere = positions(&scene(
+        "sphere = { center = [0.05, 0.05, 0.05], radius = 0.03 }",
+    ));
+    let mesh = positions(&text);
+    assert!(mesh.len() < sphere.len());
+    assert!(mesh.iter().all(|p| sphere.binary_search(p).is_ok()));
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// The triangles as an indexed list (vertices merged), scaled and moved.
+fn indexed(tris: &[[[f32; 3]; 3]], scale: f64, shift: [f64; 3]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut vertices: Vec<[f32; 3]> = Vec::new();
+    let t = tris
+        .iter()
+        .map(|tri| {
+            tri.map(|p| match vertices.iter().position(|q| *q == p) {
+                Some(i) => i as u32,
+                None => {
+                    vertices.push(p);
+                    (vertices.len() - 1) as u32
+                }
+            })
+        })
+        .collect();
+    let v = vertices
+        .iter()
+        .map(|p| [0, 1, 2].map(|k| f64::from(p[k]) * scale + shift[k]))
+        .collect();
+    (v, t)
+}
+
+/// A 20 x 30 x 40 mm block written as 12 triangles, placed by `translate` in a scenario
+/// that names the file relative to its own folder: exactly the particles of the same box
+/// given as `box`.
+#[test]
+fn block_from_a_file_is_the_box() {
+    let dir = folder("block");
+    let (a, b) = ([0.0f32; 3], [0.02f32, 0.03, 0.04]);
+    let corner = |i: usize| [0, 1, 2].map(|k| if (i >> k) & 1 == 1 { b[k] } else { a[k] });
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let tris: Vec<[[f32; 3]; 3]> = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .map(|t: [usize; 3]| t.map(corner))
+        .collect();
+    write_stl(&dir.join("block.stl"), &tris);
+    let file = dir.join("block.toml");
+    std::fs::write(
+        &file,
+        scene("mesh = { file = \"block.stl\", translate = [0.0103, 0.0201, 0.0307] }"),
+    )
+    .unwrap();
+    let mesh = build::<D3>(&Source::load(&file, &[]).unwrap())
+        .unwrap()
+        .world;
+    let boxed = build::<D3>(&source(&scene(
+        "box = { min = [0.0103, 0.0201, 0.0307], max = [0.0303, 0.0501, 0.0707] }",
+    )))
+    .unwrap()
+    .world;
+    assert_eq!(mesh.particles.x, boxed.particles.x);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// A surface with a hole, a file that is not STL, a truncated binary file, a missing file
+/// and a mesh body in 2D are refused, naming the key, the file and what is wrong.
+#[test]
+fn bad_mesh_files_are_named() {
+    let dir = folder("bad");
+    let err = |body: String| match Source::parse("bad.toml", &scene(&body), &[]) {
+        Ok(src) => build::<D3>(&src)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default(),
+        Err(e) => e.to_string(),
+    };
+    let mut tris = icosphere([0.0; 3], 30.0, 1);
+    tris.remove(17);
+    let open = dir.join("open.stl");
+    write_stl(&open, &tris);
+    let e = err(format!("mesh = {{ file = \"{}\" }}", open.display()));
+    assert!(
+        e.contains("body[0].mesh.file") && e.contains("open.stl") && e.contains("not closed"),
+        "{e}"
+    );
+    let obj = dir.join("part.obj");
+    std::fs::write(&obj, "v 0 0 0\n").unwrap();
+    let e = err(format!("mesh = {{ file = \"{}\" }}", obj.display()));
+    assert!(
+        e.contains("part.obj") && e.contains("not an .stl file"),
+        "{e}"
+    );
+    let whole = dir.join("whole.stl");
+    write_stl(&whole, &icosphere([0.0; 3], 30.0, 1));
+    let bytes = std::fs::read(&whole).unwrap();
+    let cut = dir.join("cut.stl");
+    std::fs::write(&cut, &bytes[..bytes.len() - 30]).unwrap();
+    let e = err(format!("mesh = {{ file = \"{}\" }}", cut.display()));
+    assert!(e.contains("cut.stl") && e.contains("triangle 79"), "{e}");
+    let e = err(format!(
+        "mesh = {{ file = \"{}\" }}",
+        dir.join("none.stl").display()
+    ));
+    assert!(
+        e.contains("none.stl") && e.contains("cannot read it"),
+        "{e}"
+    );
+    let e = err(format!(
+        "mesh = {{ file = \"{}\", scale = -1.0 }}",
+        whole.display()
+    ));
+    assert!(e.contains("body[0].mesh.scale"), "{e}");
+    let flat = scene(&format!("mesh = {{ file = \"{}\" }}", whole.display()))
+        .replace("dimension = 3", "dimension = 2")
+        .replace("[0.0, 0.0, 0.0]", "[0.0, 0.0]")
+        .replace("[0.1, 0.1, 0.1]", "[0.1, 0.1]")
+        .replace("[0.002, 0.002, 0.002]", "[0.002, 0.002]");
+    let e = match Source::parse("flat.toml", &flat, &[]) {
+        Ok(src) => build::<fissure::base::dim::D2>(&src)
+            .err()
+            .unwrap()
+            .to_string(),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("a mesh body is 3D"), "{e}");
+    std::fs::remove_dir_all(dir).ok();
+}
