@@ -1,4 +1,4 @@
-//! Bodies read from STL files: they fill what their surface encloses, the same points as
+//! Bodies read from STL and OBJ files: they fill what their surface encloses, the same points as
 //! the built-in geometry where the two coincide, and bad files are refused by name.
 
 mod common;
@@ -215,7 +215,44 @@ fn block_from_a_file_is_the_box() {
     std::fs::remove_dir_all(dir).ok();
 }
 
-/// A surface with a hole, a file that is not STL, a truncated binary file, a missing file
+/// The same block written as an OBJ file with quadrilateral faces, drawn 30 wide in x and
+/// 20 in y and turned 90 degrees about z (x -> y, y -> -x): the particles of the box it
+/// then occupies.
+#[test]
+fn turned_block_from_an_obj_file_is_the_box() {
+    let dir = folder("obj");
+    let file = dir.join("block.obj");
+    let mut text = String::from("o block\n");
+    for i in 0..8 {
+        let c = [0.03, 0.02, 0.04];
+        let p = [0, 1, 2].map(|k| if (i >> k) & 1 == 1 { c[k] } else { 0.0 });
+        text += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for q in [
+        [1, 3, 4, 2],
+        [5, 6, 8, 7],
+        [1, 2, 6, 5],
+        [3, 7, 8, 4],
+        [1, 5, 7, 3],
+        [2, 4, 8, 6],
+    ] {
+        text += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    std::fs::write(&file, text).unwrap();
+    let mesh = positions(&scene(&format!(
+        "mesh = {{ file = \"{}\", rotate = {{ axis = [0.0, 0.0, 2.0], angle = 90.0 }}, \
+         translate = [0.0403, 0.0201, 0.0307] }}",
+        file.display()
+    )));
+    let boxed = positions(&scene(
+        "box = { min = [0.0203, 0.0201, 0.0307], max = [0.0403, 0.0501, 0.0707] }",
+    ));
+    assert_eq!(mesh, boxed);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// A surface with a hole, a file neither STL nor OBJ, an OBJ file with no faces, a
+/// truncated binary STL file, a missing file
 /// and a mesh body in 2D are refused, naming the key, the file and what is wrong.
 #[test]
 fn bad_mesh_files_are_named() {
@@ -236,11 +273,18 @@ fn bad_mesh_files_are_named() {
         e.contains("body[0].mesh.file") && e.contains("open.stl") && e.contains("not closed"),
         "{e}"
     );
-    let obj = dir.join("part.obj");
-    std::fs::write(&obj, "v 0 0 0\n").unwrap();
-    let e = err(format!("mesh = {{ file = \"{}\" }}", obj.display()));
+    let step = dir.join("part.step");
+    std::fs::write(&step, "ISO-10303-21;\n").unwrap();
+    let e = err(format!("mesh = {{ file = \"{}\" }}", step.display()));
     assert!(
-        e.contains("part.obj") && e.contains("not an .stl file"),
+        e.contains("part.step") && e.contains("not an .stl or .obj file"),
+        "{e}"
+    );
+    let points = dir.join("points.obj");
+    std::fs::write(&points, "v 0 0 0\nv 1 0 0\n").unwrap();
+    let e = err(format!("mesh = {{ file = \"{}\" }}", points.display()));
+    assert!(
+        e.contains("points.obj") && e.contains("no triangles"),
         "{e}"
     );
     let whole = dir.join("whole.stl");

@@ -182,8 +182,8 @@ pub struct RegionSpec {
     pub normal: Option<Vec<f64>>,
 }
 
-/// A body bounded by the closed surface in an STL file (ASCII or binary), placed by
-/// x = scale * x_file + translate.
+/// A body bounded by the closed surface in an STL file (ASCII or binary) or an OBJ file,
+/// placed by x = R (scale * x_file) + translate.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshBodySpec {
@@ -191,8 +191,20 @@ pub struct MeshBodySpec {
     pub file: String,
     /// Factor from the file's units to metres (default 1; 1e-3 for a part in mm).
     pub scale: Option<f64>,
-    /// Offset after scaling (m).
+    /// Rotation after scaling, before the offset.
+    pub rotate: Option<RotateSpec>,
+    /// Offset after scaling and rotating (m).
     pub translate: Option<Vec<f64>>,
+}
+
+/// A rotation by `angle` degrees about `axis` (right-handed).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotateSpec {
+    /// Axis direction (any length but zero).
+    pub axis: Vec<f64>,
+    /// Angle (degrees).
+    pub angle: f64,
 }
 
 /// A disc (2D) or sphere (3D), or a ring or spherical shell when `inner_radius` is given.
