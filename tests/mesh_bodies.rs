@@ -322,3 +322,134 @@ fn bad_mesh_files_are_named() {
     assert!(e.contains("a mesh body is 3D"), "{e}");
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// An edge crack through a 12 mm block (y = 6.5 mm, from outside the x = 0 face to
+/// x = 5 mm, through the thickness in z), its front along x = 5 mm: as vertex and triangle
+/// lists in the scenario and as an OBJ file. `crack` is the `[[crack]]` geometry line.
+fn edge_crack_block(crack: &str) -> String {
+    format!(
+        r#"name = "edge_crack"
+[simulation]
+dimension = 3
+shape = "ugimp"
+duration = 4.0e-6
+damping = 6.0e5
+[grid]
+min = [-0.002, -0.002, -0.002]
+max = [0.014, 0.014, 0.014]
+cell = [0.001, 0.001, 0.001]
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 8000.0
+[[body]]
+material = "steel"
+box = {{ min = [0.0, 0.0, 0.0], max = [0.012, 0.012, 0.012] }}
+[[crack]]
+name = "edge"
+{crack}
+[[load]]
+region = {{ min = [0.0, 0.0115, 0.0], max = [0.012, 0.012, 0.012] }}
+force = [0.0, 2.0e4, 0.0]
+time = {{ kind = "ramp", rise = 2.0e-6 }}
+[[load]]
+region = {{ min = [0.0, 0.0, 0.0], max = [0.012, 0.0005, 0.012] }}
+force = [0.0, -2.0e4, 0.0]
+time = {{ kind = "ramp", rise = 2.0e-6 }}
+[fracture]
+domain = 2
+[output]
+history_interval = 1.0e-6
+"#
+    )
+}
+
+/// The edge crack's vertices (a 3 x 8 grid over x in [-1, 5] mm, z in [-1, 13] mm),
+/// triangles (0-based) and front (the x = 5 mm column, in z order).
+fn edge_crack_mesh() -> (Vec<[f64; 3]>, Vec<[usize; 3]>, Vec<usize>) {
+    let (xs, zs) = (
+        [-0.001, 0.002, 0.005],
+        (0..8).map(|k| -0.001 + 0.002 * k as f64),
+    );
+    let zs: Vec<f64> = zs.collect();
+    let at = |i: usize, k: usize| k * 3 + i;
+    let v = (0..zs.len())
+        .flat_map(|k| xs.map(|x| [x, 0.0065, zs[k]]))
+        .collect();
+    let mut t = Vec::new();
+    for k in 0..zs.len() - 1 {
+        for i in 0..2 {
+            t.push([at(i, k), at(i, k + 1), at(i + 1, k + 1)]);
+            t.push([at(i, k), at(i + 1, k + 1), at(i + 1, k)]);
+        }
+    }
+    (v, t, (0..zs.len()).map(|k| at(2, k)).collect())
+}
+
+/// A crack surface read from an OBJ file (`mesh_file`, the front given by its vertices'
+/// positions) runs bit for bit as the same mesh written into the scenario: the same J and
+/// K at every front vertex and step, the same energies. The inline vertices are numbered
+/// in order of first use by the triangles, as a file's are once read.
+#[test]
+fn crack_from_an_obj_file_is_the_inline_mesh() {
+    let dir = folder("crack");
+    let (v, t, front) = edge_crack_mesh();
+    let mut order: Vec<usize> = Vec::new();
+    for i in t.iter().flatten() {
+        if !order.contains(i) {
+            order.push(*i);
+        }
+    }
+    let renumber = |i: usize| order.iter().position(|&j| j == i).unwrap();
+    let point = |p: &[f64; 3]| format!("[{:e}, {:e}, {:e}]", p[0], p[1], p[2]);
+    let join = |items: Vec<String>| items.join(", ");
+    let inline = format!(
+        "mesh = {{ vertices = [{}], triangles = [{}], front = [{}] }}",
+        join(order.iter().map(|&i| point(&v[i])).collect()),
+        join(
+            t.iter()
+                .map(|tri| format!(
+                    "[{}]",
+                    join(tri.iter().map(|&i| renumber(i).to_string()).collect())
+                ))
+                .collect()
+        ),
+        join(front.iter().map(|&i| renumber(i).to_string()).collect())
+    );
+    let mut obj = String::new();
+    for p in &v {
+        obj += &format!("v {:e} {:e} {:e}\n", p[0], p[1], p[2]);
+    }
+    for tri in &t {
+        obj += &format!("f {} {} {}\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
+    }
+    let file = dir.join("edge.obj");
+    std::fs::write(&file, obj).unwrap();
+    let from_file = format!(
+        "mesh_file = {{ file = \"{}\", front = [{}] }}",
+        file.display(),
+        join(front.iter().map(|&i| point(&v[i])).collect())
+    );
+    let a = common::history(&edge_crack_block(&inline));
+    let b = common::history(&edge_crack_block(&from_file));
+    assert!(
+        a.fracture.iter().any(|r| r.j[0] > 0.0),
+        "the front measures J"
+    );
+    assert_eq!(format!("{:?}", a.fracture), format!("{:?}", b.fracture));
+    assert_eq!(format!("{:?}", a.rows), format!("{:?}", b.rows));
+    let wrong = format!(
+        "mesh_file = {{ file = \"{}\", front = [[0.005, 0.0065, 0.0]] }}",
+        file.display()
+    );
+    let e = match Source::parse("bad.toml", &edge_crack_block(&wrong), &[]) {
+        Ok(src) => build::<D3>(&src).err().unwrap().to_string(),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("crack[0].mesh_file.front[0]") && e.contains("no vertex"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(dir).ok();
+}

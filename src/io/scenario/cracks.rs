@@ -217,6 +217,7 @@ fn polyline<D: Dim>(src: &Source, c: usize, spec: &CrackSpec, geom: &GridGeom<D>
     let key = |k: &str| format!("crack[{c}].{k}");
     let surface_key = [
         ("mesh", spec.mesh.is_some()),
+        ("mesh_file", spec.mesh_file.is_some()),
         ("rectangle", spec.rectangle.is_some()),
         ("ellipse", spec.ellipse.is_some()),
         ("penny", spec.penny.is_some()),

@@ -1,10 +1,11 @@
-//! `body.mesh`: a body bounded by the closed surface in an STL file (read with `stl_io`) or
-//! an OBJ file (`tobj`), placed by its scale, rotation and offset, and checked (closed,
-//! consistently oriented, nothing degenerate) with the file and the triangle named in
-//! every error.
+//! Surfaces read from files: `body.mesh`, a body bounded by the closed surface in an STL
+//! file (read with `stl_io`) or an OBJ file (`tobj`), and `crack.mesh_file`, a crack
+//! surface from either; each placed by its scale, rotation and offset, with the file and
+//! the triangle named in every error.
 
-use super::schema::MeshBodySpec;
+use super::schema::{CrackFileSpec, MeshBodySpec, RotateSpec};
 use super::source::Source;
+use super::surface::Surface;
 use crate::base::error::ScenarioError;
 use crate::base::geometry::ClosedSurface;
 use crate::physics::bodies::Solid;
@@ -13,23 +14,127 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+type R<T> = Result<T, ScenarioError>;
+
 /// Largest mesh file read (bytes): 1 GiB, some 20 million binary triangles.
 const MAX_BYTES: u64 = 1 << 30;
 
-/// The solid bounded by the surface `spec` names.
-pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> Result<Solid, ScenarioError> {
-    let scale = spec.scale.unwrap_or(1.0);
+/// Vertices in the file's order and triangles as indices into them.
+type Indexed = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+/// The solid bounded by the surface `spec` names (checked closed and oriented one way).
+pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> R<Solid> {
+    let place = placement(src, key, spec.scale, spec.rotate.as_ref(), &spec.translate)?;
+    let (path, refuse) = file(src, key, &spec.file)?;
+    let ext = extension(&path);
+    let (positions, triangles) = match ext.as_str() {
+        "stl" => read_stl(&path),
+        "obj" => read_obj(&path),
+        _ => Err(
+            "not an .stl or .obj file: bodies are read from STL (ASCII or binary) and \
+                  OBJ so far"
+                .into(),
+        ),
+    }
+    .map_err(&refuse)?;
+    finite(&positions, &triangles).map_err(&refuse)?;
+    let (unique, triangles) = merge(&positions, &triangles);
+    let vertices = unique.into_iter().map(|v| place(v).to_array()).collect();
+    let surface = ClosedSurface::new(vertices, triangles).map_err(|d| refuse(d.to_string()))?;
+    Ok(Solid::Mesh(Arc::new(surface)))
+}
+
+/// The crack surface `spec` names (vertices placed), for the crack surface's own checks; the front's positions are matched to the file's vertices.
+pub(super) fn crack_mesh(src: &Source, key: &str, spec: &CrackFileSpec) -> R<Surface> {
+    let place = placement(src, key, spec.scale, spec.rotate.as_ref(), &spec.translate)?;
+    let (path, refuse) = file(src, key, &spec.file)?;
+    let (positions, triangles) = match extension(&path).as_str() {
+        "stl" => read_stl(&path),
+        "obj" => read_obj(&path),
+        _ => {
+            Err("not an .stl or .obj file: crack surfaces are read from STL and OBJ so far".into())
+        }
+    }
+    .map_err(&refuse)?;
+    finite(&positions, &triangles).map_err(&refuse)?;
+    let (unique, triangles) = merge(&positions, &triangles);
+    // Positions typed in the scenario match the file's to round-off of its own size.
+    let (lo, hi) = unique.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(DVec3::from_array(*v)), hi.max(DVec3::from_array(*v))),
+    );
+    let tol = 1e-9 * (hi - lo).length();
+    let mut front = Vec::new();
+    for (k, p) in spec.front.iter().flatten().enumerate() {
+        let at = format!("{key}.front[{k}]");
+        let p = match p.as_slice() {
+            [x, y, z] if p.iter().all(|c| c.is_finite()) => DVec3::new(*x, *y, *z),
+            _ => return Err(src.error(&at, "give [x, y, z] in the file's units, finite")),
+        };
+        let nearest = (0..unique.len())
+            .min_by(|&a, &b| {
+                let d = |i: usize| DVec3::from_array(unique[i]).distance(p);
+                d(a).total_cmp(&d(b))
+            })
+            .filter(|&i| DVec3::from_array(unique[i]).distance(p) <= tol);
+        match nearest {
+            Some(i) if !front.contains(&(i as u32)) => front.push(i as u32),
+            Some(_) => return Err(src.error(&at, "this front vertex is listed twice")),
+            None => {
+                return Err(src.error(
+                    &at,
+                    format!("no vertex of the file lies at ({}, {}, {})", p.x, p.y, p.z),
+                ));
+            }
+        }
+    }
+    Ok(Surface {
+        vertices: unique.into_iter().map(place).collect(),
+        triangles,
+        front,
+    })
+}
+
+/// Corners at the same place are one vertex (-0.0 and 0.0 too), numbered in order of
+/// first use.
+fn merge(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Indexed {
+    let (mut unique, mut index) = (Vec::new(), HashMap::new());
+    let triangles = (triangles.iter())
+        .map(|tri| {
+            tri.map(|i| {
+                let v = positions[i as usize];
+                *index
+                    .entry(v.map(|c| (c + 0.0).to_bits()))
+                    .or_insert_with(|| {
+                        unique.push(v);
+                        (unique.len() - 1) as u32
+                    })
+            })
+        })
+        .collect();
+    (unique, triangles)
+}
+
+/// x = R (scale x_file) + translate, from the keys under `key`.
+fn placement(
+    src: &Source,
+    key: &str,
+    scale: Option<f64>,
+    rotate: Option<&RotateSpec>,
+    translate: &Option<Vec<f64>>,
+) -> R<impl Fn([f64; 3]) -> DVec3 + use<>> {
+    let scale = scale.unwrap_or(1.0);
     if !(scale.is_finite() && scale > 0.0) {
         return Err(src.error(&format!("{key}.scale"), "give a finite factor > 0"));
     }
-    let translate = match &spec.translate {
-        None => [0.0; 3],
-        Some(t) if t.len() == 3 && t.iter().all(|c| c.is_finite()) => [t[0], t[1], t[2]],
+    let translate = match translate {
+        None => DVec3::ZERO,
+        Some(t) if t.len() == 3 && t.iter().all(|c| c.is_finite()) => DVec3::new(t[0], t[1], t[2]),
         Some(_) => {
             return Err(src.error(&format!("{key}.translate"), "give [x, y, z] in m, finite"));
         }
     };
-    let rotation = match &spec.rotate {
+    let rotation = match rotate {
         None => DMat3::IDENTITY,
         Some(r) => {
             let axis = (r.axis.len() == 3 && r.axis.iter().all(|c| c.is_finite()))
@@ -48,9 +153,24 @@ pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> Result<Soli
             }
         }
     };
-    let path = resolve(src, &spec.file);
-    let name = path.display().to_string();
-    let refuse = |message: String| src.error(&format!("{key}.file"), format!("{name}: {message}"));
+    Ok(move |v: [f64; 3]| rotation * DVec3::from_array(v.map(|c| c * scale)) + translate)
+}
+
+/// The path of `name` (relative to the scenario file's folder), checked to be a regular
+/// file of at most [`MAX_BYTES`], and how to refuse it, naming the key and the file.
+fn file<'a>(
+    src: &'a Source,
+    key: &str,
+    name: &str,
+) -> R<(PathBuf, impl Fn(String) -> ScenarioError + use<'a>)> {
+    let given = Path::new(name);
+    let path = match Path::new(&src.file).parent() {
+        Some(dir) if given.is_relative() => dir.join(given),
+        _ => given.to_path_buf(),
+    };
+    let shown = path.display().to_string();
+    let file_key = format!("{key}.file");
+    let refuse = move |message: String| src.error(&file_key, format!("{shown}: {message}"));
     let meta = std::fs::metadata(&path).map_err(|e| refuse(format!("cannot read it: {e}")))?;
     if !meta.is_file() {
         return Err(refuse("not a regular file".into()));
@@ -61,62 +181,42 @@ pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> Result<Soli
             meta.len()
         )));
     }
-    let ext = (path.extension().and_then(|e| e.to_str()))
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    let soup = match ext.as_str() {
-        "stl" => read_stl(&path),
-        "obj" => read_obj(&path),
-        _ => Err(
-            "not an .stl or .obj file: bodies are read from STL (ASCII or binary) and \
-                  OBJ so far"
-                .into(),
-        ),
-    }
-    .map_err(refuse)?;
-    if let Some(t) = soup
-        .iter()
-        .position(|t| t.iter().flatten().any(|c| !c.is_finite()))
-    {
-        return Err(refuse(format!("triangle {t}: a coordinate is not finite")));
-    }
-    // Corners at the same place in the file are one vertex (-0.0 and 0.0 too).
-    let (mut vertices, mut index) = (Vec::new(), HashMap::new());
-    let place = |v: [f32; 3]| {
-        let x = rotation * DVec3::from_array(v.map(|c| f64::from(c) * scale));
-        (x + DVec3::from_array(translate)).to_array()
-    };
-    let triangles = (soup.iter())
-        .map(|tri| {
-            tri.map(|v| {
-                let key = v.map(|c| (c + 0.0).to_bits());
-                *index.entry(key).or_insert_with(|| {
-                    vertices.push(place(v));
-                    (vertices.len() - 1) as u32
-                })
-            })
-        })
-        .collect();
-    let surface = ClosedSurface::new(vertices, triangles).map_err(|d| refuse(d.to_string()))?;
-    Ok(Solid::Mesh(Arc::new(surface)))
+    Ok((path, refuse))
 }
 
-/// The triangles of an STL file (ASCII or binary), corner by corner.
-fn read_stl(path: &Path) -> Result<Vec<[[f32; 3]; 3]>, String> {
+fn extension(path: &Path) -> String {
+    (path.extension().and_then(|e| e.to_str()))
+        .unwrap_or("")
+        .to_ascii_lowercase()
+}
+
+/// Refuses a triangle with a corner that is not finite, naming it.
+fn finite(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(), String> {
+    let bad = |i: &u32| positions[*i as usize].iter().any(|c| !c.is_finite());
+    match triangles.iter().position(|t| t.iter().any(bad)) {
+        Some(t) => Err(format!("triangle {t}: a coordinate is not finite")),
+        None => Ok(()),
+    }
+}
+
+/// The triangles of an STL file (ASCII or binary), three corners each in file order.
+fn read_stl(path: &Path) -> Result<Indexed, String> {
     let mut file = std::fs::File::open(path).map_err(|e| format!("cannot open it: {e}"))?;
     let reader = stl_io::create_stl_reader(&mut file)
         .map_err(|e| format!("not a readable STL file: {e}"))?;
-    (reader.enumerate())
-        .map(|(t, tri)| {
-            tri.map(|tri| tri.vertices.map(|v| v.0))
-                .map_err(|e| format!("triangle {t}: {e}"))
-        })
-        .collect()
+    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+    for (t, tri) in reader.enumerate() {
+        let tri = tri.map_err(|e| format!("triangle {t}: {e}"))?;
+        let first = positions.len() as u32;
+        positions.extend(tri.vertices.map(|v| v.0.map(f64::from)));
+        triangles.push([first, first + 1, first + 2]);
+    }
+    Ok((positions, triangles))
 }
 
-/// The faces of an OBJ file, split into triangles (`tobj`; materials, points and lines
-/// are ignored), corner by corner, all its objects together.
-fn read_obj(path: &Path) -> Result<Vec<[[f32; 3]; 3]>, String> {
+/// The vertices of an OBJ file in its order, all its objects together, and its faces split
+/// into triangles (`tobj`; materials, points and lines are ignored).
+fn read_obj(path: &Path) -> Result<Indexed, String> {
     let file = std::fs::File::open(path).map_err(|e| format!("cannot open it: {e}"))?;
     let options = tobj::LoadOptions {
         triangulate: true,
@@ -128,34 +228,20 @@ fn read_obj(path: &Path) -> Result<Vec<[[f32; 3]; 3]>, String> {
         Err(tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| format!("not a readable OBJ file: {e}"))?;
-    let mut out = Vec::new();
+    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
     for m in &models {
-        let p = &m.mesh.positions;
-        let corner = |i: u32| -> Option<[f32; 3]> {
-            let i = 3 * i as usize;
-            p.get(i..i + 3).map(|c| [c[0], c[1], c[2]])
-        };
-        for (k, f) in m.mesh.indices.chunks(3).enumerate() {
-            let tri = [f[0], f[1], f[2]].map(corner);
-            match tri {
-                [Some(a), Some(b), Some(c)] => out.push([a, b, c]),
-                _ => {
-                    return Err(format!(
-                        "object `{}`, face {k}: a vertex index past the end",
-                        m.name
-                    ));
-                }
+        let first = positions.len() as u32;
+        let count = (m.mesh.positions.len() / 3) as u32;
+        positions.extend(m.mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+        for (k, f) in m.mesh.indices.chunks_exact(3).enumerate() {
+            if f.iter().any(|&i| i >= count) {
+                return Err(format!(
+                    "object `{}`, face {k}: a vertex index past the end",
+                    m.name
+                ));
             }
+            triangles.push([f[0] + first, f[1] + first, f[2] + first]);
         }
     }
-    Ok(out)
-}
-
-/// `file` taken relative to the scenario file's folder (as given when absolute).
-fn resolve(src: &Source, file: &str) -> PathBuf {
-    let given = Path::new(file);
-    match Path::new(&src.file).parent() {
-        Some(dir) if given.is_relative() => dir.join(given),
-        _ => given.to_path_buf(),
-    }
+    Ok((positions, triangles))
 }

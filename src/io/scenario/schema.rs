@@ -197,6 +197,25 @@ pub struct MeshBodySpec {
     pub translate: Option<Vec<f64>>,
 }
 
+/// A crack surface read from an OBJ or STL file (faces split into triangles, all objects
+/// together, corners at one place one vertex), placed by x = R (scale * x_file) +
+/// translate.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrackFileSpec {
+    /// The file, relative to the scenario file's folder.
+    pub file: String,
+    /// Factor from the file's units to metres (default 1).
+    pub scale: Option<f64>,
+    /// Rotation after scaling, before the offset.
+    pub rotate: Option<RotateSpec>,
+    /// Offset after scaling and rotating (m).
+    pub translate: Option<Vec<f64>>,
+    /// Front vertices in order along the front, as positions in the file's units
+    /// (default: no front).
+    pub front: Option<Vec<Vec<f64>>>,
+}
+
 /// A rotation by `angle` degrees about `axis` (right-handed).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -303,6 +322,8 @@ pub struct CrackSpec {
     pub line: Option<LineSpec>,
     /// 3D: a triangle mesh given as vertex and triangle lists.
     pub mesh: Option<MeshSpec>,
+    /// 3D: a triangle mesh read from an OBJ file.
+    pub mesh_file: Option<CrackFileSpec>,
     /// 3D: a planar rectangle (no front: a crack cutting through a body).
     pub rectangle: Option<PlanarSpec>,
     /// 3D: a planar ellipse, whole (an embedded crack) or half (a surface crack).

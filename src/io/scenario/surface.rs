@@ -1,6 +1,7 @@
-//! 3D crack surfaces: triangle meshes from vertex and triangle lists, or generated from
-//! rectangles, ellipses (whole or half) and pennies, with the checks a crack surface needs
-//! (indices in range, no degenerate triangle, a manifold surface oriented one way).
+//! 3D crack surfaces: triangle meshes from vertex and triangle lists or OBJ files, or
+//! generated from rectangles, ellipses (whole or half) and pennies, with the checks a crack
+//! surface needs (indices in range, no degenerate triangle, a manifold surface oriented one
+//! way).
 
 use super::check::{MIN_FOLD_ANGLE, positive, vec3};
 use super::schema::{CrackSpec, EllipseSpec, MeshSpec, PennySpec, PlanarSpec};
@@ -46,33 +47,41 @@ pub(super) fn surface(src: &Source, c: usize, spec: &CrackSpec, cell: f64) -> R<
         };
         return Err(src.error(
             &key(k),
-            "a 3D crack is a surface: give `mesh`, `rectangle`, `ellipse` or `penny`",
+            "a 3D crack is a surface: give `mesh`, `mesh_file`, `rectangle`, `ellipse` or \
+             `penny`",
         ));
     }
     let spacing = |s: Option<f64>, k: &str| match s {
         Some(s) => positive(src, &key(k), s, "m"),
         None => Ok(0.5 * cell),
     };
-    let (surface, what) = match (&spec.mesh, &spec.rectangle, &spec.ellipse, &spec.penny) {
-        (Some(m), None, None, None) => (mesh(src, c, m)?, "mesh"),
-        (None, Some(r), None, None) => {
+    let given = [spec.mesh.is_some(), spec.mesh_file.is_some()];
+    let (surface, what) = match (&spec.mesh_file, &spec.rectangle, &spec.ellipse, &spec.penny) {
+        (Some(f), None, None, None) if given == [false, true] => (
+            super::mesh_body::crack_mesh(src, &key("mesh_file"), f)?,
+            "mesh_file",
+        ),
+        (None, None, None, None) if given == [true, false] => {
+            (mesh(src, c, spec.mesh.as_ref().expect("given"))?, "mesh")
+        }
+        (None, Some(r), None, None) if given == [false, false] => {
             let h = spacing(r.spacing, "rectangle.spacing")?;
             let k = key("rectangle.spacing");
             (rectangle(src, c, r, h, &k)?, "rectangle")
         }
-        (None, None, Some(e), None) => {
+        (None, None, Some(e), None) if given == [false, false] => {
             let h = spacing(e.spacing, "ellipse.spacing")?;
             let k = key("ellipse.spacing");
             (ellipse(src, c, e, h, OVERHANG_CELLS * cell, &k)?, "ellipse")
         }
-        (None, None, None, Some(p)) => {
+        (None, None, None, Some(p)) if given == [false, false] => {
             let h = spacing(p.spacing, "penny.spacing")?;
             (penny(src, c, p, h, &key("penny.spacing"))?, "penny")
         }
         _ => {
             return Err(src.error(
                 &format!("crack[{c}]"),
-                "give exactly one of `mesh`, `rectangle`, `ellipse` and `penny`",
+                "give exactly one of `mesh`, `mesh_file`, `rectangle`, `ellipse` and `penny`",
             ));
         }
     };
