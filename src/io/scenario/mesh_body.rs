@@ -3,9 +3,8 @@
 //! surface from either; each placed by its scale, rotation and offset, with the file and
 //! the triangle named in every error.
 
-use super::schema::{CrackFileSpec, MeshBodySpec, RotateSpec};
+use super::schema::{MeshBodySpec, RotateSpec};
 use super::source::Source;
-use super::surface::Surface;
 use crate::base::error::ScenarioError;
 use crate::base::geometry::ClosedSurface;
 use crate::physics::bodies::Solid;
@@ -20,7 +19,7 @@ type R<T> = Result<T, ScenarioError>;
 const MAX_BYTES: u64 = 1 << 30;
 
 /// Vertices in the file's order and triangles as indices into them.
-type Indexed = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+pub(super) type Indexed = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
 /// The solid bounded by the surface `spec` names (checked closed and oriented one way).
 pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> R<Solid> {
@@ -44,60 +43,9 @@ pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> R<Solid> {
     Ok(Solid::Mesh(Arc::new(surface)))
 }
 
-/// The crack surface `spec` names (vertices placed), for the crack surface's own checks; the front's positions are matched to the file's vertices.
-pub(super) fn crack_mesh(src: &Source, key: &str, spec: &CrackFileSpec) -> R<Surface> {
-    let place = placement(src, key, spec.scale, spec.rotate.as_ref(), &spec.translate)?;
-    let (path, refuse) = file(src, key, &spec.file)?;
-    let (positions, triangles) = match extension(&path).as_str() {
-        "stl" => read_stl(&path),
-        "obj" => read_obj(&path),
-        _ => {
-            Err("not an .stl or .obj file: crack surfaces are read from STL and OBJ so far".into())
-        }
-    }
-    .map_err(&refuse)?;
-    finite(&positions, &triangles).map_err(&refuse)?;
-    let (unique, triangles) = merge(&positions, &triangles);
-    // Positions typed in the scenario match the file's to round-off of its own size.
-    let (lo, hi) = unique.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), v| (lo.min(DVec3::from_array(*v)), hi.max(DVec3::from_array(*v))),
-    );
-    let tol = 1e-9 * (hi - lo).length();
-    let mut front = Vec::new();
-    for (k, p) in spec.front.iter().flatten().enumerate() {
-        let at = format!("{key}.front[{k}]");
-        let p = match p.as_slice() {
-            [x, y, z] if p.iter().all(|c| c.is_finite()) => DVec3::new(*x, *y, *z),
-            _ => return Err(src.error(&at, "give [x, y, z] in the file's units, finite")),
-        };
-        let nearest = (0..unique.len())
-            .min_by(|&a, &b| {
-                let d = |i: usize| DVec3::from_array(unique[i]).distance(p);
-                d(a).total_cmp(&d(b))
-            })
-            .filter(|&i| DVec3::from_array(unique[i]).distance(p) <= tol);
-        match nearest {
-            Some(i) if !front.contains(&(i as u32)) => front.push(i as u32),
-            Some(_) => return Err(src.error(&at, "this front vertex is listed twice")),
-            None => {
-                return Err(src.error(
-                    &at,
-                    format!("no vertex of the file lies at ({}, {}, {})", p.x, p.y, p.z),
-                ));
-            }
-        }
-    }
-    Ok(Surface {
-        vertices: unique.into_iter().map(place).collect(),
-        triangles,
-        front,
-    })
-}
-
 /// Corners at the same place are one vertex (-0.0 and 0.0 too), numbered in order of
 /// first use.
-fn merge(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Indexed {
+pub(super) fn merge(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Indexed {
     let (mut unique, mut index) = (Vec::new(), HashMap::new());
     let triangles = (triangles.iter())
         .map(|tri| {
@@ -116,7 +64,7 @@ fn merge(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Indexed {
 }
 
 /// x = R (scale x_file) + translate, from the keys under `key`.
-fn placement(
+pub(super) fn placement(
     src: &Source,
     key: &str,
     scale: Option<f64>,
@@ -158,7 +106,7 @@ fn placement(
 
 /// The path of `name` (relative to the scenario file's folder), checked to be a regular
 /// file of at most [`MAX_BYTES`], and how to refuse it, naming the key and the file.
-fn file<'a>(
+pub(super) fn file<'a>(
     src: &'a Source,
     key: &str,
     name: &str,
@@ -184,14 +132,14 @@ fn file<'a>(
     Ok((path, refuse))
 }
 
-fn extension(path: &Path) -> String {
+pub(super) fn extension(path: &Path) -> String {
     (path.extension().and_then(|e| e.to_str()))
         .unwrap_or("")
         .to_ascii_lowercase()
 }
 
 /// Refuses a triangle with a corner that is not finite, naming it.
-fn finite(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(), String> {
+pub(super) fn finite(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(), String> {
     let bad = |i: &u32| positions[*i as usize].iter().any(|c| !c.is_finite());
     match triangles.iter().position(|t| t.iter().any(bad)) {
         Some(t) => Err(format!("triangle {t}: a coordinate is not finite")),
@@ -200,7 +148,7 @@ fn finite(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(), String> 
 }
 
 /// The triangles of an STL file (ASCII or binary), three corners each in file order.
-fn read_stl(path: &Path) -> Result<Indexed, String> {
+pub(super) fn read_stl(path: &Path) -> Result<Indexed, String> {
     let mut file = std::fs::File::open(path).map_err(|e| format!("cannot open it: {e}"))?;
     let reader = stl_io::create_stl_reader(&mut file)
         .map_err(|e| format!("not a readable STL file: {e}"))?;
@@ -216,7 +164,7 @@ fn read_stl(path: &Path) -> Result<Indexed, String> {
 
 /// The vertices of an OBJ file in its order, all its objects together, and its faces split
 /// into triangles (`tobj`; materials, points and lines are ignored).
-fn read_obj(path: &Path) -> Result<Indexed, String> {
+pub(super) fn read_obj(path: &Path) -> Result<Indexed, String> {
     let file = std::fs::File::open(path).map_err(|e| format!("cannot open it: {e}"))?;
     let options = tobj::LoadOptions {
         triangulate: true,

@@ -1,10 +1,11 @@
-//! 3D crack surfaces: triangle meshes from vertex and triangle lists or OBJ files, or
+//! 3D crack surfaces: triangle meshes from vertex and triangle lists or OBJ and STL files, or
 //! generated from rectangles, ellipses (whole or half) and pennies, with the checks a crack
 //! surface needs (indices in range, no degenerate triangle, a manifold surface oriented one
 //! way).
 
 use super::check::{MIN_FOLD_ANGLE, positive, vec3};
-use super::schema::{CrackSpec, EllipseSpec, MeshSpec, PennySpec, PlanarSpec};
+use super::mesh_body::{extension, file, finite, merge, placement, read_obj, read_stl};
+use super::schema::{CrackFileSpec, CrackSpec, EllipseSpec, MeshSpec, PennySpec, PlanarSpec};
 use super::source::Source;
 use crate::base::dim::D3;
 use crate::base::error::ScenarioError;
@@ -57,10 +58,9 @@ pub(super) fn surface(src: &Source, c: usize, spec: &CrackSpec, cell: f64) -> R<
     };
     let given = [spec.mesh.is_some(), spec.mesh_file.is_some()];
     let (surface, what) = match (&spec.mesh_file, &spec.rectangle, &spec.ellipse, &spec.penny) {
-        (Some(f), None, None, None) if given == [false, true] => (
-            super::mesh_body::crack_mesh(src, &key("mesh_file"), f)?,
-            "mesh_file",
-        ),
+        (Some(f), None, None, None) if given == [false, true] => {
+            (crack_mesh(src, &key("mesh_file"), f)?, "mesh_file")
+        }
         (None, None, None, None) if given == [true, false] => {
             (mesh(src, c, spec.mesh.as_ref().expect("given"))?, "mesh")
         }
@@ -156,6 +156,58 @@ fn mesh(src: &Source, c: usize, m: &MeshSpec) -> R<Surface> {
         .collect::<R<Vec<_>>>()?;
     Ok(Surface {
         vertices,
+        triangles,
+        front,
+    })
+}
+
+/// The crack surface in the file `spec` names (vertices placed), for the crack surface's
+/// own checks; the front's positions are matched to the file's vertices.
+fn crack_mesh(src: &Source, key: &str, spec: &CrackFileSpec) -> R<Surface> {
+    let place = placement(src, key, spec.scale, spec.rotate.as_ref(), &spec.translate)?;
+    let (path, refuse) = file(src, key, &spec.file)?;
+    let (positions, triangles) = match extension(&path).as_str() {
+        "stl" => read_stl(&path),
+        "obj" => read_obj(&path),
+        _ => {
+            Err("not an .stl or .obj file: crack surfaces are read from STL and OBJ so far".into())
+        }
+    }
+    .map_err(&refuse)?;
+    finite(&positions, &triangles).map_err(&refuse)?;
+    let (unique, triangles) = merge(&positions, &triangles);
+    // Positions typed in the scenario match the file's to round-off of its own size.
+    let (lo, hi) = unique.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(DVec3::from_array(*v)), hi.max(DVec3::from_array(*v))),
+    );
+    let tol = 1e-9 * (hi - lo).length();
+    let mut front = Vec::new();
+    for (k, p) in spec.front.iter().flatten().enumerate() {
+        let at = format!("{key}.front[{k}]");
+        let p = match p.as_slice() {
+            [x, y, z] if p.iter().all(|c| c.is_finite()) => DVec3::new(*x, *y, *z),
+            _ => return Err(src.error(&at, "give [x, y, z] in the file's units, finite")),
+        };
+        let nearest = (0..unique.len())
+            .min_by(|&a, &b| {
+                let d = |i: usize| DVec3::from_array(unique[i]).distance(p);
+                d(a).total_cmp(&d(b))
+            })
+            .filter(|&i| DVec3::from_array(unique[i]).distance(p) <= tol);
+        match nearest {
+            Some(i) if !front.contains(&(i as u32)) => front.push(i as u32),
+            Some(_) => return Err(src.error(&at, "this front vertex is listed twice")),
+            None => {
+                return Err(src.error(
+                    &at,
+                    format!("no vertex of the file lies at ({}, {}, {})", p.x, p.y, p.z),
+                ));
+            }
+        }
+    }
+    Ok(Surface {
+        vertices: unique.into_iter().map(place).collect(),
         triangles,
         front,
     })
