@@ -2,9 +2,11 @@
 //! scenarios (the long ones too: 3D crack meshes, growth, fatigue, plasticity, regions)
 //! with bytes deleted, replaced, inserted or lines repeated; with numbers replaced by
 //! extreme ones (0, negative, tiny, huge, NaN, infinities); and under random `--set`
-//! overrides. They either build the scene or return an error. 64 cases each by default;
-//! PROPTEST_CASES=100000 for a longer fuzzing session.
+//! and `--vary` arguments. They either build the scene or return an error, each case
+//! within a bounded time. 64 cases each by default; PROPTEST_CASES=20000 for a longer
+//! fuzzing session.
 
+use fissure::app::sweep::{Vary, combinations, run_count};
 use fissure::base::dim::{D2, D3};
 use fissure::io::scenario::{Source, build};
 use proptest::prelude::*;
@@ -29,9 +31,24 @@ fn shipped() -> &'static [String] {
     })
 }
 
+/// Longest a case may take to parse and build (s): the builder's work is bounded by the
+/// grid-size guard below, so a case past this is work growing without bound (a generous
+/// limit, for a loaded 2-core machine).
+const CASE_SECONDS: u64 = 30;
+
 /// Parses `text` with `overrides` and, when its grid is small enough to build in a
-/// moment, builds it.
+/// moment, builds it, in at most [`CASE_SECONDS`].
 fn parse_and_build(text: &str, overrides: &[String]) {
+    let start = std::time::Instant::now();
+    build_small(text, overrides);
+    let took = start.elapsed().as_secs();
+    assert!(
+        took < CASE_SECONDS,
+        "a case took {took} s: {overrides:?}\n{text}"
+    );
+}
+
+fn build_small(text: &str, overrides: &[String]) {
     let Ok(src) = Source::parse("fuzz.toml", text, overrides) else {
         return;
     };
@@ -201,6 +218,30 @@ proptest! {
             text = replace_number(&text, *k, EXTREMES[*v]);
         }
         parse_and_build(&text, &[]);
+    }
+
+    #[test]
+    fn vary_arguments_never_panic(
+        which in any::<usize>(),
+        args in proptest::collection::vec(
+            (0..KEYS.len(), proptest::collection::vec(0..VALUES.len(), 0..4), "[=,\\[\\]{}\"' a-z0-9.]{0,12}"),
+            1..3,
+        ),
+    ) {
+        let texts = shipped();
+        let mut vary = Vec::new();
+        for (k, values, noise) in &args {
+            let list: Vec<&str> = values.iter().map(|&v| VALUES[v]).collect();
+            let arg = format!("{}={}{noise}", KEYS[*k], list.join(","));
+            if let Ok(v) = Vary::parse(&arg) {
+                vary.push(v);
+            }
+        }
+        if run_count(&vary).is_some_and(|n| n <= 8) {
+            for set in combinations(&vary) {
+                parse_and_build(&texts[which % texts.len()], &set);
+            }
+        }
     }
 
     #[test]
