@@ -451,5 +451,18 @@ fn crack_from_an_obj_file_is_the_inline_mesh() {
         e.contains("crack[0].mesh_file.front[0]") && e.contains("no vertex"),
         "{e}"
     );
+    // The crack surface's own checks name the file: a front vertex off the boundary.
+    let inner = format!(
+        "mesh_file = {{ file = \"{}\", front = [[0.002, 0.0065, 0.001]] }}",
+        file.display()
+    );
+    let e = match Source::parse("bad.toml", &edge_crack_block(&inner), &[]) {
+        Ok(src) => build::<D3>(&src).err().unwrap().to_string(),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("crack[0].mesh_file") && e.contains("edge.obj") && e.contains("boundary"),
+        "{e}"
+    );
     std::fs::remove_dir_all(dir).ok();
 }

@@ -85,7 +85,13 @@ pub(super) fn surface(src: &Source, c: usize, spec: &CrackSpec, cell: f64) -> R<
             ));
         }
     };
-    check(src, &key(what), &surface)?;
+    check(src, &key(what), &surface).map_err(|mut e| {
+        // A surface read from a file is named in what its checks find.
+        if let Some(f) = &spec.mesh_file {
+            e.message = format!("{}: {}", f.file, e.message);
+        }
+        e
+    })?;
     Ok(surface)
 }
 
