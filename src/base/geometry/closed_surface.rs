@@ -157,16 +157,6 @@ impl ClosedSurface {
         (self.lo, self.hi)
     }
 
-    /// Number of triangles.
-    pub fn len(&self) -> usize {
-        self.triangles.len()
-    }
-
-    /// Whether the surface has no triangles (never, once built).
-    pub fn is_empty(&self) -> bool {
-        self.triangles.is_empty()
-    }
-
     /// The enclosed volume (m^3): the sum of the signed tetrahedra from the origin, made
     /// positive whichever way the triangles face.
     pub fn volume(&self) -> f64 {

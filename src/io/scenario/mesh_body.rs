@@ -25,27 +25,31 @@ pub(super) type Indexed = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> R<Solid> {
     let place = placement(src, key, spec.scale, spec.rotate.as_ref(), &spec.translate)?;
     let (path, refuse) = file(src, key, &spec.file)?;
-    let ext = extension(&path);
-    let (positions, triangles) = match ext.as_str() {
-        "stl" => read_stl(&path),
-        "obj" => read_obj(&path),
-        _ => Err(
-            "not an .stl or .obj file: bodies are read from STL (ASCII or binary) and \
-                  OBJ so far"
-                .into(),
-        ),
-    }
-    .map_err(&refuse)?;
-    finite(&positions, &triangles).map_err(&refuse)?;
-    let (unique, triangles) = merge(&positions, &triangles);
+    let (unique, triangles) = read(&path).map_err(&refuse)?;
     let vertices = unique.into_iter().map(|v| place(v).to_array()).collect();
     let surface = ClosedSurface::new(vertices, triangles).map_err(|d| refuse(d.to_string()))?;
     Ok(Solid::Mesh(Arc::new(surface)))
 }
 
+/// The triangles of the STL or OBJ file at `path` (by its extension), every coordinate
+/// finite, corners at one place one vertex.
+pub(super) fn read(path: &Path) -> Result<Indexed, String> {
+    let (positions, triangles) = match extension(path).as_str() {
+        "stl" => read_stl(path),
+        "obj" => read_obj(path),
+        _ => Err(
+            "not an .stl or .obj file: surfaces are read from STL (ASCII or binary) \
+                  and OBJ so far"
+                .into(),
+        ),
+    }?;
+    finite(&positions, &triangles)?;
+    Ok(merge(&positions, &triangles))
+}
+
 /// Corners at the same place are one vertex (-0.0 and 0.0 too), numbered in order of
 /// first use.
-pub(super) fn merge(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Indexed {
+fn merge(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Indexed {
     let (mut unique, mut index) = (Vec::new(), HashMap::new());
     let triangles = (triangles.iter())
         .map(|tri| {
@@ -132,14 +136,14 @@ pub(super) fn file<'a>(
     Ok((path, refuse))
 }
 
-pub(super) fn extension(path: &Path) -> String {
+fn extension(path: &Path) -> String {
     (path.extension().and_then(|e| e.to_str()))
         .unwrap_or("")
         .to_ascii_lowercase()
 }
 
 /// Refuses a triangle with a corner that is not finite, naming it.
-pub(super) fn finite(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(), String> {
+fn finite(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(), String> {
     let bad = |i: &u32| positions[*i as usize].iter().any(|c| !c.is_finite());
     match triangles.iter().position(|t| t.iter().any(bad)) {
         Some(t) => Err(format!("triangle {t}: a coordinate is not finite")),
@@ -148,7 +152,7 @@ pub(super) fn finite(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(
 }
 
 /// The triangles of an STL file (ASCII or binary), three corners each in file order.
-pub(super) fn read_stl(path: &Path) -> Result<Indexed, String> {
+fn read_stl(path: &Path) -> Result<Indexed, String> {
     let mut file = std::fs::File::open(path).map_err(|e| format!("cannot open it: {e}"))?;
     let reader = stl_io::create_stl_reader(&mut file)
         .map_err(|e| format!("not a readable STL file: {e}"))?;
@@ -164,7 +168,7 @@ pub(super) fn read_stl(path: &Path) -> Result<Indexed, String> {
 
 /// The vertices of an OBJ file in its order, all its objects together, and its faces split
 /// into triangles (`tobj`; materials, points and lines are ignored).
-pub(super) fn read_obj(path: &Path) -> Result<Indexed, String> {
+fn read_obj(path: &Path) -> Result<Indexed, String> {
     let file = std::fs::File::open(path).map_err(|e| format!("cannot open it: {e}"))?;
     let options = tobj::LoadOptions {
         triangulate: true,

@@ -4,7 +4,7 @@
 //! way).
 
 use super::check::{MIN_FOLD_ANGLE, positive, vec3};
-use super::mesh_body::{extension, file, finite, merge, placement, read_obj, read_stl};
+use super::mesh_body::{file, placement, read};
 use super::schema::{CrackFileSpec, CrackSpec, EllipseSpec, MeshSpec, PennySpec, PlanarSpec};
 use super::source::Source;
 use crate::base::dim::D3;
@@ -172,16 +172,7 @@ fn mesh(src: &Source, c: usize, m: &MeshSpec) -> R<Surface> {
 fn crack_mesh(src: &Source, key: &str, spec: &CrackFileSpec) -> R<Surface> {
     let place = placement(src, key, spec.scale, spec.rotate.as_ref(), &spec.translate)?;
     let (path, refuse) = file(src, key, &spec.file)?;
-    let (positions, triangles) = match extension(&path).as_str() {
-        "stl" => read_stl(&path),
-        "obj" => read_obj(&path),
-        _ => {
-            Err("not an .stl or .obj file: crack surfaces are read from STL and OBJ so far".into())
-        }
-    }
-    .map_err(&refuse)?;
-    finite(&positions, &triangles).map_err(&refuse)?;
-    let (unique, triangles) = merge(&positions, &triangles);
+    let (unique, triangles) = read(&path).map_err(&refuse)?;
     // Positions typed in the scenario match the file's to round-off of its own size.
     let (lo, hi) = unique.iter().fold(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
