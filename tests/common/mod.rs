@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: scenario text for bars, running to a history.
 #![allow(dead_code)]
 
+pub mod mesh;
+
 use fissure::app::run::{Outcome, RunOptions, run};
 use fissure::io::scenario::{Source, build};
 use fissure::pipeline::schedule::{Schedule, System};

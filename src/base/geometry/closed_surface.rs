@@ -1,5 +1,5 @@
-//! A closed, consistently oriented triangulated surface and the exact test of whether a
-//! point lies inside it: a body read from a mesh file.
+//! A closed triangulated surface, its triangles turned to agree with their neighbours, and
+//! the exact test of whether a point lies inside it: a body read from a mesh file.
 //!
 //! The test casts a ray from the point along +x and counts the triangles it crosses
 //! (ray parity). Each decision is an exact predicate (`robust`'s orient2d on the triangle's
@@ -35,13 +35,17 @@ pub enum SurfaceDefect {
         /// The edge's end points.
         edge: [[f64; 3]; 2],
     },
-    /// An edge traversed twice in the same direction (two neighbours facing opposite
-    /// ways) or shared by more than two triangles.
+    /// An edge shared by more than two triangles: the surface is not a manifold.
     Inconsistent {
         /// A triangle along the edge.
         triangle: usize,
         /// The edge's end points.
         edge: [[f64; 3]; 2],
+    },
+    /// Triangles that cannot all be turned to agree with their neighbours.
+    OneSided {
+        /// The triangle where turning failed.
+        triangle: usize,
     },
 }
 
@@ -65,11 +69,15 @@ impl std::fmt::Display for SurfaceDefect {
             ),
             SurfaceDefect::Inconsistent { triangle, edge } => write!(
                 f,
-                "the edge {} - {} of triangle {triangle} is shared by triangles facing \
-                 opposite ways or by more than two: orient every triangle the same way \
-                 (all outward or all inward) and keep the surface manifold",
+                "the edge {} - {} of triangle {triangle} is shared by more than two \
+                 triangles: the surface is not a manifold",
                 p(&edge[0]),
                 p(&edge[1])
+            ),
+            SurfaceDefect::OneSided { triangle } => write!(
+                f,
+                "the surface is one-sided: turning triangle {triangle} to agree with one \
+                 neighbour turns it against another"
             ),
         }
     }
@@ -90,8 +98,8 @@ pub struct ClosedSurface {
 }
 
 impl ClosedSurface {
-    /// Checks `triangles` over `vertices` and indexes them. The orientation may be outward
-    /// or inward, as long as it is the same everywhere.
+    /// Checks `triangles` over `vertices`, turns those that disagree with their neighbours
+    /// (the inside test does not depend on which way they face) and indexes them.
     pub fn new(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Result<Self, SurfaceDefect> {
         if triangles.is_empty() {
             return Err(SurfaceDefect::Empty);
@@ -115,7 +123,7 @@ impl ClosedSurface {
                 return Err(SurfaceDefect::Degenerate { triangle: t });
             }
         }
-        check_edges(&vertices, &triangles)?;
+        let triangles = orient(&vertices, &triangles)?;
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for v in &vertices {
             for a in 0..3 {
@@ -245,32 +253,72 @@ fn on_triangle(t: [[f64; 3]; 3], p: [f64; 3]) -> bool {
     s.iter().all(|&x| x >= 0.0) || s.iter().all(|&x| x <= 0.0)
 }
 
-/// Every edge must be traversed once each way: closed and consistently oriented.
-fn check_edges(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(), SurfaceDefect> {
-    let mut directed: HashMap<(u32, u32), usize> = HashMap::with_capacity(3 * triangles.len());
-    let edge = |(i, j): (u32, u32)| [vertices[i as usize], vertices[j as usize]];
+/// The triangles turned, where needed, to agree with their neighbours: every edge
+/// traversed once each way. The first triangle of each connected piece keeps its turn. An
+/// edge with one triangle leaves the surface open; one with more than two, or a piece that
+/// cannot be turned to agree (one-sided), is refused.
+fn orient(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Vec<[u32; 3]>, SurfaceDefect> {
+    let key = |i: u32, j: u32| (i.min(j), i.max(j));
+    let mut uses: HashMap<(u32, u32), Vec<usize>> = HashMap::with_capacity(3 * triangles.len());
     for (t, tri) in triangles.iter().enumerate() {
-        for e in [(tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])] {
-            if directed.insert(e, t).is_some() {
-                return Err(SurfaceDefect::Inconsistent {
-                    triangle: t,
-                    edge: edge(e),
-                });
+        for k in 0..3 {
+            uses.entry(key(tri[k], tri[(k + 1) % 3]))
+                .or_default()
+                .push(t);
+        }
+    }
+    let edge = |(i, j): (u32, u32)| [vertices[i as usize], vertices[j as usize]];
+    let mut bad: Vec<(usize, (u32, u32), bool)> = (uses.iter())
+        .filter(|(_, ts)| ts.len() != 2)
+        .map(|(&e, ts)| (ts[0], e, ts.len() == 1))
+        .collect();
+    bad.sort_unstable();
+    if let Some(&(triangle, e, open)) = bad.first() {
+        return Err(if open {
+            SurfaceDefect::Open {
+                triangle,
+                edge: edge(e),
+            }
+        } else {
+            SurfaceDefect::Inconsistent {
+                triangle,
+                edge: edge(e),
+            }
+        });
+    }
+    // Whether triangle t runs its edge i -> j (rather than j -> i).
+    let runs =
+        |tri: &[u32; 3], i: u32, j: u32| (0..3).any(|k| tri[k] == i && tri[(k + 1) % 3] == j);
+    let mut out = triangles.to_vec();
+    let mut done = vec![false; triangles.len()];
+    let mut stack = Vec::new();
+    for first in 0..triangles.len() {
+        if done[first] {
+            continue;
+        }
+        done[first] = true;
+        stack.push(first);
+        while let Some(t) = stack.pop() {
+            let tri = out[t];
+            for k in 0..3 {
+                let (i, j) = (tri[k], tri[(k + 1) % 3]);
+                let ts = &uses[&key(i, j)];
+                let n = if ts[0] == t { ts[1] } else { ts[0] };
+                if done[n] {
+                    if runs(&out[n], i, j) {
+                        return Err(SurfaceDefect::OneSided { triangle: n });
+                    }
+                    continue;
+                }
+                if runs(&out[n], i, j) {
+                    out[n].swap(1, 2);
+                }
+                done[n] = true;
+                stack.push(n);
             }
         }
     }
-    let mut open: Vec<(usize, (u32, u32))> = (directed.iter())
-        .filter(|((i, j), _)| !directed.contains_key(&(*j, *i)))
-        .map(|(&e, &t)| (t, e))
-        .collect();
-    open.sort_unstable();
-    match open.first() {
-        Some(&(t, e)) => Err(SurfaceDefect::Open {
-            triangle: t,
-            edge: edge(e),
-        }),
-        None => Ok(()),
-    }
+    Ok(out)
 }
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
@@ -319,12 +367,16 @@ mod tests {
 
     /// Inside, outside and on the cube, including points whose rays run along its faces
     /// and through its edges and vertices: every one decided as the box would, with the
-    /// triangles in either orientation and any order.
+    /// triangles in either orientation, any order, or some turned against the rest.
     #[test]
     fn cube_decides_like_a_box() {
         let (v, t) = cube();
         let flipped: Vec<[u32; 3]> = t.iter().rev().map(|[a, b, c]| [*a, *c, *b]).collect();
-        for tris in [t, flipped] {
+        let mut mixed = t.clone();
+        for k in [3, 4, 9] {
+            mixed[k].swap(0, 1);
+        }
+        for tris in [t, flipped, mixed] {
             let s = ClosedSurface::new(v.clone(), tris).unwrap();
             assert!((s.volume() - 1.0).abs() < 1e-15);
             let vals = [-0.5, 0.0, 0.25, 0.5, 1.0, 1.5];
@@ -339,16 +391,17 @@ mod tests {
         }
     }
 
-    /// A surface with a hole, one with a triangle turned over, a degenerate triangle and a
-    /// NaN coordinate are refused, naming what is wrong.
+    /// A surface with a hole, one with an edge of three triangles (a fin inside the cube),
+    /// a degenerate triangle and a NaN coordinate are refused, naming what is wrong.
     #[test]
     fn defects_are_named() {
         let (v, t) = cube();
         let open = ClosedSurface::new(v.clone(), t[1..].to_vec()).unwrap_err();
         assert!(matches!(open, SurfaceDefect::Open { .. }), "{open}");
-        let mut turned = t.clone();
-        turned[3] = [turned[3][0], turned[3][2], turned[3][1]];
-        let e = ClosedSurface::new(v.clone(), turned).unwrap_err();
+        let mut fin = t.clone();
+        fin.push([0, 1, 2]);
+        fin.push([0, 2, 1]);
+        let e = ClosedSurface::new(v.clone(), fin).unwrap_err();
         assert!(matches!(e, SurfaceDefect::Inconsistent { .. }), "{e}");
         let mut flat = t.clone();
         flat.push([0, 0, 1]);

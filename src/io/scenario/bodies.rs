@@ -27,6 +27,8 @@ pub(super) struct Filled<D: Dim> {
     pub used: Vec<bool>,
     /// The tiles the particles are ordered by.
     pub tiles: Tiles,
+    /// Each body's region, in the order listed (where a crack's front may lie).
+    pub claims: Vec<Claim>,
 }
 
 /// Fills every `[[body]]` in order (the first listed keeps a point two bodies share),
@@ -101,6 +103,7 @@ pub(super) fn bodies<D: Dim>(
         ppc,
         used,
         tiles,
+        claims,
     })
 }
 

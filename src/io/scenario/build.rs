@@ -52,7 +52,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         super::expects::expects::<D>(src, &probes, &geom, &materials, sim.plane, sim.thickness)?;
     let output = output_plan(src, sim.duration)?;
     let checkpoint = checkpoint_plan(src)?;
-    let cracks = super::cracks::build::<D>(src, &particles, &materials, &geom, dt)?;
+    let cracks = super::cracks::build::<D>(src, &particles, &filled.claims, &materials, &geom, dt)?;
     let fracture = super::cracks::fracture_plan(src, cracks.as_ref(), &geom)?;
     super::cracks::check_front_expects(src, &expects, cracks.as_ref(), geom.min_cell())?;
     if fracture.is_some() {

@@ -1,6 +1,7 @@
 //! Building the crack store from `[[crack]]` tables, with every check a crack needs.
 
 use super::check::{MIN_FOLD_ANGLE, positive, to_vec, vec3};
+use super::claim::Claim;
 use super::schema::{AlongSpec, CrackSpec, ExpectSpec, FractureSpec};
 use super::source::Source;
 use super::surface;
@@ -30,6 +31,7 @@ const REACH_CELLS: f64 = 2.0;
 pub(super) fn build<D: Dim>(
     src: &Source,
     particles: &Particles<D>,
+    bodies: &[Claim],
     materials: &[Material],
     geom: &GridGeom<D>,
     dt: f64,
@@ -47,7 +49,7 @@ pub(super) fn build<D: Dim>(
     let occupied = Occupied::new(particles, geom);
     let mut store = Cracks::<D>::default();
     for (c, spec) in specs.iter().enumerate() {
-        let piece = piece::<D>(src, c, spec, geom)?;
+        let piece = piece::<D>(src, c, spec, geom, bodies)?;
         placed(src, &piece, geom, &occupied)?;
         apart(src, &store, &piece, geom)?;
         let contact = contact(src, c, spec)?;
@@ -100,12 +102,19 @@ pub(super) fn build<D: Dim>(
 }
 
 /// Crack `c` as a piece: a polyline in 2D, a triangulated surface in 3D that does not meet
-/// itself.
-fn piece<D: Dim>(src: &Source, c: usize, spec: &CrackSpec, geom: &GridGeom<D>) -> R<Piece<D>> {
+/// itself (its front, when read from a file and not given, where it lies in `bodies`).
+fn piece<D: Dim>(
+    src: &Source,
+    c: usize,
+    spec: &CrackSpec,
+    geom: &GridGeom<D>,
+    bodies: &[Claim],
+) -> R<Piece<D>> {
     if D::D == 2 {
         return polyline::<D>(src, c, spec, geom);
     }
-    let s = surface::surface(src, c, spec, geom.min_cell())?;
+    let inside = |x: DVec3| bodies.iter().any(|b| b.contains(x.to_array(), 3));
+    let s = surface::surface(src, c, spec, geom.min_cell(), &inside)?;
     let piece = Piece {
         key: format!("crack[{c}]"),
         points: s
@@ -126,10 +135,11 @@ fn piece<D: Dim>(src: &Source, c: usize, spec: &CrackSpec, geom: &GridGeom<D>) -
     };
     let tol = 1e-6 * geom.min_cell();
     if let Some((a, b)) = super::crack_meet::self_meets::<D>(&piece.points, &piece.elems, tol) {
+        let file = (spec.mesh_file.as_ref()).map_or(String::new(), |f| format!("{}: ", f.file));
         return Err(src.error(
             &piece.key,
             format!(
-                "the surface meets itself (triangles {a} and {b}, which share no \
+                "{file}the surface meets itself (triangles {a} and {b}, which share no \
                  vertex, cross or touch)"
             ),
         ));

@@ -1,12 +1,13 @@
 //! Surfaces read from files: `body.mesh`, a body bounded by the closed surface in an STL
-//! file (read with `stl_io`) or an OBJ file (`tobj`), and `crack.mesh_file`, a crack
-//! surface from either; each placed by its scale, rotation and offset, with the file and
-//! the triangle named in every error.
+//! file (read with `stl_io`), an OBJ file (`tobj`) or a Gmsh MSH file (`mshio`, see
+//! [`super::msh`]), and `crack.mesh_file`, a crack surface from any of them; each placed by
+//! its scale, rotation and offset, with the file and the triangle named in every error.
 
 use super::schema::{MeshBodySpec, RotateSpec};
 use super::source::Source;
+use crate::base::dim::D3;
 use crate::base::error::ScenarioError;
-use crate::base::geometry::ClosedSurface;
+use crate::base::geometry::{ClosedSurface, Element, Triangle};
 use crate::physics::bodies::Solid;
 use glam::{DMat3, DVec3};
 use std::collections::HashMap;
@@ -18,6 +19,10 @@ type R<T> = Result<T, ScenarioError>;
 /// Largest mesh file read (bytes): 1 GiB, some 20 million binary triangles.
 const MAX_BYTES: u64 = 1 << 30;
 
+/// How close (a fraction of the surface's size) two triangles sharing no vertex may come
+/// before the surface is taken to meet itself.
+const SELF_MEET: f64 = 1e-9;
+
 /// Vertices in the file's order and triangles as indices into them.
 pub(super) type Indexed = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
@@ -26,8 +31,22 @@ pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> R<Solid> {
     let place = placement(src, key, spec.scale, spec.rotate.as_ref(), &spec.translate)?;
     let (path, refuse) = file(src, key, &spec.file)?;
     let (unique, triangles) = read(&path).map_err(&refuse)?;
-    let vertices = unique.into_iter().map(|v| place(v).to_array()).collect();
-    let surface = ClosedSurface::new(vertices, triangles).map_err(|d| refuse(d.to_string()))?;
+    let points: Vec<DVec3> = unique.into_iter().map(place).collect();
+    let vertices = points.iter().map(|v| v.to_array()).collect();
+    let surface =
+        ClosedSurface::new(vertices, triangles.clone()).map_err(|d| refuse(d.to_string()))?;
+    let elems: Vec<Triangle> = triangles
+        .iter()
+        .map(|t| Triangle::from_vertices(t))
+        .collect();
+    let (lo, hi) = surface.bounds();
+    let tol = SELF_MEET * DVec3::from(hi).distance(DVec3::from(lo));
+    if let Some((a, b)) = super::crack_meet::self_meets::<D3>(&points, &elems, tol) {
+        return Err(refuse(format!(
+            "the surface meets itself: triangles {a} and {b}, which share no vertex, cross \
+             or touch"
+        )));
+    }
     Ok(Solid::Mesh(Arc::new(surface)))
 }
 
@@ -37,9 +56,10 @@ pub(super) fn read(path: &Path) -> Result<Indexed, String> {
     let (positions, triangles) = match extension(path).as_str() {
         "stl" => read_stl(path),
         "obj" => read_obj(path),
+        "msh" => super::msh::read_msh(path),
         _ => Err(
-            "not an .stl or .obj file: surfaces are read from STL (ASCII or binary) \
-                  and OBJ so far"
+            "not an .stl, .obj or .msh file: surfaces are read from STL (ASCII or \
+                  binary), OBJ and Gmsh MSH 4.1 files"
                 .into(),
         ),
     }?;

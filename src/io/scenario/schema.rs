@@ -212,7 +212,7 @@ pub struct CrackFileSpec {
     /// Offset after scaling and rotating (m).
     pub translate: Option<Vec<f64>>,
     /// Front vertices in order along the front, as positions in the file's units
-    /// (default: no front).
+    /// (default: the boundary edges inside a body; `[]`: no front).
     pub front: Option<Vec<Vec<f64>>>,
 }
 

@@ -4,6 +4,7 @@
 //! way).
 
 use super::check::{MIN_FOLD_ANGLE, positive, vec3};
+use super::crack_front::found_front;
 use super::mesh_body::{file, placement, read};
 use super::schema::{CrackFileSpec, CrackSpec, EllipseSpec, MeshSpec, PennySpec, PlanarSpec};
 use super::source::Source;
@@ -35,8 +36,15 @@ pub(super) struct Surface {
 }
 
 /// The surface of 3D crack `c`, generated or read, and checked; `cell` is the smallest
-/// cell size (m), the default spacing.
-pub(super) fn surface(src: &Source, c: usize, spec: &CrackSpec, cell: f64) -> R<Surface> {
+/// cell size (m), the default spacing. A surface read from a file without a `front` takes
+/// the boundary edges that lie `inside` a body.
+pub(super) fn surface(
+    src: &Source,
+    c: usize,
+    spec: &CrackSpec,
+    cell: f64,
+    inside: &dyn Fn(DVec3) -> bool,
+) -> R<Surface> {
     let key = |k: &str| format!("crack[{c}].{k}");
     if spec.points.is_some() || spec.line.is_some() || spec.tips.is_some() {
         let k = if spec.points.is_some() {
@@ -85,13 +93,20 @@ pub(super) fn surface(src: &Source, c: usize, spec: &CrackSpec, cell: f64) -> R<
             ));
         }
     };
-    check(src, &key(what), &surface).map_err(|mut e| {
+    let named = |mut e: ScenarioError| {
         // A surface read from a file is named in what its checks find.
         if let Some(f) = &spec.mesh_file {
             e.message = format!("{}: {}", f.file, e.message);
         }
         e
-    })?;
+    };
+    check(src, &key(what), &surface).map_err(named)?;
+    let mut surface = surface;
+    if spec.mesh_file.as_ref().is_some_and(|f| f.front.is_none()) {
+        let front = found_front(&surface.vertices, &surface.triangles, inside)
+            .map_err(|m| named(src.error(&key("mesh_file"), m)))?;
+        surface.front = front;
+    }
     Ok(surface)
 }
 
