@@ -2,25 +2,11 @@
 //! the built-in geometry where the two coincide, and bad files are refused by name.
 
 mod common;
-use common::mesh::{Block, folder, msh, positions, scene};
+use common::mesh::{Block, folder, msh, positions, scene, write_stl};
 use common::source;
 use fissure::base::dim::D3;
 use fissure::base::geometry::ClosedSurface;
 use fissure::io::scenario::{Source, build};
-use std::path::Path;
-
-/// Writes `triangles` as a binary STL file.
-fn write_stl(path: &Path, triangles: &[[[f32; 3]; 3]]) {
-    let tris: Vec<stl_io::Triangle> = triangles
-        .iter()
-        .map(|t| stl_io::Triangle {
-            normal: stl_io::Normal::new([0.0; 3]),
-            vertices: t.map(stl_io::Vertex::new),
-        })
-        .collect();
-    let mut f = std::fs::File::create(path).unwrap();
-    stl_io::write_stl(&mut f, tris.iter()).unwrap();
-}
 
 /// The surface of a sphere of radius `r` about `c`: an icosahedron whose faces are split
 /// `levels` times, vertices pushed onto the sphere, faces outward.

@@ -106,13 +106,13 @@ def write_obj(path, verts, tris):
 
 def write_svg(path, shaft_tris, verts, crack_tris):
     """An oblique view: the shaft's profile lines and rings, the crack disc inside."""
-    az, el = math.radians(35.0), math.radians(20.0)
+    az, el = math.radians(25.0), math.radians(25.0)
 
     def view(p):
         x, y, z = p
         u = x * math.cos(az) - y * math.sin(az)
         w = x * math.sin(az) + y * math.cos(az)
-        return 200 + 4 * u, 360 - 4 * (z * math.cos(el) - w * math.sin(el))
+        return 240 + 5.5 * u, 515 - 5.5 * (z * math.cos(el) - w * math.sin(el))
 
     lines = []
     prof = profile()
@@ -124,9 +124,9 @@ def write_svg(path, shaft_tris, verts, crack_tris):
         pts = [view((r * math.cos(2 * math.pi * j / N), r * math.sin(2 * math.pi * j / N), z))
                for j in range(N + 1)]
         lines.append(("#444", pts))
-    out = ['<svg xmlns="http://www.w3.org/2000/svg" width="400" height="420" '
-           'viewBox="0 0 400 420" font-family="sans-serif" font-size="12">',
-           '<rect width="400" height="420" fill="white"/>']
+    out = ['<svg xmlns="http://www.w3.org/2000/svg" width="480" height="600" '
+           'viewBox="0 0 480 600" font-family="sans-serif" font-size="13">',
+           '<rect width="480" height="600" fill="white"/>']
     for colour, pts in lines:
         d = " ".join("%.1f,%.1f" % p for p in pts)
         out.append('<polyline fill="none" stroke="%s" stroke-width="0.7" points="%s"/>'
@@ -137,10 +137,11 @@ def write_svg(path, shaft_tris, verts, crack_tris):
         d = " ".join("%.1f,%.1f" % view(p) for p in pts)
         out.append('<polygon fill="%s" stroke="none" points="%s"/>'
                    % ("#d62728" if inside else "#f4b6b6", d))
-    out.append('<text x="10" y="20">Stepped shaft (R 20 / 30 mm, fillet 5 mm) with a '
-               '6 mm crack at the fillet toe</text>')
-    out.append('<text x="10" y="38" fill="#d62728">crack inside the shaft</text>')
-    out.append('<text x="170" y="38" fill="#e08080">part of the disc outside (no crack)</text>')
+    out.append('<text x="10" y="20">Stepped shaft: radius 20 / 30 mm, fillet 5 mm</text>')
+    out.append('<text x="10" y="38" fill="#d62728">the crack: the disc of radius 6 mm '
+               'inside the shaft</text>')
+    out.append('<text x="10" y="56" fill="#e08080">the disc outside the shaft '
+               '(no crack there)</text>')
     out.append("</svg>")
     with open(path, "w") as f:
         f.write("\n".join(out) + "\n")

@@ -4,7 +4,7 @@
 use super::source;
 use fissure::base::dim::D3;
 use fissure::io::scenario::build;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// A fresh folder for one test's files.
 pub fn folder(name: &str) -> PathBuf {
@@ -138,4 +138,17 @@ pub fn msh(tags: &[u64], nodes: &[[f64; 3]], blocks: &[Block], binary: bool) -> 
     }
     out.extend(b"$EndElements\n");
     out
+}
+
+/// Writes `triangles` as a binary STL file.
+pub fn write_stl(path: &Path, triangles: &[[[f32; 3]; 3]]) {
+    let tris: Vec<stl_io::Triangle> = triangles
+        .iter()
+        .map(|t| stl_io::Triangle {
+            normal: stl_io::Normal::new([0.0; 3]),
+            vertices: t.map(stl_io::Vertex::new),
+        })
+        .collect();
+    let mut f = std::fs::File::create(path).unwrap();
+    stl_io::write_stl(&mut f, tris.iter()).unwrap();
 }

@@ -11,7 +11,6 @@
 //! a box's faces.
 
 use robust::{Coord, Coord3D, orient2d, orient3d};
-use std::collections::HashMap;
 
 /// What makes a triangle list unfit to bound a body.
 #[derive(Clone, Debug, PartialEq)]
@@ -258,35 +257,41 @@ fn on_triangle(t: [[f64; 3]; 3], p: [f64; 3]) -> bool {
 /// edge with one triangle leaves the surface open; one with more than two, or a piece that
 /// cannot be turned to agree (one-sided), is refused.
 fn orient(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Vec<[u32; 3]>, SurfaceDefect> {
-    let key = |i: u32, j: u32| (i.min(j), i.max(j));
-    let mut uses: HashMap<(u32, u32), Vec<usize>> = HashMap::with_capacity(3 * triangles.len());
+    // Every side as (lower vertex, higher vertex, triangle, slot), sorted so that the sides
+    // of one edge are neighbours in the list.
+    let mut sides: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * triangles.len());
     for (t, tri) in triangles.iter().enumerate() {
         for k in 0..3 {
-            uses.entry(key(tri[k], tri[(k + 1) % 3]))
-                .or_default()
-                .push(t);
+            let (i, j) = (tri[k], tri[(k + 1) % 3]);
+            sides.push((i.min(j), i.max(j), t as u32, k as u8));
         }
     }
-    let edge = |(i, j): (u32, u32)| [vertices[i as usize], vertices[j as usize]];
-    let mut bad: Vec<(usize, (u32, u32), bool)> = (uses.iter())
-        .filter(|(_, ts)| ts.len() != 2)
-        .map(|(&e, ts)| (ts[0], e, ts.len() == 1))
-        .collect();
-    bad.sort_unstable();
-    if let Some(&(triangle, e, open)) = bad.first() {
-        return Err(if open {
-            SurfaceDefect::Open {
-                triangle,
-                edge: edge(e),
-            }
-        } else {
-            SurfaceDefect::Inconsistent {
-                triangle,
-                edge: edge(e),
-            }
-        });
+    sides.sort_unstable();
+    let edge = |i: u32, j: u32| [vertices[i as usize], vertices[j as usize]];
+    // The triangle across each slot, and the first defect by triangle index.
+    let mut across = vec![[0u32; 3]; triangles.len()];
+    let mut bad: Option<(u32, SurfaceDefect)> = None;
+    for group in sides.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)) {
+        if let [(_, _, t1, k1), (_, _, t2, k2)] = group {
+            across[*t1 as usize][*k1 as usize] = *t2;
+            across[*t2 as usize][*k2 as usize] = *t1;
+            continue;
+        }
+        let (i, j, t, _) = group[0];
+        if bad.as_ref().is_none_or(|b| t < b.0) {
+            let (triangle, edge) = (t as usize, edge(i, j));
+            let defect = if group.len() == 1 {
+                SurfaceDefect::Open { triangle, edge }
+            } else {
+                SurfaceDefect::Inconsistent { triangle, edge }
+            };
+            bad = Some((t, defect));
+        }
     }
-    // Whether triangle t runs its edge i -> j (rather than j -> i).
+    if let Some((_, defect)) = bad {
+        return Err(defect);
+    }
+    // Whether triangle tri runs its edge i -> j (rather than j -> i).
     let runs =
         |tri: &[u32; 3], i: u32, j: u32| (0..3).any(|k| tri[k] == i && tri[(k + 1) % 3] == j);
     let mut out = triangles.to_vec();
@@ -299,11 +304,10 @@ fn orient(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Vec<[u32; 3]>
         done[first] = true;
         stack.push(first);
         while let Some(t) = stack.pop() {
-            let tri = out[t];
             for k in 0..3 {
-                let (i, j) = (tri[k], tri[(k + 1) % 3]);
-                let ts = &uses[&key(i, j)];
-                let n = if ts[0] == t { ts[1] } else { ts[0] };
+                let (a, b) = (triangles[t][k], triangles[t][(k + 1) % 3]);
+                let (i, j) = if runs(&out[t], a, b) { (a, b) } else { (b, a) };
+                let n = across[t][k] as usize;
                 if done[n] {
                     if runs(&out[n], i, j) {
                         return Err(SurfaceDefect::OneSided { triangle: n });
