@@ -891,3 +891,21 @@ fn a_copied_snapshot_with_a_bad_name_is_refused() {
     assert!(!dir.join("out").exists(), "nothing written");
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// A static scene (the shipped cantilever on 2 mm cells, its load ramped over 24 load
+/// steps): stopped after 7 and resumed, every output and the last snapshot the same bits.
+#[test]
+fn restart_is_bit_exact_with_a_static_scene() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/cantilever_static_2d.toml"
+    ))
+    .unwrap()
+    .replace("cell = [0.001, 0.001]", "cell = [0.002, 0.002]")
+    .replace("load_steps = 1", "load_steps = 24")
+    .replace(
+        "force = [0.0, -100.0]     # N",
+        "force = [0.0, -100.0]\ntime = { kind = \"ramp\", rise = 0.5 }",
+    ) + "\n[checkpoint]\nevery_steps = 10\n";
+    restart_is_bit_exact(&text, 7, 2, "static");
+}

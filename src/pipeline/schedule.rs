@@ -4,10 +4,11 @@ use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::fracture::plan::{FracturePlan, Measured};
 use crate::pipeline::warm::with_warm_workers;
-use crate::store::world::{Update, World};
+use crate::record::solve_log::SolveLog;
+use crate::store::world::{Solver, Update, World};
 use crate::systems::{
-    DimSystems, bin, classify, contact, crack_advect, g2p, grid_update, grow, p2g, stress,
-    stress_bin, stress_force,
+    DimSystems, bin, classify, contact, crack_advect, g2p, grid_update, grow, p2g, static_solve,
+    stress, stress_bin, stress_force,
 };
 use std::time::Instant;
 
@@ -56,6 +57,8 @@ pub enum System {
     Fracture,
     /// Advance the growing crack tips, after the step and its measurement.
     Grow,
+    /// A static scene's load step: equilibrium on the grid, the particles set to it.
+    StaticSolve,
 }
 
 impl System {
@@ -75,6 +78,7 @@ impl System {
             System::G2pRemap => "g2p_remap",
             System::Fracture => "fracture",
             System::Grow => "grow",
+            System::StaticSolve => "static_solve",
         }
     }
 }
@@ -90,6 +94,8 @@ pub struct Schedule {
     fracture: Option<FracturePlan>,
     /// Whether some crack grows.
     grows: bool,
+    /// A static scene's solves so far.
+    pub solves: SolveLog,
 }
 
 impl Schedule {
@@ -101,6 +107,15 @@ impl Schedule {
     /// plan adds `fracture` at the end of the steps that end at an output row.
     pub fn for_world<D: Dim>(world: &World<D>, fracture: Option<FracturePlan>) -> Self {
         use System::*;
+        if world.settings.solver == Solver::Static {
+            return Schedule {
+                systems: vec![StaticSolve],
+                seconds: vec![0.0],
+                fracture: None,
+                grows: false,
+                solves: SolveLog::default(),
+            };
+        }
         let bc = !world.bcs.is_empty();
         let update = world.settings.update;
         let cracks = world.cracks.is_some();
@@ -161,6 +176,7 @@ impl Schedule {
             seconds,
             fracture,
             grows,
+            solves: SolveLog::default(),
         }
     }
 
@@ -281,6 +297,10 @@ impl Schedule {
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),
+                System::StaticSolve => {
+                    let solved = static_solve::run(world)?;
+                    self.solves.add(solved);
+                }
                 System::Fracture | System::Grow => continue,
             }
             self.seconds[k] += t0.elapsed().as_secs_f64();

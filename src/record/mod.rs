@@ -4,4 +4,5 @@
 pub mod expect;
 pub mod history;
 pub mod probe;
+pub mod solve_log;
 pub mod state;

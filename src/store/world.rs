@@ -25,9 +25,22 @@ pub enum Update {
     Usavg,
 }
 
+/// How a scene is advanced: explicit dynamics, or static equilibrium load step by load step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Solver {
+    /// Explicit time integration (waves, damping, inertia).
+    #[default]
+    Explicit,
+    /// Equilibrium at each load step, no inertia (`systems::static_solve`).
+    Static,
+}
+
 /// Scene-wide settings that systems read.
 #[derive(Clone, Debug)]
 pub struct Settings<D: Dim> {
+    /// Explicit dynamics or static load steps.
+    pub solver: Solver,
     /// Shape function.
     pub shape: ShapeKind,
     /// Stress-update order.
@@ -38,7 +51,7 @@ pub struct Settings<D: Dim> {
     pub damping: f64,
     /// Body force per unit mass (m/s^2).
     pub gravity: D::Vec,
-    /// Time step (s).
+    /// Time step (s); a static scene's load step.
     pub dt: f64,
     /// Nodes lighter than this carry no velocity (kg).
     pub mass_tol: f64,

@@ -338,6 +338,8 @@ impl<'a, D: DimSystems> Run<'a, D> {
             cell_crossings: world.cell_crossings(),
             node_lines: self.node_lines.clone(),
             energies: world.energies(),
+            static_solve: (world.settings.solver == crate::store::world::Solver::Static)
+                .then_some(self.schedule.solves),
             probes: reports::probes(&self.probes, history),
             expects: results,
             paths: reports::paths(world, fracture, history),

@@ -12,6 +12,9 @@
 
 use robust::{Coord, Coord3D, orient2d, orient3d};
 
+/// Vertices and triangles as indices into them: a surface as files give it.
+pub type TriangleList = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
 /// What makes a triangle list unfit to bound a body.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SurfaceDefect {

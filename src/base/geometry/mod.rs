@@ -9,7 +9,7 @@ mod element;
 mod point;
 
 pub use bounds::{Aabb, meeting_pairs};
-pub use closed_surface::{ClosedSurface, SurfaceDefect};
+pub use closed_surface::{ClosedSurface, SurfaceDefect, TriangleList};
 pub use distance::{point_segment, point_segment_sq, point_triangle, segment_segment};
 pub use element::{Element, NUDGE, Segment, Triangle};
 pub use point::Point;

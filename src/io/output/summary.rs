@@ -2,6 +2,7 @@
 
 use crate::record::expect::ExpectResult;
 use crate::record::probe::ProbeQty;
+use crate::record::solve_log::SolveLog;
 use crate::store::world::Energies;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -87,6 +88,8 @@ pub struct Summary {
     pub node_lines: Vec<NodeLineReport>,
     /// Energies at the end (J).
     pub energies: Energies,
+    /// A static scene's solves (None in an explicit run).
+    pub static_solve: Option<SolveLog>,
     /// Every probe's last sample (e.g. the crack-mouth opening of an `opening` probe).
     pub probes: Vec<ProbeReport>,
     /// Results of the scenario's `[[expect]]` blocks (only for a completed run).

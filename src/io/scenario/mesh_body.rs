@@ -7,7 +7,7 @@ use super::schema::{MeshBodySpec, RotateSpec};
 use super::source::Source;
 use crate::base::dim::D3;
 use crate::base::error::ScenarioError;
-use crate::base::geometry::{ClosedSurface, Element, Triangle};
+use crate::base::geometry::{ClosedSurface, Element, Triangle, TriangleList};
 use crate::physics::bodies::Solid;
 use glam::{DMat3, DVec3};
 use std::collections::HashMap;
@@ -22,9 +22,6 @@ const MAX_BYTES: u64 = 1 << 30;
 /// How close (a fraction of the surface's size) two triangles sharing no vertex may come
 /// before the surface is taken to meet itself.
 const SELF_MEET: f64 = 1e-9;
-
-/// Vertices in the file's order and triangles as indices into them.
-pub(super) type Indexed = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
 /// The solid bounded by the surface `spec` names (checked closed and oriented one way).
 pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> R<Solid> {
@@ -52,7 +49,7 @@ pub(super) fn solid(src: &Source, key: &str, spec: &MeshBodySpec) -> R<Solid> {
 
 /// The triangles of the STL or OBJ file at `path` (by its extension), every coordinate
 /// finite, corners at one place one vertex.
-pub(super) fn read(path: &Path) -> Result<Indexed, String> {
+pub(super) fn read(path: &Path) -> Result<TriangleList, String> {
     let (positions, triangles) = match extension(path).as_str() {
         "stl" => read_stl(path),
         "obj" => read_obj(path),
@@ -69,7 +66,7 @@ pub(super) fn read(path: &Path) -> Result<Indexed, String> {
 
 /// Corners at the same place are one vertex (-0.0 and 0.0 too), numbered in order of
 /// first use.
-fn merge(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Indexed {
+fn merge(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> TriangleList {
     let (mut unique, mut index) = (Vec::new(), HashMap::new());
     let triangles = (triangles.iter())
         .map(|tri| {
@@ -172,7 +169,7 @@ fn finite(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(), String> 
 }
 
 /// The triangles of an STL file (ASCII or binary), three corners each in file order.
-fn read_stl(path: &Path) -> Result<Indexed, String> {
+fn read_stl(path: &Path) -> Result<TriangleList, String> {
     let mut file = std::fs::File::open(path).map_err(|e| format!("cannot open it: {e}"))?;
     let reader = stl_io::create_stl_reader(&mut file)
         .map_err(|e| format!("not a readable STL file: {e}"))?;
@@ -188,7 +185,7 @@ fn read_stl(path: &Path) -> Result<Indexed, String> {
 
 /// The vertices of an OBJ file in its order, all its objects together, and its faces split
 /// into triangles (`tobj`; materials, points and lines are ignored).
-fn read_obj(path: &Path) -> Result<Indexed, String> {
+fn read_obj(path: &Path) -> Result<TriangleList, String> {
     let file = std::fs::File::open(path).map_err(|e| format!("cannot open it: {e}"))?;
     let options = tobj::LoadOptions {
         triangulate: true,

@@ -24,6 +24,7 @@ mod region;
 pub mod schema;
 mod settings;
 pub mod source;
+mod statics;
 mod surface;
 mod traction;
 

@@ -3,7 +3,7 @@
 //! tetrahedra, hexahedra, prisms and pyramids that no second element shares), each face
 //! turned to point out of its element. Higher-order elements are read by their corners.
 
-use super::mesh_body::Indexed;
+use crate::base::geometry::TriangleList;
 use mshio::mshfile::{ElementType, MshFile};
 use std::collections::HashMap;
 use std::path::Path;
@@ -59,7 +59,7 @@ fn kind(t: ElementType) -> Option<Kind> {
 }
 
 /// The surface in the MSH file at `path`: all its nodes, and triangles indexing them.
-pub(super) fn read_msh(path: &Path) -> Result<Indexed, String> {
+pub(super) fn read_msh(path: &Path) -> Result<TriangleList, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))?;
     let binary = header(&bytes)?;
     for section in ["$Nodes", "$Elements"] {

@@ -2,7 +2,7 @@
 
 use crate::physics::shape::ShapeKind;
 use crate::physics::timefn::TimeFn;
-use crate::store::world::Update;
+use crate::store::world::{Solver, Update};
 use serde::Deserialize;
 
 /// A whole scenario file.
@@ -77,6 +77,12 @@ pub struct Simulation {
     pub gravity: Option<Vec<f64>>,
     /// Cells per tile edge (default 8 in 2D, 4 in 3D).
     pub tile: Option<usize>,
+    /// "explicit" (default) or "static".
+    #[serde(default)]
+    pub solver: Solver,
+    /// A static scene's load steps over `duration` (default: one per history row when
+    /// `[output] history_interval` is given, else 10).
+    pub load_steps: Option<u64>,
 }
 
 /// `[grid]`.

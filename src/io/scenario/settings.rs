@@ -7,6 +7,7 @@ use crate::base::dim::Dim;
 use crate::physics::material::{Material, Plane};
 use crate::store::grid::GridGeom;
 use crate::store::tiles::MIN_TILE;
+use crate::store::world::Solver;
 
 /// Most time steps a run may take (a duration or `--until` needing more is refused).
 pub const MAX_STEPS: f64 = 1e10;
@@ -97,9 +98,16 @@ pub(super) fn simulation<D: Dim>(src: &Source) -> R<Simulation> {
     })
 }
 
+/// Most load steps a static scene may take.
+const MAX_LOAD_STEPS: u64 = 1_000_000;
+
+/// Load steps of a static scene without `load_steps` or a history interval.
+const DEFAULT_LOAD_STEPS: u64 = 10;
+
 /// The time step and the stability limit (smallest cell over the fastest wave speed of the
 /// materials some body uses), both in s: `dt` as given (refused above the limit), else the
-/// CFL fraction of the limit.
+/// CFL fraction of the limit. A static scene steps by its load step instead, `duration`
+/// over `load_steps` (`dt`, `cfl` and `damping` do not apply to it).
 pub(super) fn time_step<D: Dim>(
     src: &Source,
     sim: &Simulation,
@@ -114,6 +122,27 @@ pub(super) fn time_step<D: Dim>(
         .map(|(m, _)| m.wave_speed(sim.plane))
         .fold(0.0, f64::max);
     let dt_limit = geom.min_cell() / c_max;
+    let s = &src.scenario;
+    if s.simulation.solver == Solver::Static {
+        let steps = match (s.simulation.load_steps, s.output.history_interval) {
+            (Some(n), _) => n,
+            (None, Some(h)) if h > 0.0 => (sim.duration / h).round().max(1.0) as u64,
+            _ => DEFAULT_LOAD_STEPS,
+        };
+        if !(1..=MAX_LOAD_STEPS).contains(&steps) {
+            return Err(src.error(
+                "simulation.load_steps",
+                format!("give 1 to {MAX_LOAD_STEPS} load steps"),
+            ));
+        }
+        return Ok((sim.duration / steps as f64, dt_limit));
+    }
+    if s.simulation.load_steps.is_some() {
+        return Err(src.error(
+            "simulation.load_steps",
+            "load steps belong to a static scene (solver = \"static\")",
+        ));
+    }
     let dt = match src.scenario.simulation.dt {
         Some(dt) => {
             positive(src, "simulation.dt", dt, "s")?;

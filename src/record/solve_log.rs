@@ -1,0 +1,35 @@
+//! What a static scene's solves took, for summary.json.
+
+use serde::Serialize;
+
+/// How one load step's solve went.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Solved {
+    /// Conjugate-gradient iterations.
+    pub iterations: usize,
+    /// Final residual over the external force's norm.
+    pub residual: f64,
+}
+
+/// What a static scene's load steps took: counts, iterations and the worst residual.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SolveLog {
+    /// Load steps solved.
+    pub load_steps: u64,
+    /// Conjugate-gradient iterations, all load steps.
+    pub iterations: u64,
+    /// Most iterations in one load step.
+    pub most_iterations: u64,
+    /// Largest final residual over the external force.
+    pub worst_residual: f64,
+}
+
+impl SolveLog {
+    /// Counts one load step's solve.
+    pub fn add(&mut self, s: Solved) {
+        self.load_steps += 1;
+        self.iterations += s.iterations as u64;
+        self.most_iterations = self.most_iterations.max(s.iterations as u64);
+        self.worst_residual = self.worst_residual.max(s.residual);
+    }
+}
