@@ -108,10 +108,16 @@ impl Schedule {
     pub fn for_world<D: Dim>(world: &World<D>, fracture: Option<FracturePlan>) -> Self {
         use System::*;
         if world.settings.solver == Solver::Static {
+            // Open cracks are the solve's own affair; J and K are measured on its result.
+            let fracture = fracture.filter(|_| world.cracks.is_some());
+            let mut systems = vec![StaticSolve];
+            if fracture.is_some() {
+                systems.push(Fracture);
+            }
             return Schedule {
-                systems: vec![StaticSolve],
-                seconds: vec![0.0],
-                fracture: None,
+                seconds: vec![0.0; systems.len()],
+                systems,
+                fracture,
                 grows: false,
                 solves: SolveLog::default(),
             };

@@ -9,6 +9,10 @@ pub struct Solved {
     pub iterations: usize,
     /// Final residual over the external force's norm.
     pub residual: f64,
+    /// Rigid motions left free (a body held by no support: up to 3 in 2D, 6 in 3D).
+    pub free_motions: usize,
+    /// The part of the load's norm along them, removed before the solve.
+    pub imbalance: f64,
 }
 
 /// What a static scene's load steps took: counts, iterations and the worst residual.
@@ -22,6 +26,10 @@ pub struct SolveLog {
     pub most_iterations: u64,
     /// Largest final residual over the external force.
     pub worst_residual: f64,
+    /// Rigid motions left free at the last load step.
+    pub free_motions: usize,
+    /// Largest part of a load step's load removed as imbalance along them.
+    pub largest_imbalance: f64,
 }
 
 impl SolveLog {
@@ -31,5 +39,7 @@ impl SolveLog {
         self.iterations += s.iterations as u64;
         self.most_iterations = self.most_iterations.max(s.iterations as u64);
         self.worst_residual = self.worst_residual.max(s.residual);
+        self.free_motions = s.free_motions;
+        self.largest_imbalance = self.largest_imbalance.max(s.imbalance);
     }
 }

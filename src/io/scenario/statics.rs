@@ -1,6 +1,7 @@
 //! What a static scene (`solver = "static"`) may hold so far: linear elastic bodies held
-//! still by their boundaries, under loads and gravity. Cracks, plasticity and prescribed
-//! displacements are refused by name until the static solver takes them.
+//! still by their boundaries, under loads and gravity, with open cracks. Crack-face
+//! contact, growth, plasticity and prescribed displacements are refused by name until the
+//! static solver takes them.
 
 use super::check::R;
 use super::source::Source;
@@ -13,12 +14,22 @@ pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()
     if sc.simulation.solver != Solver::Static {
         return Ok(());
     }
-    if !sc.cracks.is_empty() {
-        return Err(src.error(
-            "crack[0]",
-            "the static solver does not take cracks yet: run this scene with solver = \
-             \"explicit\"",
-        ));
+    for (c, crack) in sc.cracks.iter().enumerate() {
+        if crack.contact.as_ref().is_some_and(|k| k.law != "none") {
+            return Err(src.error(
+                &format!("crack[{c}].contact"),
+                "the static solver does not take crack-face contact yet (faces that close \
+                 need contact constraints): give law = \"none\" for open cracks, or run \
+                 this scene with solver = \"explicit\"",
+            ));
+        }
+        if crack.growth.is_some() {
+            return Err(src.error(
+                &format!("crack[{c}].growth"),
+                "the static solver does not grow cracks yet: run this scene with solver = \
+                 \"explicit\"",
+            ));
+        }
     }
     if let Some(k) = (0..materials.len()).find(|&k| used[k] && materials[k].j2.is_some()) {
         return Err(src.error(
