@@ -116,9 +116,10 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     solved.free_motions = modes.len();
     solved.imbalance = imbalance;
     reactions(world, &u);
-    let work = load_work(world, &before, t_start, t_end, &u);
+    let after = gather(world, &u);
+    let work = load_work(world, &before, &after, t_start, t_end);
     world.work.external += work;
-    set_particles(world, &u);
+    set_particles(world, &u, &after);
     Ok(solved)
 }
 
@@ -370,17 +371,17 @@ fn reactions<D: Dim>(world: &mut World<D>, u: &[D::Vec]) {
     }
 }
 
-/// The work of the particle loads and gravity over the step, the force taken as the mean
-/// of its values at the step's ends (exact for a linear response). The first step starts
+/// The work of the particle loads and gravity over the step (particle displacements
+/// `before` and `after` it), the force taken as the mean of its values at the step's ends
+/// (exact for a linear response). The first step starts
 /// from the unloaded body: its loads rise from zero, whatever their value at t = 0.
 fn load_work<D: Dim>(
     world: &World<D>,
     before: &[D::Vec],
+    after: &[D::Vec],
     t_start: f64,
     t_end: f64,
-    u: &[D::Vec],
 ) -> f64 {
-    let after = gather(world, u);
     let p = &world.particles;
     let step = |i: usize| after[i] - before[i];
     let first = world.step == 0;
@@ -409,10 +410,9 @@ fn gather<D: Dim>(world: &World<D>, u: &[D::Vec]) -> Vec<D::Vec> {
         .collect()
 }
 
-/// Each particle at the solution: x = x0 + u, at rest, with grad u (when kept) and the
-/// stress C : sym(grad u).
-fn set_particles<D: Dim>(world: &mut World<D>, u: &[D::Vec]) {
-    let disp = gather(world, u);
+/// Each particle at the solution: x = x0 + its displacement `disp` (interpolated from the
+/// entries' `u`), at rest, with grad u (when kept) and the stress C : sym(grad u).
+fn set_particles<D: Dim>(world: &mut World<D>, u: &[D::Vec], disp: &[D::Vec]) {
     let plane = world.settings.plane;
     let keep = !world.particles.grad_u.is_empty();
     for (i, &d) in disp.iter().enumerate() {
