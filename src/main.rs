@@ -185,6 +185,9 @@ fn cmd_sweep(
                 for note in node_line_notes(&s.node_lines, s.dimension) {
                     println!("  warning: {note}");
                 }
+                for note in on_particle_notes(&s.particles_on_cracks) {
+                    println!("  warning: {note}");
+                }
             }
             (None, Some(e)) => println!("[{k}/{n}] {what}: {e}"),
             (None, None) => {}
@@ -300,6 +303,9 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
         );
     }
     for note in node_line_notes(&s.node_lines, s.dimension) {
+        println!("  note: {note}");
+    }
+    for note in on_particle_notes(&s.particles_on_cracks) {
         println!("  note: {note}");
     }
     if let Some(note) = k_withheld_note(s) {
@@ -521,6 +527,10 @@ fn cmd_check(path: &Path, overrides: &[String]) -> ExitCode {
                     for note in node_line_notes(&fissure::app::run::node_lines(w), dim) {
                         println!("  note: {note}");
                     }
+                    let on = fissure::app::run::particles_on_cracks(w);
+                    for note in on_particle_notes(&on) {
+                        println!("  note: {note}");
+                    }
                     ExitCode::SUCCESS
                 }
                 Err(e) => bad_input(&e),
@@ -643,6 +653,20 @@ fn k_withheld_note(s: &Summary) -> Option<&'static str> {
          lies near the J contour or tube (K comes from J only where the response is \
          elastic); J is reported there",
     )
+}
+
+/// What the launcher says of each crack that passes through particle centres.
+fn on_particle_notes(on: &[fissure::io::output::summary::ParticlesOnReport]) -> Vec<String> {
+    on.iter()
+        .map(|o| {
+            format!(
+                "crack `{}` passes through {} particle centres: round-off decides their side \
+                 of it, and J and K with it (a few %); set it a fraction of a particle \
+                 spacing off them",
+                o.crack, o.particles
+            )
+        })
+        .collect()
 }
 
 /// What the launcher says of each crack that lies on a line or plane of grid nodes.

@@ -5,6 +5,7 @@
 use crate::base::dim::Dim;
 use crate::physics::shape::{ShapeKind, Stencil};
 use crate::store::crack::{Cracks, Fields, Positions};
+use crate::store::grid::Grid;
 use crate::store::world::{Update, World};
 
 /// Momentum and mass at node `n`, all fields together (Eq. 23's centre of mass), and of its
@@ -42,18 +43,7 @@ fn node_fields<D: Dim>(
 /// nodal velocities with linear shape functions (crack vertices are massless points).
 /// Vertices outside the grid do not move.
 pub fn run<D: Dim>(world: &mut World<D>) {
-    let Some(Cracks {
-        topology,
-        geometry: Positions { x: xs, top, bottom },
-        scratch,
-        ..
-    }) = world.cracks.as_mut()
-    else {
-        return;
-    };
     let dt = world.settings.dt;
-    let sliver = world.settings.sliver_mass;
-    let g = &world.grid;
     // After the momentum remap (USL, USAVG) the grid momenta are the particles' updated
     // momenta, whose mass-weighted average is the material's velocity. The updated nodal
     // velocities p/m + a dt are not, at a field holding part of a few particles near a
@@ -61,12 +51,54 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     // balance, and a dt f/m ran at 0.7 m/s on a damped inclined crack at rest, walking the
     // tip (and the interaction integral's K with it) by 1 % per 200 us.
     let remapped = world.settings.update != Update::Usf;
+    let g = &world.grid;
     let momentum = |e: usize| {
         if remapped {
             g.momentum[e]
         } else {
             g.velocity[e] * g.mass[e]
         }
+    };
+    advect(
+        world.cracks.as_mut(),
+        g,
+        world.settings.sliver_mass,
+        momentum,
+        dt,
+    );
+}
+
+/// Moves every crack vertex and both surfaces by a static load step's displacement:
+/// `moved` holds, per grid entry, the mass-weighted sum of its particles' displacements
+/// over the step (a momentum with dt = 1).
+pub fn displace<D: Dim>(world: &mut World<D>, moved: &[D::Vec]) {
+    let g = &world.grid;
+    advect(
+        world.cracks.as_mut(),
+        g,
+        world.settings.sliver_mass,
+        |e| moved[e],
+        1.0,
+    );
+}
+
+/// Moves the cracks by `dt` times the mass-weighted velocity (`momentum` per entry over the
+/// grid's masses) at each vertex.
+fn advect<D: Dim>(
+    cracks: Option<&mut Cracks<D>>,
+    g: &Grid<D>,
+    sliver: f64,
+    momentum: impl Fn(usize) -> D::Vec,
+    dt: f64,
+) {
+    let Some(Cracks {
+        topology,
+        geometry: Positions { x: xs, top, bottom },
+        scratch,
+        ..
+    }) = cracks
+    else {
+        return;
     };
     let geom = &g.geom;
     let fields = &scratch.fields;

@@ -19,11 +19,14 @@ use crate::store::disjoint::Disjoint;
 use crate::store::world::{CHUNK, World};
 use crate::systems::p2g::add_internal_force;
 use crate::systems::stress::velocity_gradient;
-use crate::systems::{bin, classify, p2g};
+use crate::systems::{bin, classify, crack_advect, p2g};
 use crate::with_shape;
 use rayon::prelude::*;
 
 mod rigid;
+mod unknowns;
+
+use unknowns::Unknowns;
 
 /// Most of the load (as a fraction of its norm) a body free to move may leave unbalanced:
 /// the discrete imbalance of balanced tractions is far below it; a load that would
@@ -81,17 +84,19 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     for (f, &m) in grid.force.iter_mut().zip(&grid.mass) {
         *f += g * m;
     }
-    let free = free_dofs(world);
-    let diag = diagonal(world, &free);
-    let largest = (diag.iter().zip(&free))
+    let dofs = Unknowns::new(world);
+    let free = &dofs.free;
+    let diag = diagonal(world, &dofs);
+    let largest = (diag.iter().zip(free))
         .flat_map(|(d, k)| (0..D::D).filter(|&a| k[a] != 0.0).map(|a| d[a]))
         .fold(0.0, f64::max);
-    let mut f_ext: Vec<D::Vec> = (world.grid.force.iter())
-        .zip(&free)
-        .map(|(&f, &k)| mask::<D>(f, k))
-        .collect();
+    let mut f_ext = world.grid.force.clone();
+    dofs.fold(&mut f_ext);
+    for (f, &k) in f_ext.iter_mut().zip(free) {
+        *f = mask::<D>(*f, k);
+    }
     let ghost = ghost_stiffness(world, &diag);
-    let modes = rigid::free_motions(world, &free, &ghost, largest);
+    let modes = rigid::free_motions(world, &dofs, &ghost, largest);
     let norm = dot::<D>(&f_ext, &f_ext).sqrt();
     rigid::deflate::<D>(&mut f_ext, &modes);
     let imbalance = if norm > 0.0 {
@@ -111,41 +116,18 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
             ),
         });
     }
-    let (u, mut solved) = conjugate_gradients(world, &f_ext, &ghost, &diag, &free, &modes)?;
-    leans_on_ghost(world, &u, &ghost, &f_ext, t_end)?;
+    let (mut u, mut solved) = conjugate_gradients(world, &f_ext, &ghost, &diag, &dofs, &modes)?;
+    dofs.expand(&mut u);
+    leans_on_ghost(world, &u, &ghost, &dofs, &f_ext, t_end)?;
     solved.free_motions = modes.len();
     solved.imbalance = imbalance;
-    reactions(world, &u);
+    reactions(world, &dofs, &u);
     let after = gather(world, &u);
+    move_cracks(world, &before, &after);
     let work = load_work(world, &before, &after, t_start, t_end);
     world.work.external += work;
     set_particles(world, &u, &after);
     Ok(solved)
-}
-
-/// Per node, 1 on the components that are unknowns: the node carries mass (a particle
-/// reaches it) and no boundary prescribes it.
-fn free_dofs<D: Dim>(world: &World<D>) -> Vec<D::Vec> {
-    let tol = world.settings.mass_tol;
-    let mut free: Vec<D::Vec> = (world.grid.mass.iter())
-        .map(|&m| if m > tol { ones::<D>() } else { D::zero() })
-        .collect();
-    for bc in &world.bcs {
-        let held = (0..D::D).filter(|&a| bc.axes[a]);
-        for &n in &bc.nodes {
-            for e in entries(n, fields(world)) {
-                held.clone().for_each(|a| free[e][a] = 0.0);
-            }
-        }
-    }
-    free
-}
-
-/// The vector of ones.
-fn ones<D: Dim>() -> D::Vec {
-    let mut k = D::zero();
-    (0..D::D).for_each(|a| k[a] = 1.0);
-    k
 }
 
 /// `v` with the components `keep` has at 0 cleared.
@@ -166,17 +148,20 @@ fn elastic<D: Dim>(m: &Material, plane: Plane, l: &D::Mat) -> D::Sym {
     D::Sym::from_sym3(s)
 }
 
-/// y = K x on the free components, particle by particle: grad x gathered at each particle,
-/// the stress it gives, and that stress's nodal force, tile by tile in colour classes (the
-/// same scatter, in the same order, for any thread count); with `ghost`, its stiffness
-/// (per component) times x added.
-fn apply<D: Dim>(
-    world: &World<D>,
-    x: &[D::Vec],
-    free: &[D::Vec],
-    ghost: Option<&[D::Vec]>,
-    y: &mut [D::Vec],
-) {
+/// y = K x, particle by particle: grad x gathered at each particle (tied entries taking
+/// the value of the entry they move with), the stress it gives, and that stress's nodal
+/// force, tile by tile in colour classes (the same scatter, in the same order, for any
+/// thread count), tied entries' forces folded into their partners'.
+fn stiffness<D: Dim>(world: &World<D>, x: &[D::Vec], dofs: &Unknowns<D>, y: &mut [D::Vec]) {
+    let expanded;
+    let x = if dofs.ties.is_empty() {
+        x
+    } else {
+        let mut e = x.to_vec();
+        dofs.expand(&mut e);
+        expanded = e;
+        &expanded[..]
+    };
     y.par_chunks_mut(CHUNK).for_each(|c| c.fill(D::zero()));
     let (shape, plane) = (world.settings.shape, world.settings.plane);
     let stride = &world.grid.geom.stride;
@@ -204,8 +189,21 @@ fn apply<D: Dim>(
             y[n] += D::stress_dot(&s, g) * p.volume[i]
         });
     }
+    dofs.fold(y);
+}
+
+/// y = K x on the free components ([`stiffness`]), with `ghost`'s stiffness (per
+/// component) times x added when given.
+fn apply<D: Dim>(
+    world: &World<D>,
+    x: &[D::Vec],
+    dofs: &Unknowns<D>,
+    ghost: Option<&[D::Vec]>,
+    y: &mut [D::Vec],
+) {
+    stiffness(world, x, dofs, y);
     y.par_chunks_mut(CHUNK)
-        .zip(free.par_chunks(CHUNK))
+        .zip(dofs.free.par_chunks(CHUNK))
         .zip(x.par_chunks(CHUNK))
         .enumerate()
         .for_each(|(c, ((y, k), x))| {
@@ -223,8 +221,10 @@ fn apply<D: Dim>(
 
 /// The diagonal of K (its free components; 1 elsewhere, so the preconditioner leaves the
 /// fixed ones alone): for node n and axis a, sum over particles of V e_a . (C : sym(e_a ⊗
-/// grad S_n)) . grad S_n.
-fn diagonal<D: Dim>(world: &World<D>, free: &[D::Vec]) -> Vec<D::Vec> {
+/// grad S_n)) . grad S_n. A tied entry adds its own to its partner's: a particle reaches
+/// one entry of a node, so the two share no particle and K has no term between them.
+fn diagonal<D: Dim>(world: &World<D>, dofs: &Unknowns<D>) -> Vec<D::Vec> {
+    let free = &dofs.free;
     let mut d = vec![D::zero(); free.len()];
     let plane = world.settings.plane;
     let p = &world.particles;
@@ -239,6 +239,7 @@ fn diagonal<D: Dim>(world: &World<D>, free: &[D::Vec]) -> Vec<D::Vec> {
             }
         });
     }
+    dofs.fold(&mut d);
     for (d, &k) in d.iter_mut().zip(free) {
         for a in 0..D::D {
             if k[a] == 0.0 || d[a] <= 0.0 {
@@ -267,7 +268,7 @@ fn conjugate_gradients<D: Dim>(
     f: &[D::Vec],
     ghost: &[D::Vec],
     diag: &[D::Vec],
-    free: &[D::Vec],
+    dofs: &Unknowns<D>,
     modes: &[Vec<D::Vec>],
 ) -> Result<(Vec<D::Vec>, Solved), Unstable> {
     let n = f.len();
@@ -297,7 +298,7 @@ fn conjugate_gradients<D: Dim>(
     let cells = world.grid.geom.cells;
     let most = ITERATIONS_PER_NODE * (cells[0].max(cells[1]).max(cells[2]) + 1);
     for k in 1..=most {
-        apply(world, &dir, free, Some(ghost), &mut q);
+        apply(world, &dir, dofs, Some(ghost), &mut q);
         let pq = dot::<D>(&dir, &q);
         // A direction of no stiffness (or NaN): K is singular on what the loads start.
         if pq.is_nan() || pq <= 0.0 {
@@ -347,14 +348,14 @@ fn not_converged<D: Dim>(world: &World<D>, iterations: usize, residual: f64) -> 
 }
 
 /// Each support's reaction on the body, K u - f_ext on its held components (the grid's
-/// force column still holds f_ext).
-fn reactions<D: Dim>(world: &mut World<D>, u: &[D::Vec]) {
+/// force column still holds f_ext; a node's entries are summed, so a tied entry's force
+/// counts once, wherever it sits).
+fn reactions<D: Dim>(world: &mut World<D>, dofs: &Unknowns<D>, u: &[D::Vec]) {
     if world.bcs.is_empty() {
         return;
     }
-    let every = vec![ones::<D>(); u.len()];
     let mut ku = vec![D::zero(); u.len()];
-    apply(world, u, &every, None, &mut ku);
+    stiffness(world, u, dofs, &mut ku);
     let force = &world.grid.force;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     for bc in &mut world.bcs {
@@ -399,6 +400,22 @@ fn load_work<D: Dim>(
         .sum::<f64>()
 }
 
+/// Moves the cracks' vertices and surfaces over the step as the explicit solver would
+/// (`crack_advect`), with each entry's mass-weighted particle displacement in place of
+/// its velocity: each surface follows its side's fields, which gives the crack opening.
+fn move_cracks<D: Dim>(world: &mut World<D>, before: &[D::Vec], after: &[D::Vec]) {
+    if world.cracks.is_none() {
+        return;
+    }
+    let mut moved = vec![D::zero(); world.grid.mass.len()];
+    let mass = &world.particles.mass;
+    for (i, (&b, &a)) in before.iter().zip(after).enumerate() {
+        let d = (a - b) * mass[i];
+        each_entry(world, i, |n, w, _| moved[n] += d * w);
+    }
+    crack_advect::displace(world, &moved);
+}
+
 /// Each particle's displacement, interpolated from the nodes'.
 fn gather<D: Dim>(world: &World<D>, u: &[D::Vec]) -> Vec<D::Vec> {
     (0..world.particles.len())
@@ -440,11 +457,12 @@ fn leans_on_ghost<D: Dim>(
     world: &World<D>,
     u: &[D::Vec],
     ghost: &[D::Vec],
+    dofs: &Unknowns<D>,
     f: &[D::Vec],
     t_end: f64,
 ) -> Result<(), Unstable> {
-    let held: f64 = (u.iter().zip(ghost))
-        .map(|(u, g)| (0..D::D).map(|a| g[a] * u[a] * u[a]).sum::<f64>())
+    let held: f64 = (u.iter().zip(ghost).zip(&dofs.free))
+        .map(|((u, g), k)| (0..D::D).map(|a| g[a] * k[a] * u[a] * u[a]).sum::<f64>())
         .sum();
     let total = dot::<D>(f, u);
     if held <= GHOST_SHARE * total.abs() {

@@ -170,7 +170,8 @@ fn switched(name: &str) -> fissure::io::scenario::Source {
 /// The centre crack in a finite plate (scenarios/centre_crack_2d.toml) solved static in one
 /// load step: K_I at both tips within 0.5 % of Tada's form of Feddersen's formula (good to
 /// 0.1 %; the static solve reads -0.06 %, the damped explicit run +0.0003 %), K_II nil
-/// against K_I.
+/// against K_I; the crack-opening split, from the surfaces the solve moved, within 1 %
+/// (it takes J's magnitude, which the 1 mm cells leave 0.3-0.4 % high both ways).
 #[test]
 fn centre_crack_solved_static() {
     let opts = fissure::app::run::RunOptions::default();
@@ -189,6 +190,8 @@ fn centre_crack_solved_static() {
     for t in tips {
         assert!((t.k[0] - want).abs() / want < 5e-3, "{} vs {want}", t.k[0]);
         assert!(t.k[1].abs() < 1e-6 * want, "{}", t.k[1]);
+        let opening = t.k_opening[0];
+        assert!((opening - want).abs() / want < 1e-2, "{opening} vs {want}");
     }
 }
 

@@ -5,6 +5,7 @@
 //! solution along them. The solve removes that imbalance and keeps its iterates clear of
 //! them (deflation), and reports the part of the load it removed.
 
+use super::unknowns::Unknowns;
 use super::{apply, dot, entry_node};
 use crate::base::dim::Dim;
 use crate::store::world::{CHUNK, World};
@@ -19,10 +20,11 @@ const FREE_STIFFNESS: f64 = 1e-10;
 /// An orthonormal basis (in the free components) of the rigid motions K does not resist.
 pub(super) fn free_motions<D: Dim>(
     world: &World<D>,
-    free: &[D::Vec],
+    dofs: &Unknowns<D>,
     ghost: &[D::Vec],
     largest_diagonal: f64,
 ) -> Vec<Vec<D::Vec>> {
+    let free = &dofs.free;
     let candidates = rigid_candidates(world, free);
     let basis = orthonormal::<D>(candidates);
     if basis.is_empty() {
@@ -33,7 +35,7 @@ pub(super) fn free_motions<D: Dim>(
     let mut q = vec![D::zero(); free.len()];
     let mut g = [[0.0; 6]; 6];
     for (j, bj) in basis.iter().enumerate() {
-        apply(world, bj, free, Some(ghost), &mut q);
+        apply(world, bj, dofs, Some(ghost), &mut q);
         // K is symmetric: the upper triangle, mirrored.
         for (i, bi) in basis.iter().enumerate().take(j + 1) {
             let v = dot::<D>(bi, &q);

@@ -9,7 +9,7 @@ use super::{Outcome, RunOptions, Stop, check_finite, check_snapshot, row_due, st
 use crate::base::error::UsageError;
 use crate::fracture::plan::{FracturePlan, Measured};
 use crate::io::output::figures::Figures;
-use crate::io::output::summary::{NodeLineReport, Status, Summary};
+use crate::io::output::summary::{NodeLineReport, ParticlesOnReport, Status, Summary};
 use crate::io::scenario::{MAX_STEPS, OutputPlan, Scene, Source};
 use crate::pipeline::schedule::Schedule;
 use crate::record::expect::Expect;
@@ -42,6 +42,7 @@ pub(super) struct Run<'a, D: DimSystems> {
     crack_names: Option<Vec<String>>,
     grows: bool,
     node_lines: Vec<NodeLineReport>,
+    particles_on_cracks: Vec<ParticlesOnReport>,
     /// The step the run started from (0, or the snapshot's).
     pub first_step: u64,
 }
@@ -84,6 +85,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
         let crack_names: Option<Vec<String>> = (fracture.as_ref().and(world.cracks.as_ref()))
             .map(|c| c.topology.cracks().iter().map(|c| c.name.clone()).collect());
         let node_lines = reports::node_lines(&world);
+        let particles_on_cracks = reports::particles_on_cracks(&world);
         let growing: Option<(Vec<String>, bool)> = (world.cracks.as_ref())
             .filter(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()))
             .map(|c| {
@@ -140,6 +142,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             crack_names,
             grows: growing.is_some(),
             node_lines,
+            particles_on_cracks,
             first_step,
         };
         if run.resumed_from.is_none() {
@@ -337,6 +340,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             peak_resident_bytes: crate::io::output::summary::peak_resident_bytes(),
             cell_crossings: world.cell_crossings(),
             node_lines: self.node_lines.clone(),
+            particles_on_cracks: self.particles_on_cracks.clone(),
             energies: world.energies(),
             static_solve: (world.settings.solver == crate::store::world::Solver::Static)
                 .then_some(self.schedule.solves),

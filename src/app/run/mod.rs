@@ -4,7 +4,7 @@
 pub mod checkpoint;
 mod driver;
 mod reports;
-pub use reports::node_lines;
+pub use reports::{node_lines, particles_on_cracks};
 pub mod stop;
 pub mod writers;
 

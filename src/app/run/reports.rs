@@ -4,12 +4,13 @@
 use crate::base::dim::Dim;
 use crate::fracture::plan::FracturePlan;
 use crate::io::output::summary::{
-    ContourReport, GrowthReport, NodeLineReport, PathReport, ProbeReport, TubeReport,
+    ContourReport, GrowthReport, NodeLineReport, ParticlesOnReport, PathReport, ProbeReport,
+    TubeReport,
 };
 use crate::physics::growth::Stopped;
 use crate::record::history::{History, last_rows, path_difference, path_tips};
 use crate::record::probe::Probe;
-use crate::store::crack::on_node_lines;
+use crate::store::crack::{on_node_lines, particles_on};
 use crate::store::world::World;
 
 /// The path-dependence report of summary.json: every crack tip against every compared
@@ -205,6 +206,22 @@ pub fn node_lines<D: Dim>(world: &World<D>) -> Vec<NodeLineReport> {
             axis: ["x", "y", "z"][n.axis].into(),
             at: n.at,
             share: n.share,
+        })
+        .collect()
+}
+
+/// The cracks that pass through particle centres as the world stands.
+pub fn particles_on_cracks<D: Dim>(world: &World<D>) -> Vec<ParticlesOnReport> {
+    let Some(cracks) = &world.cracks else {
+        return Vec::new();
+    };
+    let geom = &world.grid.geom;
+    let mut cell = [f64::INFINITY; 3];
+    (0..D::D).for_each(|a| cell[a] = geom.h[a]);
+    (particles_on(cracks, &world.particles.x, cell).into_iter())
+        .map(|(c, particles)| ParticlesOnReport {
+            crack: cracks.topology.cracks()[c].name.clone(),
+            particles,
         })
         .collect()
 }

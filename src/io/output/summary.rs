@@ -86,6 +86,8 @@ pub struct Summary {
     pub cell_crossings: Option<usize>,
     /// Cracks that lay on a line (2D) or plane (3D) of grid nodes when the run began.
     pub node_lines: Vec<NodeLineReport>,
+    /// Cracks that passed through particle centres when the run began.
+    pub particles_on_cracks: Vec<ParticlesOnReport>,
     /// Energies at the end (J).
     pub energies: Energies,
     /// A static scene's solves (None in an explicit run).
@@ -160,6 +162,15 @@ pub struct ContourReport {
     pub tip: String,
     /// Contour size asked for (cells), `[fracture] contour`.
     pub cells: usize,
+}
+
+/// A crack passing through particle centres, whose side of it round-off decides.
+#[derive(Clone, Debug, Serialize)]
+pub struct ParticlesOnReport {
+    /// Crack name.
+    pub crack: String,
+    /// How many particle centres lie on it (within 1e-7 of a cell).
+    pub particles: usize,
 }
 
 /// A crack lying on a line or plane of grid nodes, which costs J and K accuracy.

@@ -108,6 +108,39 @@ impl ElementBins {
         }
     }
 
+    /// Whether a binned element lies within `tol` of `x` (`tol` under a millionth of a bin,
+    /// so such an element is binned where `x` is).
+    pub fn touches<D: Dim>(
+        &self,
+        x: D::Vec,
+        verts: &[D::Vec],
+        elems: &[D::Elem],
+        tol: f64,
+    ) -> bool {
+        let p = D::to_xyz(x);
+        let dims = D::D;
+        if (0..dims).any(|k| {
+            let c = (p[k] - self.origin[k]) / self.size[k];
+            !(c >= 0.0 && c < self.counts[k] as f64)
+        }) || self.items.is_empty()
+        {
+            return false;
+        }
+        let mut r = [(0usize, 0usize); 3];
+        for (k, r) in r.iter_mut().enumerate().take(dims) {
+            let i = self.index(k, p[k]);
+            *r = (i, i);
+        }
+        let mut near = false;
+        self.for_each_bin(r, |b| {
+            let (s, t) = (self.start[b] as usize, self.start[b + 1] as usize);
+            near |= self.items[s..t]
+                .iter()
+                .any(|&e| elems[e as usize].distance_sq(x, verts) <= tol * tol);
+        });
+        near
+    }
+
     /// The binned element nearest to `x` (by [`Dim::elem_distance_sq`]), the lowest index
     /// among equally near ones, as a scan of all of them in order would find; None without
     /// elements.

@@ -12,6 +12,7 @@ mod colors;
 mod fields;
 mod law;
 mod node_lines;
+mod on_particles;
 mod topology;
 
 pub use bins::ElementBins;
@@ -19,6 +20,7 @@ pub use colors::{COLORS, Crowded, colors};
 pub use fields::{Classified, Displacements, Fields, Links, Scratch, side_bit};
 pub use law::{Contact, Law};
 pub use node_lines::{NodeLine, on_node_lines};
+pub use on_particles::particles_on;
 pub use topology::{Crack, Front, Topology, TopologyError};
 
 use crate::base::dim::Dim;

@@ -1,0 +1,100 @@
+//! The unknowns of a load step: the components of the grid entries that are free (a
+//! particle reaches the entry, no boundary holds it), and the crack fields that hold a
+//! sliver of mass, tied to their node's heaviest entry.
+
+use super::{entries, fields};
+use crate::base::dim::Dim;
+use crate::store::world::World;
+
+/// Which entry components are unknowns, and which entries move with another.
+pub(super) struct Unknowns<D: Dim> {
+    /// Per entry, 1 on the free components, 0 on the held ones and on tied entries.
+    pub free: Vec<D::Vec>,
+    /// (sliver field, the entry of the same node it moves with), in entry order.
+    pub ties: Vec<(usize, usize)>,
+}
+
+impl<D: Dim> Unknowns<D> {
+    /// The free components and ties of the world's grid after `p2g`.
+    pub fn new(world: &World<D>) -> Self {
+        let tol = world.settings.mass_tol;
+        let mut free: Vec<D::Vec> = (world.grid.mass.iter())
+            .map(|&m| if m > tol { ones::<D>() } else { D::zero() })
+            .collect();
+        for bc in &world.bcs {
+            let held = (0..D::D).filter(|&a| bc.axes[a]);
+            for &n in &bc.nodes {
+                for e in entries(n, fields(world)) {
+                    held.clone().for_each(|a| free[e][a] = 0.0);
+                }
+            }
+        }
+        let ties = slivers(world);
+        for &(s, _) in &ties {
+            free[s] = D::zero();
+        }
+        Unknowns { free, ties }
+    }
+
+    /// Gives each tied entry the value of the entry it moves with.
+    pub fn expand(&self, x: &mut [D::Vec]) {
+        for &(s, m) in &self.ties {
+            x[s] = x[m];
+        }
+    }
+
+    /// Adds each tied entry's value (a force) to the entry it moves with, and clears it.
+    pub fn fold(&self, y: &mut [D::Vec]) {
+        for &(s, m) in &self.ties {
+            y[m] += y[s];
+            y[s] = D::zero();
+        }
+    }
+}
+
+/// A node's crack fields that hold a sliver of mass (above the grid's mass tolerance, at
+/// most the scene's `sliver_mass`: a particle whose line to the node crosses the crack
+/// while the node is at the edge of its support), each with the node's heaviest entry.
+/// The explicit solver moves such fields with that entry (`grid_update`); here they are
+/// the same unknown. Held on their own, by the few corners of particles that reach them,
+/// they are near-mechanisms whose motions spoil the stresses next to the crack: the
+/// inclined penny's K varied along the front by twice as much.
+fn slivers<D: Dim>(world: &World<D>) -> Vec<(usize, usize)> {
+    let Some(f) = fields(world) else {
+        return Vec::new();
+    };
+    let (mass, tol, sliver) = (
+        &world.grid.mass,
+        world.settings.mass_tol,
+        world.settings.sliver_mass,
+    );
+    let light = |e: usize| mass[e] > tol && mass[e] <= sliver;
+    let mut ties = Vec::new();
+    let mut k = 0;
+    while k < f.node.len() {
+        let node = f.node[k];
+        let rows = f.rows_of(node);
+        k += rows.len();
+        let group = || std::iter::once(node as usize).chain(rows.clone());
+        if !group().any(light) {
+            continue;
+        }
+        let heavy = group()
+            .max_by(|&a, &b| mass[a].total_cmp(&mass[b]))
+            .unwrap_or(node as usize);
+        ties.extend(
+            group()
+                .filter(|&e| e != heavy && light(e))
+                .map(|e| (e, heavy)),
+        );
+    }
+    ties.sort_unstable();
+    ties
+}
+
+/// The vector of ones.
+fn ones<D: Dim>() -> D::Vec {
+    let mut k = D::zero();
+    (0..D::D).for_each(|a| k[a] = 1.0);
+    k
+}
