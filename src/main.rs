@@ -308,6 +308,9 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
     for note in on_particle_notes(&s.particles_on_cracks) {
         println!("  note: {note}");
     }
+    if let Some(note) = ignored_note(&s.ignored_keys) {
+        println!("  note: {note}");
+    }
     if let Some(note) = k_withheld_note(s) {
         println!("  note: {note}");
     }
@@ -531,6 +534,9 @@ fn cmd_check(path: &Path, overrides: &[String]) -> ExitCode {
                     for note in on_particle_notes(&on) {
                         println!("  note: {note}");
                     }
+                    if let Some(note) = ignored_note(&fissure::io::scenario::ignored(&src)) {
+                        println!("  note: {note}");
+                    }
                     ExitCode::SUCCESS
                 }
                 Err(e) => bad_input(&e),
@@ -653,6 +659,16 @@ fn k_withheld_note(s: &Summary) -> Option<&'static str> {
          lies near the J contour or tube (K comes from J only where the response is \
          elastic); J is reported there",
     )
+}
+
+/// What the launcher says of the keys a static scene ignores, if any.
+fn ignored_note(keys: &[String]) -> Option<String> {
+    (!keys.is_empty()).then(|| {
+        format!(
+            "a static scene ignores {} (they apply to explicit runs only)",
+            keys.join(", ")
+        )
+    })
 }
 
 /// What the launcher says of each crack that passes through particle centres.

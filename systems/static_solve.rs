@@ -24,6 +24,7 @@ use crate::with_shape;
 use rayon::prelude::*;
 
 mod rigid;
+mod supports;
 mod unknowns;
 
 use unknowns::Unknowns;
@@ -60,8 +61,9 @@ pub const TOLERANCE: f64 = 1e-8;
 const ITERATIONS_PER_NODE: usize = 50;
 
 /// Solves the load step ending at the next step's time and sets the particles to it: x =
-/// x0 + u, v = 0, grad u and the stress it gives; adds the work of the loads over the step
-/// (trapezoidal, exact for a linear response). Refuses a solve that does not converge.
+/// x0 + u, v = 0, grad u and the stress it gives; adds the work of the loads and the moving
+/// supports over the step (trapezoidal, exact for a linear response). Refuses a solve that
+/// does not converge.
 pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     let t_end = (world.step + 1) as f64 * world.settings.dt;
     let before: Vec<D::Vec> = (world.particles.x.iter())
@@ -90,7 +92,15 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     let largest = (diag.iter().zip(free))
         .flat_map(|(d, k)| (0..D::D).filter(|&a| k[a] != 0.0).map(|a| d[a]))
         .fold(0.0, f64::max);
+    // Moving supports: K u = f with u = u_f + u_c, u_c prescribed, leaves K u_f = f - K u_c.
+    let held = supports::prescribed(world, t_end);
+    let start_forces = supports::start_forces(world, t_start);
     let mut f_ext = world.grid.force.clone();
+    if let Some(u_c) = &held {
+        let mut k_c = vec![D::zero(); u_c.len()];
+        stiffness(world, u_c, &dofs, &mut k_c);
+        f_ext.iter_mut().zip(&k_c).for_each(|(f, &k)| *f -= k);
+    }
     dofs.fold(&mut f_ext);
     for (f, &k) in f_ext.iter_mut().zip(free) {
         *f = mask::<D>(*f, k);
@@ -119,12 +129,16 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     let (mut u, mut solved) = conjugate_gradients(world, &f_ext, &ghost, &diag, &dofs, &modes)?;
     dofs.expand(&mut u);
     leans_on_ghost(world, &u, &ghost, &dofs, &f_ext, t_end)?;
+    if let Some(u_c) = &held {
+        u.iter_mut().zip(u_c).for_each(|(u, &c)| *u += c);
+    }
     solved.free_motions = modes.len();
     solved.imbalance = imbalance;
     reactions(world, &dofs, &u);
     let after = gather(world, &u);
     move_cracks(world, &before, &after);
-    let work = load_work(world, &before, &after, t_start, t_end);
+    let work = load_work(world, &before, &after, t_start, t_end)
+        + supports::work(world, &start_forces, t_start, t_end);
     world.work.external += work;
     set_particles(world, &u, &after);
     Ok(solved)

@@ -911,6 +911,34 @@ fn restart_is_bit_exact_with_a_cracked_static_scene() {
     restart_is_bit_exact(&text, 7, 2, "static_crack");
 }
 
+/// A static scene whose grip moves (a bar pulled by a prescribed velocity's displacement
+/// over 24 load steps): the grip's work over each step takes its force at the step's start
+/// from the particles' stresses, so a resumed run books the same work; stopped after 7 and
+/// resumed, the same bits.
+#[test]
+fn restart_is_bit_exact_with_a_moving_static_grip() {
+    let text = common::strip_2d(
+        "plane = \"stress\"\nthickness = 0.01\nsolver = \"static\"\nload_steps = 24",
+        3e-5,
+        r#"
+[[body]]
+material = "m"
+box = { min = [0.002, 0.002], max = [0.03, 0.01] }
+[[boundary]]
+region = { min = [0.0, 0.0], max = [0.002, 0.012] }
+fix = ["x", "y"]
+[[boundary]]
+region = { min = [0.03, 0.0], max = [0.04, 0.012] }
+fix = ["x"]
+velocity = [0.1, 0.0]
+time = { kind = "ramp", rise = 1e-5 }
+[checkpoint]
+every_steps = 10
+"#,
+    );
+    restart_is_bit_exact(&text, 7, 2, "static_grip");
+}
+
 /// A static scene (the shipped cantilever on 2 mm cells, its load ramped over 24 load
 /// steps): stopped after 7 and resumed, every output and the last snapshot the same bits.
 #[test]

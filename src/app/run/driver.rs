@@ -344,6 +344,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             energies: world.energies(),
             static_solve: (world.settings.solver == crate::store::world::Solver::Static)
                 .then_some(self.schedule.solves),
+            ignored_keys: crate::io::scenario::ignored(self.src),
             probes: reports::probes(&self.probes, history),
             expects: results,
             paths: reports::paths(world, fracture, history),

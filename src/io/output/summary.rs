@@ -92,6 +92,9 @@ pub struct Summary {
     pub energies: Energies,
     /// A static scene's solves (None in an explicit run).
     pub static_solve: Option<SolveLog>,
+    /// The keys a static scene ignores (explicit runs only: cfl, dt, damping, initial
+    /// velocities), as given.
+    pub ignored_keys: Vec<String>,
     /// Every probe's last sample (e.g. the crack-mouth opening of an `opening` probe).
     pub probes: Vec<ProbeReport>,
     /// Results of the scenario's `[[expect]]` blocks (only for a completed run).

@@ -33,3 +33,4 @@ pub use check::folder_name_problem;
 pub use output::{CheckpointPlan, OutputPlan};
 pub use settings::MAX_STEPS;
 pub use source::Source;
+pub use statics::ignored;

@@ -1,7 +1,7 @@
 //! What a static scene (`solver = "static"`) may hold so far: linear elastic bodies held
-//! still by their boundaries, under loads and gravity, with open cracks. Crack-face
-//! contact, growth, plasticity and prescribed displacements are refused by name until the
-//! static solver takes them.
+//! by their boundaries (still, or moved by a prescribed velocity's displacement), under
+//! loads and gravity, with open cracks. Crack-face contact, growth and plasticity are
+//! refused by name until the static solver takes them.
 
 use super::check::R;
 use super::source::Source;
@@ -38,18 +38,32 @@ pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()
              run this scene with solver = \"explicit\"",
         ));
     }
-    for (i, bc) in sc.boundaries.iter().enumerate() {
-        if bc
-            .velocity
-            .as_ref()
-            .is_some_and(|v| v.iter().any(|&c| c != 0.0))
-        {
-            return Err(src.error(
-                &format!("boundary[{i}].velocity"),
-                "a static scene's boundaries hold their nodes still: prescribed \
-                 displacements are not taken yet",
-            ));
+    Ok(())
+}
+
+/// The keys of a static scene that apply to explicit runs only, as given (none in an
+/// explicit scene): the launcher and summary.json name them, so that a scene switched
+/// between the solvers by one key never drops one silently.
+pub fn ignored(src: &Source) -> Vec<String> {
+    let sc = &src.scenario;
+    let sim = &sc.simulation;
+    if sim.solver != Solver::Static {
+        return Vec::new();
+    }
+    let mut keys = Vec::new();
+    let given = [
+        ("simulation.cfl", sim.cfl.is_some()),
+        ("simulation.dt", sim.dt.is_some()),
+        ("simulation.damping", sim.damping != 0.0),
+    ];
+    keys.extend((given.iter()).filter(|g| g.1).map(|g| g.0.to_string()));
+    for (b, body) in sc.bodies.iter().enumerate() {
+        if body.velocity.is_some() {
+            keys.push(format!("body[{b}].velocity"));
+        }
+        if body.angular_velocity.is_some() {
+            keys.push(format!("body[{b}].angular_velocity"));
         }
     }
-    Ok(())
+    keys
 }

@@ -1,0 +1,110 @@
+//! Supports that move: a static scene's boundary with a `velocity` prescribes the
+//! displacement that velocity would give by each load step's time (the same motion an
+//! explicit run of the scene imposes), and does work on the body through its reaction.
+
+use super::{each_entry, entries, fields};
+use crate::base::dim::Dim;
+use crate::store::world::World;
+
+/// Per grid entry, the displacement the moving supports prescribe at time `t` on their
+/// held components (zero elsewhere); None when no support moves.
+pub(super) fn prescribed<D: Dim>(world: &World<D>, t: f64) -> Option<Vec<D::Vec>> {
+    let moves = |bc: &crate::physics::loads::VelocityBc<D>| {
+        (0..D::D).any(|a| bc.axes[a] && bc.velocity[a] != 0.0)
+    };
+    if !world.bcs.iter().any(moves) {
+        return None;
+    }
+    let mut u = vec![D::zero(); world.grid.mass.len()];
+    for bc in world.bcs.iter().filter(|bc| moves(bc)) {
+        let d = displacement(bc, t);
+        for &n in &bc.nodes {
+            for e in entries(n, fields(world)) {
+                (0..D::D)
+                    .filter(|&a| bc.axes[a])
+                    .for_each(|a| u[e][a] = d[a]);
+            }
+        }
+    }
+    Some(u)
+}
+
+/// The displacement support `bc` prescribes by time `t` on its held components: its
+/// velocity times the integral of its time function from 0.
+fn displacement<D: Dim>(bc: &crate::physics::loads::VelocityBc<D>, t: f64) -> D::Vec {
+    let mut d = D::zero();
+    let scale = bc.time.integral(t);
+    (0..D::D)
+        .filter(|&a| bc.axes[a])
+        .for_each(|a| d[a] = bc.velocity[a] * scale);
+    d
+}
+
+/// Each support's force on the body per node at the start of the step, from the state the
+/// last step left: K u_old (the particles' stresses, C : sym(grad u_old), scattered as
+/// the internal force) less the loads and gravity at `t_start`, summed over the node's
+/// entries. The particles' stresses are in every snapshot, so a resumed run finds the
+/// same forces. Zero on the first step, which starts from the unloaded body.
+pub(super) fn start_forces<D: Dim>(world: &World<D>, t_start: f64) -> Vec<Vec<D::Vec>> {
+    let zero = || (world.bcs.iter()).map(|bc| vec![D::zero(); bc.nodes.len()]);
+    if world.step == 0 {
+        return zero().collect();
+    }
+    // Only entries of support nodes are needed: mark them.
+    let mut wanted = vec![false; world.grid.mass.len()];
+    for bc in &world.bcs {
+        for &n in &bc.nodes {
+            entries(n, fields(world)).for_each(|e| wanted[e] = true);
+        }
+    }
+    let p = &world.particles;
+    let mut r = vec![D::zero(); wanted.len()];
+    for i in 0..p.len() {
+        let s = p.stress[i];
+        each_entry(world, i, |n, _, g| {
+            if wanted[n] {
+                r[n] += D::stress_dot(&s, g) * p.volume[i];
+            }
+        });
+    }
+    for load in &world.loads {
+        let scale = load.time.at(t_start);
+        for (&i, &f) in load.particles.iter().zip(&load.forces) {
+            each_entry(world, i as usize, |n, w, _| {
+                if wanted[n] {
+                    r[n] -= f * (scale * w);
+                }
+            });
+        }
+    }
+    let g = world.settings.gravity;
+    for (e, r) in r.iter_mut().enumerate().filter(|(e, _)| wanted[*e]) {
+        *r -= g * world.grid.mass[e];
+    }
+    (world.bcs.iter())
+        .map(|bc| {
+            (bc.nodes.iter())
+                .map(|&n| entries(n, fields(world)).fold(D::zero(), |s, e| s + r[e]))
+                .collect()
+        })
+        .collect()
+}
+
+/// The work the moving supports did on the body over the step: each node's force, the
+/// mean of its values at the step's ends (`start` and the reactions now in the world:
+/// exact for a linear response), times its prescribed displacement over the step.
+pub(super) fn work<D: Dim>(
+    world: &World<D>,
+    start: &[Vec<D::Vec>],
+    t_start: f64,
+    t_end: f64,
+) -> f64 {
+    let mut work = 0.0;
+    for (bc, start) in world.bcs.iter().zip(start) {
+        let step = displacement(bc, t_end) - displacement(bc, t_start);
+        for (r0, r1) in start.iter().zip(&bc.reaction) {
+            work += D::dot((*r0 + *r1) * 0.5, step);
+        }
+    }
+    work
+}
