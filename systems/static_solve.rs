@@ -50,12 +50,6 @@ const GHOST: f64 = 1e-11;
 /// nodes (a half and a quarter) above. At 3 % the turned DCB's K moved in the fourth digit.
 const LIGHT: f64 = 0.1;
 
-/// The residual, relative to the external force, at which a load step has converged: four
-/// orders below the discretisation's own error (1e-4 at best in the shipped scenes), and
-/// above the floor the iteration's round-off reaches (1e-10 to 3e-9 on the cracked 2D
-/// scenes).
-pub const TOLERANCE: f64 = 1e-8;
-
 /// Most iterations per load step, per unknown along the grid's longest axis: conjugate
 /// gradients on a well-supported grid converge in a small multiple of it.
 const ITERATIONS_PER_NODE: usize = 50;
@@ -276,7 +270,7 @@ fn dot<D: Dim>(a: &[D::Vec], b: &[D::Vec]) -> f64 {
 }
 
 /// Solves K u = f on the free components from u = 0 by preconditioned conjugate gradients
-/// (Hestenes & Stiefel 1952), to a residual of [`TOLERANCE`] times |f|.
+/// (Hestenes & Stiefel 1952), to a residual of the scene's tolerance times |f|.
 fn conjugate_gradients<D: Dim>(
     world: &World<D>,
     f: &[D::Vec],
@@ -327,7 +321,7 @@ fn conjugate_gradients<D: Dim>(
                 *r -= q * alpha;
             });
         let residual = dot::<D>(&r, &r).sqrt() / norm_f;
-        if residual <= TOLERANCE {
+        if residual <= world.settings.tolerance {
             return Ok((
                 u,
                 Solved {

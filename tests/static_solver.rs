@@ -96,7 +96,8 @@ fn static_solve_is_the_same_on_any_thread_count() {
 }
 
 /// Crack-face contact, crack growth and a plastic material are refused in a static scene,
-/// naming the key; load steps in an explicit scene too.
+/// naming the key; load steps and a tolerance in an explicit scene too, and a tolerance
+/// outside 1e-12 to 1e-2.
 #[test]
 fn what_the_static_solver_does_not_take_is_refused() {
     let err = |text: String| match build::<D3>(&source(&text)) {
@@ -128,6 +129,24 @@ fn what_the_static_solver_does_not_take_is_refused() {
     let explicit = column("").replace("solver = \"static\"\n", "");
     let e = err(explicit);
     assert!(e.contains("simulation.load_steps"), "{e}");
+    let explicit = column("")
+        .replace("solver = \"static\"\n", "")
+        .replace("load_steps = 2", "tolerance = 1e-6");
+    let e = err(explicit);
+    assert!(
+        e.contains("simulation.tolerance") && e.contains("static"),
+        "{e}"
+    );
+    for t in ["1e-14", "0.5", "-1e-8"] {
+        let e = err(column("").replace(
+            "load_steps = 2",
+            &format!("load_steps = 2\ntolerance = {t}"),
+        ));
+        assert!(
+            e.contains("simulation.tolerance") && e.contains("between"),
+            "{e}"
+        );
+    }
 }
 
 /// An aluminium bar 28 x 8 mm (plane stress, 10 mm thick) between two grips that hold x
@@ -216,6 +235,34 @@ fn explicit_only_keys_are_ignored_by_name() {
     assert!(plain.summary.ignored_keys.is_empty());
     let top = |o: &fissure::app::run::Outcome| o.history.probes[0].last().unwrap().to_bits();
     assert_eq!(top(&plain), top(&noisy));
+}
+
+/// `tolerance` is where each load step stops: the column at 1e-4 stops within it, in
+/// fewer iterations than at the default 1e-8, and its floor still carries the weight
+/// within 1e-3.
+#[test]
+fn the_tolerance_is_the_scenes() {
+    let exact = common::run_text(&column(""));
+    let loose = column("").replace("load_steps = 2", "load_steps = 2\ntolerance = 1e-4");
+    let loose = common::run_text(&loose);
+    let (a, b) = (
+        exact.summary.static_solve.unwrap(),
+        loose.summary.static_solve.unwrap(),
+    );
+    assert!(
+        a.worst_residual <= 1e-8 && b.worst_residual <= 1e-4,
+        "{a:?} {b:?}"
+    );
+    assert!(
+        b.worst_residual > 1e-8 && b.iterations < a.iterations,
+        "{a:?} {b:?}"
+    );
+    let weight = 8000.0 * 9.81e4 * 0.01 * 0.01 * 0.1;
+    let floor = *loose.history.probes[1].last().unwrap();
+    assert!(
+        (floor - weight).abs() <= 1e-3 * weight,
+        "{floor} vs {weight}"
+    );
 }
 
 /// A column with nothing to stand on: gravity would start it moving, so equilibrium has no

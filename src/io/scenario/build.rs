@@ -10,7 +10,7 @@ use crate::fracture::plan::FracturePlan;
 use crate::record::expect::Expect;
 use crate::record::probe::Probe;
 use crate::store::grid::Grid;
-use crate::store::world::{Settings, Work, World};
+use crate::store::world::{STATIC_TOLERANCE, Settings, Work, World};
 
 /// A World ready to run, with what the run records and checks.
 #[derive(Clone, Debug)]
@@ -73,6 +73,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         materials,
         settings: Settings {
             solver: s.solver,
+            tolerance: s.tolerance.unwrap_or(STATIC_TOLERANCE),
             shape: s.shape,
             update: s.update,
             plane: sim.plane,

@@ -83,6 +83,9 @@ pub struct Simulation {
     /// A static scene's load steps over `duration` (default: one per history row when
     /// `[output] history_interval` is given, else 10).
     pub load_steps: Option<u64>,
+    /// A static scene's residual, relative to the external force, at which a load step has
+    /// converged (default 1e-8).
+    pub tolerance: Option<f64>,
 }
 
 /// `[grid]`.

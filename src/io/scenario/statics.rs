@@ -8,9 +8,31 @@ use super::source::Source;
 use crate::physics::material::Material;
 use crate::store::world::Solver;
 
+/// The convergence tolerances a static scene may ask for: below the lower, round-off
+/// keeps the iteration from converging; above the upper, the answer is not a solution.
+const TOLERANCE_RANGE: (f64, f64) = (1e-12, 1e-2);
+
 /// Refuses what the static solver does not take yet, naming the key.
 pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()> {
     let sc = &src.scenario;
+    if let Some(t) = sc.simulation.tolerance {
+        if sc.simulation.solver != Solver::Static {
+            return Err(src.error(
+                "simulation.tolerance",
+                "a convergence tolerance belongs to a static scene (solver = \"static\")",
+            ));
+        }
+        if !(TOLERANCE_RANGE.0..=TOLERANCE_RANGE.1).contains(&t) {
+            return Err(src.error(
+                "simulation.tolerance",
+                format!(
+                    "give a residual between {:e} (round-off stops conjugate gradients near \
+                     1e-10) and {:e} of the load",
+                    TOLERANCE_RANGE.0, TOLERANCE_RANGE.1
+                ),
+            ));
+        }
+    }
     if sc.simulation.solver != Solver::Static {
         return Ok(());
     }
