@@ -16,7 +16,7 @@ use crate::with_shape;
 /// element nearest to `x`, from that colour's bins (built on first use: scenes without
 /// contact rows pay nothing). Cracks sharing a colour are never within a stencil's reach of
 /// one another, so the nearest is the one the row's particles crossed.
-fn nearest<D: Dim>(
+pub(crate) fn nearest<D: Dim>(
     bins: &mut [Option<ElementBins>],
     cracks: &Cracks<D>,
     cell: [f64; 3],

@@ -23,6 +23,7 @@ use crate::systems::{bin, classify, crack_advect, p2g};
 use crate::with_shape;
 use rayon::prelude::*;
 
+mod faces;
 mod rigid;
 mod supports;
 mod unknowns;
@@ -80,27 +81,84 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     for (f, &m) in grid.force.iter_mut().zip(&grid.mass) {
         *f += g * m;
     }
-    let dofs = Unknowns::new(world);
+    let held = supports::prescribed(world, t_end);
+    let start_forces = supports::start_forces(world, t_start);
+    let pairs = faces::pairs(world);
+    let mut closed = vec![false; pairs.len()];
+    let mut iterations = 0;
+    let mut rounds = 0;
+    let mut last: Option<Vec<D::Vec>> = None;
+    let (u, dofs, mut solved) = loop {
+        let dofs = Unknowns::new(world, &pairs, &closed);
+        let (u, solved) = equilibrium(world, &dofs, held.as_deref(), last.as_deref(), t_end)?;
+        iterations += solved.iterations;
+        rounds += 1;
+        if pairs.is_empty() {
+            break (u, dofs, solved);
+        }
+        let changes = faces_round(world, &pairs, &mut closed, &u);
+        if changes.closed + changes.opened == 0 {
+            break (u, dofs, solved);
+        }
+        last = Some(u);
+        if rounds >= CONTACT_ROUNDS {
+            return Err(Unstable {
+                step: world.step + 1,
+                time: t_end,
+                what: format!(
+                    "the crack faces' contact did not settle in {rounds} solves (the last \
+                     closed {} pairs and opened {})",
+                    changes.closed, changes.opened
+                ),
+            });
+        }
+    };
+    solved.iterations = iterations;
+    solved.contact_rounds = rounds;
+    solved.closed_faces = closed.iter().filter(|&&c| c).count();
+    reactions(world, &dofs, &u);
+    let after = gather(world, &u);
+    move_cracks(world, &before, &after);
+    let work = load_work(world, &before, &after, t_start, t_end)
+        + supports::work(world, &start_forces, t_start, t_end);
+    world.work.external += work;
+    set_particles(world, &u, &after);
+    Ok(solved)
+}
+
+/// Most solves a load step's contact active set may take: each round closes the pairs
+/// that overlap and opens those that pull, and a few rounds settle a face.
+const CONTACT_ROUNDS: usize = 50;
+
+/// Equilibrium with the unknowns `dofs`: K u_f = f - K u_c on the free components (u_c
+/// the moving supports' displacement `held`), the rigid motions K leaves free taken out,
+/// from `guess` (every entry's displacement) or from zero; returns every entry's
+/// displacement u_f + u_c (tied entries given their partners').
+fn equilibrium<D: Dim>(
+    world: &World<D>,
+    dofs: &Unknowns<D>,
+    held: Option<&[D::Vec]>,
+    guess: Option<&[D::Vec]>,
+    t_end: f64,
+) -> Result<(Vec<D::Vec>, Solved), Unstable> {
     let free = &dofs.free;
-    let diag = diagonal(world, &dofs);
+    let diag = diagonal(world, dofs);
     let largest = (diag.iter().zip(free))
         .flat_map(|(d, k)| (0..D::D).filter(|&a| k[a] != 0.0).map(|a| d[a]))
         .fold(0.0, f64::max);
-    // Moving supports: K u = f with u = u_f + u_c, u_c prescribed, leaves K u_f = f - K u_c.
-    let held = supports::prescribed(world, t_end);
-    let start_forces = supports::start_forces(world, t_start);
     let mut f_ext = world.grid.force.clone();
-    if let Some(u_c) = &held {
+    if let Some(u_c) = held {
         let mut k_c = vec![D::zero(); u_c.len()];
-        stiffness(world, u_c, &dofs, &mut k_c);
+        stiffness(world, u_c, dofs, &mut k_c);
         f_ext.iter_mut().zip(&k_c).for_each(|(f, &k)| *f -= k);
     }
     dofs.fold(&mut f_ext);
     for (f, &k) in f_ext.iter_mut().zip(free) {
         *f = mask::<D>(*f, k);
     }
+    dofs.project(&mut f_ext);
     let ghost = ghost_stiffness(world, &diag);
-    let modes = rigid::free_motions(world, &dofs, &ghost, largest);
+    let modes = rigid::free_motions(world, dofs, &ghost, largest);
     let norm = dot::<D>(&f_ext, &f_ext).sqrt();
     rigid::deflate::<D>(&mut f_ext, &modes);
     let imbalance = if norm > 0.0 {
@@ -120,22 +178,49 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
             ),
         });
     }
-    let (mut u, mut solved) = conjugate_gradients(world, &f_ext, &ghost, &diag, &dofs, &modes)?;
+    // A start from the last round's answer (contact), in this round's unknowns.
+    let start = guess.map(|g| {
+        let mut s: Vec<D::Vec> = (g.iter().enumerate())
+            .map(|(e, &x)| mask::<D>(x - held.map_or(D::zero(), |h| h[e]), free[e]))
+            .collect();
+        dofs.project(&mut s);
+        rigid::deflate::<D>(&mut s, &modes);
+        s
+    });
+    let (mut u, mut solved) =
+        conjugate_gradients(world, &f_ext, &ghost, &diag, dofs, &modes, start)?;
     dofs.expand(&mut u);
-    leans_on_ghost(world, &u, &ghost, &dofs, &f_ext, t_end)?;
-    if let Some(u_c) = &held {
+    leans_on_ghost(world, &u, &ghost, dofs, &f_ext, t_end)?;
+    if let Some(u_c) = held {
         u.iter_mut().zip(u_c).for_each(|(u, &c)| *u += c);
     }
     solved.free_motions = modes.len();
     solved.imbalance = imbalance;
-    reactions(world, &dofs, &u);
-    let after = gather(world, &u);
-    move_cracks(world, &before, &after);
-    let work = load_work(world, &before, &after, t_start, t_end)
-        + supports::work(world, &start_forces, t_start, t_end);
-    world.work.external += work;
-    set_particles(world, &u, &after);
-    Ok(solved)
+    Ok((u, solved))
+}
+
+/// One active-set round on the crack-face `pairs` at the solution `u`: the overlap along
+/// each pair's normal, and the force its constraint carries (K u - f_ext on the field
+/// above). Tolerances: 1e-9 of the largest displacement, 1e-8 of the largest nodal force.
+fn faces_round<D: Dim>(
+    world: &World<D>,
+    pairs: &[faces::Pair<D::Vec>],
+    closed: &mut [bool],
+    u: &[D::Vec],
+) -> faces::Changes {
+    let loose = Unknowns::new(world, &[], &[]);
+    let mut r = vec![D::zero(); u.len()];
+    stiffness(world, u, &loose, &mut r);
+    let largest = |v: &[D::Vec]| {
+        (v.iter())
+            .map(|x| D::dot(*x, *x).sqrt())
+            .fold(0.0, f64::max)
+    };
+    let force_tol = 1e-8 * largest(&r);
+    r.iter_mut()
+        .zip(&world.grid.force)
+        .for_each(|(r, &f)| *r -= f);
+    faces::update::<D>(pairs, closed, u, &r, 1e-9 * largest(u), force_tol)
 }
 
 /// `v` with the components `keep` has at 0 cleared.
@@ -162,7 +247,7 @@ fn elastic<D: Dim>(m: &Material, plane: Plane, l: &D::Mat) -> D::Sym {
 /// thread count), tied entries' forces folded into their partners'.
 fn stiffness<D: Dim>(world: &World<D>, x: &[D::Vec], dofs: &Unknowns<D>, y: &mut [D::Vec]) {
     let expanded;
-    let x = if dofs.ties.is_empty() {
+    let x = if dofs.ties.is_empty() && dofs.normal_ties.is_empty() {
         x
     } else {
         let mut e = x.to_vec();
@@ -225,6 +310,7 @@ fn apply<D: Dim>(
                 }
             }
         });
+    dofs.project(y);
 }
 
 /// The diagonal of K (its free components; 1 elsewhere, so the preconditioner leaves the
@@ -278,12 +364,12 @@ fn conjugate_gradients<D: Dim>(
     diag: &[D::Vec],
     dofs: &Unknowns<D>,
     modes: &[Vec<D::Vec>],
+    start: Option<Vec<D::Vec>>,
 ) -> Result<(Vec<D::Vec>, Solved), Unstable> {
     let n = f.len();
-    let mut u = vec![D::zero(); n];
     let norm_f = dot::<D>(f, f).sqrt();
     if norm_f == 0.0 {
-        return Ok((u, Solved::default()));
+        return Ok((vec![D::zero(); n], Solved::default()));
     }
     let precondition = |r: &[D::Vec]| -> Vec<D::Vec> {
         r.par_iter()
@@ -298,7 +384,25 @@ fn conjugate_gradients<D: Dim>(
             .collect()
     };
     let mut r = f.to_vec();
+    let mut u = match start {
+        Some(u) => {
+            let mut q = vec![D::zero(); n];
+            apply(world, &u, dofs, Some(ghost), &mut q);
+            r.iter_mut().zip(&q).for_each(|(r, &q)| *r -= q);
+            u
+        }
+        None => vec![D::zero(); n],
+    };
+    let residual = dot::<D>(&r, &r).sqrt() / norm_f;
+    if residual <= world.settings.tolerance {
+        let solved = Solved {
+            residual,
+            ..Solved::default()
+        };
+        return Ok((u, solved));
+    }
     let mut z = precondition(&r);
+    dofs.project(&mut z);
     rigid::deflate::<D>(&mut z, modes);
     let mut dir = z.clone();
     let mut rz = dot::<D>(&r, &z);
@@ -332,6 +436,7 @@ fn conjugate_gradients<D: Dim>(
             ));
         }
         z = precondition(&r);
+        dofs.project(&mut z);
         rigid::deflate::<D>(&mut z, modes);
         let rz_next = dot::<D>(&r, &z);
         let beta = rz_next / rz;

@@ -13,6 +13,10 @@ pub struct Solved {
     pub free_motions: usize,
     /// The part of the load's norm along them, removed before the solve.
     pub imbalance: f64,
+    /// Crack-face pairs closed at the solution.
+    pub closed_faces: usize,
+    /// Solves the contact active set took (1 without contact).
+    pub contact_rounds: usize,
 }
 
 /// What a static scene's load steps took: counts, iterations and the worst residual.
@@ -30,6 +34,10 @@ pub struct SolveLog {
     pub free_motions: usize,
     /// Largest part of a load step's load removed as imbalance along them.
     pub largest_imbalance: f64,
+    /// Crack-face pairs closed at the last load step.
+    pub closed_faces: usize,
+    /// Most solves one load step's contact active set took.
+    pub most_contact_rounds: usize,
 }
 
 impl SolveLog {
@@ -41,5 +49,7 @@ impl SolveLog {
         self.worst_residual = self.worst_residual.max(s.residual);
         self.free_motions = s.free_motions;
         self.largest_imbalance = self.largest_imbalance.max(s.imbalance);
+        self.closed_faces = s.closed_faces;
+        self.most_contact_rounds = self.most_contact_rounds.max(s.contact_rounds);
     }
 }

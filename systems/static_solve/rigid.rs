@@ -25,7 +25,8 @@ pub(super) fn free_motions<D: Dim>(
     largest_diagonal: f64,
 ) -> Vec<Vec<D::Vec>> {
     let free = &dofs.free;
-    let candidates = rigid_candidates(world, free);
+    let mut candidates = rigid_candidates(world, free);
+    candidates.iter_mut().for_each(|c| dofs.project(c));
     let basis = orthonormal::<D>(candidates);
     if basis.is_empty() {
         return basis;

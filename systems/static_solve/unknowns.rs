@@ -1,7 +1,9 @@
 //! The unknowns of a load step: the components of the grid entries that are free (a
-//! particle reaches the entry, no boundary holds it), and the crack fields that hold a
-//! sliver of mass, tied to their node's heaviest entry.
+//! particle reaches the entry, no boundary holds it), the crack fields that hold a sliver
+//! of mass, tied to their node's heaviest entry, and the closed frictionless crack faces,
+//! tied along the crack's normal.
 
+use super::faces::Pair;
 use super::{entries, fields};
 use crate::base::dim::Dim;
 use crate::store::world::World;
@@ -12,11 +14,15 @@ pub(super) struct Unknowns<D: Dim> {
     pub free: Vec<D::Vec>,
     /// (sliver field, the entry of the same node it moves with), in entry order.
     pub ties: Vec<(usize, usize)>,
+    /// (tied entry, its partner, the unit normal along which they move together): closed
+    /// frictionless pairs. The tied entry's normal component is not an unknown.
+    pub normal_ties: Vec<(usize, usize, D::Vec)>,
 }
 
 impl<D: Dim> Unknowns<D> {
-    /// The free components and ties of the world's grid after `p2g`.
-    pub fn new(world: &World<D>) -> Self {
+    /// The free components and ties of the world's grid after `p2g`, with the face
+    /// `pairs` flagged in `closed` closed.
+    pub fn new(world: &World<D>, pairs: &[Pair<D::Vec>], closed: &[bool]) -> Self {
         let tol = world.settings.mass_tol;
         let mut free: Vec<D::Vec> = (world.grid.mass.iter())
             .map(|&m| if m > tol { ones::<D>() } else { D::zero() })
@@ -30,24 +36,51 @@ impl<D: Dim> Unknowns<D> {
             }
         }
         let ties = slivers(world);
+        let sliver = |e: usize| ties.binary_search_by_key(&e, |t| t.0).is_ok();
+        let normal_ties = (pairs.iter().zip(closed))
+            .filter(|(p, c)| **c && !sliver(p.row) && !sliver(p.own))
+            .map(|(p, _)| (p.row, p.own, p.normal))
+            .collect();
         for &(s, _) in &ties {
             free[s] = D::zero();
         }
-        Unknowns { free, ties }
+        Unknowns {
+            free,
+            ties,
+            normal_ties,
+        }
     }
 
-    /// Gives each tied entry the value of the entry it moves with.
+    /// Gives each tied entry the value of the entry it moves with (along the normal for a
+    /// frictionless pair).
     pub fn expand(&self, x: &mut [D::Vec]) {
         for &(s, m) in &self.ties {
             x[s] = x[m];
         }
+        for &(s, m, n) in &self.normal_ties {
+            x[s] += n * D::dot(x[m] - x[s], n);
+        }
     }
 
-    /// Adds each tied entry's value (a force) to the entry it moves with, and clears it.
+    /// Adds each tied entry's value (a force) to the entry it moves with, and clears it
+    /// (its normal part, for a frictionless pair).
     pub fn fold(&self, y: &mut [D::Vec]) {
         for &(s, m) in &self.ties {
             y[m] += y[s];
             y[s] = D::zero();
+        }
+        for &(s, m, n) in &self.normal_ties {
+            let along = n * D::dot(y[s], n);
+            y[m] += along;
+            y[s] -= along;
+        }
+    }
+
+    /// Clears the components that are not unknowns: the normal part of each frictionless
+    /// pair's tied entry (the free mask clears the rest).
+    pub fn project(&self, x: &mut [D::Vec]) {
+        for &(s, _, n) in &self.normal_ties {
+            x[s] -= n * D::dot(x[s], n);
         }
     }
 }

@@ -1,7 +1,7 @@
 //! What a static scene (`solver = "static"`) may hold so far: linear elastic bodies held
 //! by their boundaries (still, or moved by a prescribed velocity's displacement), under
-//! loads and gravity, with open cracks. Crack-face contact, growth and plasticity are
-//! refused by name until the static solver takes them.
+//! loads and gravity, with open cracks or faces in frictionless contact. Stick and friction,
+//! growth and plasticity are refused by name until the static solver takes them.
 
 use super::check::R;
 use super::source::Source;
@@ -37,12 +37,16 @@ pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()
         return Ok(());
     }
     for (c, crack) in sc.cracks.iter().enumerate() {
-        if crack.contact.as_ref().is_some_and(|k| k.law != "none") {
+        if let Some(law) = (crack.contact.as_ref())
+            .map(|k| k.law.as_str())
+            .filter(|&l| l != "none" && l != "frictionless")
+        {
             return Err(src.error(
-                &format!("crack[{c}].contact"),
-                "the static solver does not take crack-face contact yet (faces that close \
-                 need contact constraints): give law = \"none\" for open cracks, or run \
-                 this scene with solver = \"explicit\"",
+                &format!("crack[{c}].contact.law"),
+                format!(
+                    "the static solver takes frictionless crack faces, not `{law}` yet: run \
+                     this scene with solver = \"explicit\""
+                ),
             ));
         }
         if crack.growth.is_some() {
