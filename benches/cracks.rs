@@ -9,6 +9,9 @@
 //!
 //! `cargo bench --bench cracks`.
 
+mod common;
+
+use common::PENNY;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use fissure::base::dim::{D2, D3};
 use fissure::io::scenario::{Source, build};
@@ -74,38 +77,6 @@ fn cracks(c: &mut Criterion) {
     });
     g.finish();
 }
-
-/// The penny-crack cube of the 3D benches.
-const PENNY: &str = r#"
-[simulation]
-dimension = 3
-shape = "ugimp"
-update = "usavg"
-duration = 1.0e-4
-[grid]
-min = [-0.002, -0.002, -0.002]
-max = [0.032, 0.032, 0.032]
-cell = [0.001, 0.001, 0.001]
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 8000.0
-[[body]]
-material = "steel"
-box = { min = [0.0, 0.0, 0.0], max = [0.03, 0.03, 0.03] }
-[[crack]]
-name = "penny"
-penny = { center = [0.015, 0.015, 0.015], normal = [0.0, 1.0, 0.0], radius = 0.005 }
-[[load]]
-region = { min = [0.0, 0.0295, 0.0], max = [0.03, 0.03, 0.03] }
-force = [0.0, 45000.0, 0.0]
-[[load]]
-region = { min = [0.0, 0.0, 0.0], max = [0.03, 0.0005, 0.03] }
-force = [0.0, -45000.0, 0.0]
-[fracture]
-domain = 4
-"#;
 
 fn cracks_3d(c: &mut Criterion) {
     let src = Source::parse("penny.toml", PENNY, &[]).expect("the penny scene parses");

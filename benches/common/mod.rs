@@ -1,5 +1,5 @@
-//! The benchmark scene shared by the benches: a steel block filling a regular grid of 1 mm
-//! cells at 2 particles per cell per axis, moving at 1 mm/s.
+//! The benchmark scenes shared by the benches: a steel block filling a regular grid of 1 mm
+//! cells at 2 particles per cell per axis, moving at 1 mm/s; a cube with a penny crack.
 #![allow(dead_code)]
 
 use fissure::base::dim::Dim;
@@ -64,3 +64,36 @@ pub const SCENES: [(&str, usize, usize, &str, &str); 7] = [
     ("3d-ugimp-27k", 3, 15, "ugimp", "usavg"),
     ("3d-bspline", 3, 40, "bspline", "usavg"),
 ];
+
+/// The penny-crack cube of the 3D benches: a 5 mm penny crack in a 30 mm steel cube under
+/// 50 MPa, 1 mm cells, 216,000 particles.
+pub const PENNY: &str = r#"
+[simulation]
+dimension = 3
+shape = "ugimp"
+update = "usavg"
+duration = 1.0e-4
+[grid]
+min = [-0.002, -0.002, -0.002]
+max = [0.032, 0.032, 0.032]
+cell = [0.001, 0.001, 0.001]
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 8000.0
+[[body]]
+material = "steel"
+box = { min = [0.0, 0.0, 0.0], max = [0.03, 0.03, 0.03] }
+[[crack]]
+name = "penny"
+penny = { center = [0.015, 0.015, 0.015], normal = [0.0, 1.0, 0.0], radius = 0.005 }
+[[load]]
+region = { min = [0.0, 0.0295, 0.0], max = [0.03, 0.03, 0.03] }
+force = [0.0, 45000.0, 0.0]
+[[load]]
+region = { min = [0.0, 0.0, 0.0], max = [0.03, 0.0005, 0.03] }
+force = [0.0, -45000.0, 0.0]
+[fracture]
+domain = 4
+"#;

@@ -1,0 +1,85 @@
+//! The first static load step of a scene (`systems::static_solve`: classification, the
+//! loads, conjugate gradients to the scene's tolerance, the particles set to the answer), in
+//! particle-iterations per second: each conjugate-gradient iteration is one pass over the
+//! particles (K applied without assembling it), so the time per iteration is the load
+//! step's time over its iterations (printed). Scenes: the shipped static cantilever
+//! (`scenarios/cantilever_static_2d.toml`, 16,000 particles, no crack), the DCB
+//! (`scenarios/dcb_2d.toml`, 9,600 particles, a crack: its fields are unknowns) and the
+//! ENF (`scenarios/enf_2d.toml`, frictionless faces: an active set of solves) switched to
+//! static, and the penny crack in a 30 mm cube (216,000 particles, 3D).
+//!
+//! `cargo bench --bench static_solve`.
+
+mod common;
+
+use common::PENNY;
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use fissure::io::scenario::{Source, build};
+use fissure::systems::{DimSystems, static_solve};
+use std::time::{Duration, Instant};
+
+/// The scenario at `scenarios/{name}.toml`, switched to static in one load step.
+fn source(name: &str) -> Source {
+    let path = format!("{}/scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    let set = [
+        "simulation.solver=\"static\"".to_string(),
+        "simulation.load_steps=1".to_string(),
+    ];
+    Source::load(std::path::Path::new(&path), &set).expect("the scenario loads")
+}
+
+fn bench<D: DimSystems>(c: &mut Criterion, label: &str, src: &Source) {
+    let world = build::<D>(src).expect("the scenario builds").world;
+    let solved = static_solve::run(&mut world.clone()).expect("the load step solves");
+    let iterations = solved.iterations.max(1);
+    println!(
+        "{label}: {} particles, {iterations} iterations in {} solves",
+        world.particles.len(),
+        solved.contact_rounds
+    );
+    let mut g = c.benchmark_group("static_solve");
+    g.sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(5))
+        .throughput(Throughput::Elements(
+            (world.particles.len() * iterations) as u64,
+        ));
+    // Each sample solves the first load step from the built scene (a fresh copy, not
+    // timed). As in the launcher, the solves run inside the thread pool: each conjugate-
+    // gradient iteration makes several parallel passes, and a hand-over from this thread
+    // for each would cost a worker's wake-up (it made the cantilever twice as slow).
+    let pool = rayon::ThreadPoolBuilder::new()
+        .build()
+        .expect("thread pool");
+    g.bench_function(label, |b| {
+        b.iter_custom(|iters| {
+            let mut spent = Duration::ZERO;
+            for _ in 0..iters {
+                let mut fresh = world.clone();
+                spent += pool.install(|| {
+                    let t0 = Instant::now();
+                    static_solve::run(&mut fresh).expect("the load step solves");
+                    t0.elapsed()
+                });
+            }
+            spent
+        })
+    });
+    g.finish();
+}
+
+fn static_solve(c: &mut Criterion) {
+    use fissure::base::dim::{D2, D3};
+    bench::<D2>(c, "cantilever", &source("cantilever_static_2d"));
+    bench::<D2>(c, "dcb", &source("dcb_2d"));
+    bench::<D2>(c, "enf", &source("enf_2d"));
+    let set = [
+        "simulation.solver=\"static\"".to_string(),
+        "simulation.load_steps=1".to_string(),
+    ];
+    let penny = Source::parse("penny.toml", PENNY, &set).expect("the penny scene parses");
+    bench::<D3>(c, "penny-216k", &penny);
+}
+
+criterion_group!(benches, static_solve);
+criterion_main!(benches);
