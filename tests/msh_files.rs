@@ -68,23 +68,8 @@ fn blocks_from_msh_files_are_the_box() {
         .unwrap();
         assert_eq!(positions(&body(&file)), want, "hexahedra, binary {binary}");
     }
-    let tets = Block {
-        dim: 3,
-        kind: 4,
-        elements: [
-            [1, 2, 4],
-            [1, 4, 3],
-            [1, 3, 7],
-            [1, 7, 5],
-            [1, 5, 6],
-            [1, 6, 2],
-        ]
-        .iter()
-        .map(|t| vec![t[0], t[1], t[2], 8])
-        .collect(),
-    };
     let file = dir.join("tet.msh");
-    std::fs::write(&file, msh(&tags[..8], &corners(false), &[tets], false)).unwrap();
+    std::fs::write(&file, msh(&tags[..8], &corners(false), &[tets(0)], false)).unwrap();
     assert_eq!(positions(&body(&file)), want, "tetrahedra");
     // Faces as quads of corner tags (tags 10 * (i + 1)), split in two; the second entity's
     // triangles turned the other way.
@@ -128,6 +113,26 @@ fn blocks_from_msh_files_are_the_box() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// The block as six tetrahedra around its main diagonal (corner tags 1..=8 from
+/// [`corners`], plus `shift`), some listed inside out.
+fn tets(shift: u64) -> Block {
+    Block {
+        dim: 3,
+        kind: 4,
+        elements: [
+            [1, 2, 4],
+            [1, 4, 3],
+            [1, 3, 7],
+            [1, 7, 5],
+            [1, 5, 6],
+            [1, 6, 2],
+        ]
+        .iter()
+        .map(|t| vec![t[0] + shift, t[1] + shift, t[2] + shift, 8 + shift])
+        .collect(),
+    }
+}
+
 /// Node tags 1..=n.
 fn tags_of(n: u64) -> Vec<u64> {
     (1..=n).collect()
@@ -152,21 +157,6 @@ fn refused(file: &std::path::Path) -> String {
 #[test]
 fn bad_msh_files_are_named() {
     let dir = folder("msh-bad");
-    let tets = |shift: u64| Block {
-        dim: 3,
-        kind: 4,
-        elements: [
-            [1, 2, 4],
-            [1, 4, 3],
-            [1, 3, 7],
-            [1, 7, 5],
-            [1, 5, 6],
-            [1, 6, 2],
-        ]
-        .iter()
-        .map(|t| vec![t[0] + shift, t[1] + shift, t[2] + shift, 8 + shift])
-        .collect(),
-    };
     let tri28 = Block {
         dim: 2,
         kind: 42,
