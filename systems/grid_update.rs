@@ -135,11 +135,7 @@ fn merge_slivers<D: Dim>(
         settings.mass_tol,
     );
     let sliver = settings.sliver_mass;
-    let mut k = 0;
-    while k < fields.node.len() {
-        let node = fields.node[k];
-        let rows = fields.rows_of(node);
-        k += rows.len();
+    for (node, rows) in fields.groups() {
         let group = || std::iter::once(node as usize).chain(rows.clone());
         let light = |n: usize| grid.mass[n] > tol && grid.mass[n] <= sliver;
         if !group().any(light) {

@@ -297,33 +297,10 @@ fn a_pressure_on_a_flat_face_is_p_times_its_area() {
 /// equilibrium). Each holds every node from its end of the bar outwards.
 #[test]
 fn support_and_grip_reactions_are_the_bars_tension() {
-    let rest = r#"
-[[body]]
-material = "m"
-box = { min = [0.002, 0.002], max = [0.03, 0.01] }
-[[boundary]]
-region = { min = [0.0, 0.0], max = [0.002, 0.012] }
-fix = ["x"]
-[[boundary]]
-region = { min = [0.03, 0.0], max = [0.04, 0.012] }
-fix = ["x"]
-velocity = [0.1, 0.0]
-time = { kind = "table", points = [[0.0, 0.0], [1e-5, 1.0], [2e-5, 1.0], [3e-5, 0.0]] }
-[[probe]]
-name = "support"
-region = { min = [0.0, 0.0], max = [0.002, 0.012] }
-quantity = "reaction"
-component = "x"
-[[probe]]
-name = "grip"
-region = { min = [0.03, 0.0], max = [0.04, 0.012] }
-quantity = "reaction"
-component = "x"
-"#;
     let text = common::strip_2d(
         "plane = \"stress\"\nthickness = 0.01\ndamping = 2e5",
         2e-4,
-        rest,
+        common::GRIPPED_BAR,
     );
     let h = common::history(&text);
     let (support, grip) = (*h.probes[0].last().unwrap(), *h.probes[1].last().unwrap());

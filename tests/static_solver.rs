@@ -165,35 +165,13 @@ fn what_the_static_solver_does_not_take_is_refused() {
 /// exact for a linear response) to 1e-6 all along, and ends at E A d^2 / (2 L).
 #[test]
 fn a_moving_grip_prescribes_its_displacement() {
-    let rest = r#"
-[[body]]
-material = "m"
-box = { min = [0.002, 0.002], max = [0.03, 0.01] }
-[[boundary]]
-region = { min = [0.0, 0.0], max = [0.002, 0.012] }
-fix = ["x"]
-[[boundary]]
-region = { min = [0.03, 0.0], max = [0.04, 0.012] }
-fix = ["x"]
-velocity = [0.1, 0.0]
-time = { kind = "table", points = [[0.0, 0.0], [1e-5, 1.0], [2e-5, 1.0], [3e-5, 0.0]] }
-[[probe]]
-name = "support"
-region = { min = [0.0, 0.0], max = [0.002, 0.012] }
-quantity = "reaction"
-component = "x"
-[[probe]]
-name = "grip"
-region = { min = [0.03, 0.0], max = [0.04, 0.012] }
-quantity = "reaction"
-component = "x"
-[output]
-history_interval = 2.5e-6
-"#;
     let text = common::strip_2d(
         "plane = \"stress\"\nthickness = 0.01\nsolver = \"static\"\nload_steps = 12",
         3e-5,
-        rest,
+        &format!(
+            "{}\n[output]\nhistory_interval = 2.5e-6\n",
+            common::GRIPPED_BAR
+        ),
     );
     let h = history(&text);
     let (support, grip) = (*h.probes[0].last().unwrap(), *h.probes[1].last().unwrap());

@@ -103,11 +103,7 @@ fn slivers<D: Dim>(world: &World<D>) -> Vec<(usize, usize)> {
     );
     let light = |e: usize| mass[e] > tol && mass[e] <= sliver;
     let mut ties = Vec::new();
-    let mut k = 0;
-    while k < f.node.len() {
-        let node = f.node[k];
-        let rows = f.rows_of(node);
-        k += rows.len();
+    for (node, rows) in f.groups() {
         let group = || std::iter::once(node as usize).chain(rows.clone());
         if !group().any(light) {
             continue;

@@ -285,6 +285,34 @@ box = {{ min = [{lo:e}, {lo:e}], max = [{hi:e}, {hi:e}] }}
     )
 }
 
+/// For [`strip_2d`]: a bar 28 x 8 mm between a support at x = 2 mm and a grip at 30 mm,
+/// both holding x only (each every node from its end of the bar outwards), the grip moved
+/// at 0.1 m/s under a table that rises over 10 us, holds 10 us and falls back over 10 us
+/// (2 um in all); probes `support` and `grip` read their reactions along x.
+pub const GRIPPED_BAR: &str = r#"
+[[body]]
+material = "m"
+box = { min = [0.002, 0.002], max = [0.03, 0.01] }
+[[boundary]]
+region = { min = [0.0, 0.0], max = [0.002, 0.012] }
+fix = ["x"]
+[[boundary]]
+region = { min = [0.03, 0.0], max = [0.04, 0.012] }
+fix = ["x"]
+velocity = [0.1, 0.0]
+time = { kind = "table", points = [[0.0, 0.0], [1e-5, 1.0], [2e-5, 1.0], [3e-5, 0.0]] }
+[[probe]]
+name = "support"
+region = { min = [0.0, 0.0], max = [0.002, 0.012] }
+quantity = "reaction"
+component = "x"
+[[probe]]
+name = "grip"
+region = { min = [0.03, 0.0], max = [0.04, 0.012] }
+quantity = "reaction"
+component = "x"
+"#;
+
 /// A 2D scene on a 40 x 12 mm grid of 1 mm cells with an aluminium named "m" (E = 70 GPa,
 /// nu = 0.3, rho = 2700 kg/m^3), run for `duration` (s); `simulation` adds keys to
 /// `[simulation]` (one per line) and `rest` follows the material (bodies, cracks).

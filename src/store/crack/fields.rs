@@ -235,6 +235,19 @@ impl Fields {
             .unwrap_or(n)
     }
 
+    /// Each node with extra fields and those fields' grid entries, in node order.
+    pub fn groups(&self) -> impl Iterator<Item = (u32, Range<usize>)> + '_ {
+        let mut k = 0;
+        std::iter::from_fn(move || {
+            let &n = self.node.get(k)?;
+            let start = k;
+            while self.node.get(k) == Some(&n) {
+                k += 1;
+            }
+            Some((n, self.nodes + start..self.nodes + k))
+        })
+    }
+
     /// Grid entries of the extra fields of node `n`.
     pub fn rows_of(&self, n: u32) -> Range<usize> {
         let lo = self.node.partition_point(|&m| m < n);
