@@ -83,6 +83,34 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     }
     let held = supports::prescribed(world, t_end);
     let start_forces = supports::start_forces(world, t_start);
+    let Solution { u, dofs, solved } = with_contact(world, held.as_deref(), t_end)?;
+    reactions(world, &dofs, &u);
+    let after = gather(world, &u);
+    move_cracks(world, &before, &after);
+    let work = load_work(world, &before, &after, t_start, t_end)
+        + supports::work(world, &start_forces, t_start, t_end);
+    world.work.external += work;
+    set_particles(world, &u, &after);
+    Ok(solved)
+}
+
+/// A load step's answer.
+struct Solution<D: Dim> {
+    /// Every grid entry's displacement.
+    u: Vec<D::Vec>,
+    /// The unknowns of the last solve.
+    dofs: Unknowns<D>,
+    /// What the solves took, all together.
+    solved: Solved,
+}
+
+/// The load step's equilibrium with its crack faces' contact settled: solves until the
+/// active set of closed face pairs changes no more (one solve without such faces).
+fn with_contact<D: Dim>(
+    world: &World<D>,
+    held: Option<&[D::Vec]>,
+    t_end: f64,
+) -> Result<Solution<D>, Unstable> {
     let pairs = faces::pairs(world);
     let mut closed = vec![false; pairs.len()];
     let mut iterations = 0;
@@ -90,7 +118,7 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     let mut last: Option<Vec<D::Vec>> = None;
     let (u, dofs, mut solved) = loop {
         let dofs = Unknowns::new(world, &pairs, &closed);
-        let (u, solved) = equilibrium(world, &dofs, held.as_deref(), last.as_deref(), t_end)?;
+        let (u, solved) = equilibrium(world, &dofs, held, last.as_deref(), t_end)?;
         iterations += solved.iterations;
         rounds += 1;
         if pairs.is_empty() {
@@ -116,14 +144,7 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     solved.iterations = iterations;
     solved.contact_rounds = rounds;
     solved.closed_faces = closed.iter().filter(|&&c| c).count();
-    reactions(world, &dofs, &u);
-    let after = gather(world, &u);
-    move_cracks(world, &before, &after);
-    let work = load_work(world, &before, &after, t_start, t_end)
-        + supports::work(world, &start_forces, t_start, t_end);
-    world.work.external += work;
-    set_particles(world, &u, &after);
-    Ok(solved)
+    Ok(Solution { u, dofs, solved })
 }
 
 /// Most solves a load step's contact active set may take: each round closes the pairs
