@@ -4,14 +4,12 @@
 
 use super::{each_entry, entries, fields};
 use crate::base::dim::Dim;
+use crate::physics::loads::VelocityBc;
 use crate::store::world::World;
 
 /// Per grid entry, the displacement the moving supports prescribe at time `t` on their
 /// held components (zero elsewhere); None when no support moves.
 pub(super) fn prescribed<D: Dim>(world: &World<D>, t: f64) -> Option<Vec<D::Vec>> {
-    let moves = |bc: &crate::physics::loads::VelocityBc<D>| {
-        (0..D::D).any(|a| bc.axes[a] && bc.velocity[a] != 0.0)
-    };
     if !world.bcs.iter().any(moves) {
         return None;
     }
@@ -29,9 +27,14 @@ pub(super) fn prescribed<D: Dim>(world: &World<D>, t: f64) -> Option<Vec<D::Vec>
     Some(u)
 }
 
+/// Whether support `bc` prescribes a non-zero velocity on a component it holds.
+fn moves<D: Dim>(bc: &VelocityBc<D>) -> bool {
+    (0..D::D).any(|a| bc.axes[a] && bc.velocity[a] != 0.0)
+}
+
 /// The displacement support `bc` prescribes by time `t` on its held components: its
 /// velocity times the integral of its time function from 0.
-fn displacement<D: Dim>(bc: &crate::physics::loads::VelocityBc<D>, t: f64) -> D::Vec {
+fn displacement<D: Dim>(bc: &VelocityBc<D>, t: f64) -> D::Vec {
     let mut d = D::zero();
     let scale = bc.time.integral(t);
     (0..D::D)
@@ -44,10 +47,11 @@ fn displacement<D: Dim>(bc: &crate::physics::loads::VelocityBc<D>, t: f64) -> D:
 /// last step left: K u_old (the particles' stresses, C : sym(grad u_old), scattered as
 /// the internal force) less the loads and gravity at `t_start`, summed over the node's
 /// entries. The particles' stresses are in every snapshot, so a resumed run finds the
-/// same forces. Zero on the first step, which starts from the unloaded body.
+/// same forces. Zero on the first step, which starts from the unloaded body, and where no
+/// support moves (a still support does no work): no pass over the particles then.
 pub(super) fn start_forces<D: Dim>(world: &World<D>, t_start: f64) -> Vec<Vec<D::Vec>> {
     let zero = || (world.bcs.iter()).map(|bc| vec![D::zero(); bc.nodes.len()]);
-    if world.step == 0 {
+    if world.step == 0 || !world.bcs.iter().any(moves) {
         return zero().collect();
     }
     // Only entries of support nodes are needed: mark them.
