@@ -10,24 +10,23 @@
 
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
-use crate::base::sym::{Sym3, SymTensor};
-use crate::physics::material::{Material, Plane};
 use crate::physics::shape::{ShapeKind, Stencil};
 use crate::record::solve_log::Solved;
 use crate::store::crack::Fields;
-use crate::store::disjoint::Disjoint;
-use crate::store::world::{CHUNK, World};
-use crate::systems::p2g::add_internal_force;
-use crate::systems::stress::velocity_gradient;
+use crate::store::world::World;
 use crate::systems::{bin, classify, crack_advect, p2g};
 use crate::with_shape;
-use rayon::prelude::*;
 
+mod cg;
 mod faces;
+mod newton;
+mod operator;
 mod rigid;
 mod supports;
 mod unknowns;
 
+use cg::{Frame, conjugate_gradients, dot};
+use operator::{Law, elastic, mask, stiffness};
 use unknowns::Unknowns;
 
 /// Most of the load (as a fraction of its norm) a body free to move may leave unbalanced:
@@ -51,16 +50,12 @@ const GHOST: f64 = 1e-11;
 /// nodes (a half and a quarter) above. At 3 % the turned DCB's K moved in the fourth digit.
 const LIGHT: f64 = 0.1;
 
-/// Most iterations per load step, per unknown along the grid's longest axis: conjugate
-/// gradients on a well-supported grid converge in a small multiple of it.
-const ITERATIONS_PER_NODE: usize = 50;
-
 /// Solves the load step ending at the next step's time and sets the particles to it: x =
 /// x0 + u, v = 0, grad u and the stress it gives; adds the work of the loads and the moving
 /// supports over the step (trapezoidal, exact for a linear response). Refuses a solve that
 /// does not converge.
 pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
-    let t_end = (world.step + 1) as f64 * world.settings.dt;
+    let t_end = end_time(world);
     let before: Vec<D::Vec> = (world.particles.x.iter())
         .zip(&world.particles.x0)
         .map(|(&x, &x0)| x - x0)
@@ -83,14 +78,48 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     }
     let held = supports::prescribed(world, t_end);
     let start_forces = supports::start_forces(world, t_start);
+    if !world.particles.hardened.is_empty() {
+        return plastic_step(world, held, &start_forces, &before, t_start, t_end);
+    }
     let Solution { u, dofs, solved } = with_contact(world, held.as_deref(), t_end)?;
-    reactions(world, &dofs, &u);
+    reactions(world, &dofs, Law::Elastic, &u);
     let after = gather(world, &u);
     move_cracks(world, &before, &after);
     let work = load_work(world, &before, &after, t_start, t_end)
         + supports::work(world, &start_forces, t_start, t_end);
     world.work.external += work;
     set_particles(world, &u, &after);
+    Ok(solved)
+}
+
+/// The load step of a scene with plastic materials ([`newton`]; its cracks' faces stay
+/// open: the scenario check refuses contact there): the supports move by their increment
+/// over the step, from `held` (their displacement at the step's end).
+fn plastic_step<D: Dim>(
+    world: &mut World<D>,
+    held: Option<Vec<D::Vec>>,
+    start_forces: &[Vec<D::Vec>],
+    before: &[D::Vec],
+    t_start: f64,
+    t_end: f64,
+) -> Result<Solved, Unstable> {
+    let increment = held.map(|mut end| {
+        let start = supports::prescribed(world, t_start).unwrap_or_default();
+        end.iter_mut().zip(&start).for_each(|(e, &s)| *e -= s);
+        end
+    });
+    let dofs = Unknowns::new(world, &[], &[]);
+    let step = newton::solve(world, &dofs, increment.as_deref(), t_end)?;
+    reactions(world, &dofs, Law::Given(&step.returned.stress), &step.du);
+    let after: Vec<D::Vec> = (before.iter().zip(gather(world, &step.du)))
+        .map(|(&b, d)| b + d)
+        .collect();
+    move_cracks(world, before, &after);
+    let work = load_work(world, before, &after, t_start, t_end)
+        + supports::work(world, start_forces, t_start, t_end);
+    world.work.external += work;
+    let solved = step.solved;
+    newton::commit(world, step, &after);
     Ok(solved)
 }
 
@@ -118,7 +147,10 @@ fn with_contact<D: Dim>(
     let mut last: Option<Vec<D::Vec>> = None;
     let (u, dofs, mut solved) = loop {
         let dofs = Unknowns::new(world, &pairs, &closed);
-        let (u, solved) = equilibrium(world, &dofs, held, last.as_deref(), t_end)?;
+        let frame = Frame::new(world, &dofs);
+        let load = world.grid.force.clone();
+        let linear = Linear::elastic(world);
+        let (u, solved) = equilibrium(world, &dofs, &frame, linear, load, held, last.as_deref())?;
         iterations += solved.iterations;
         rounds += 1;
         if pairs.is_empty() {
@@ -147,43 +179,64 @@ fn with_contact<D: Dim>(
     Ok(Solution { u, dofs, solved })
 }
 
+/// How a linear solve is made: the stiffness, and the residual (relative to the load) at
+/// which it stops.
+#[derive(Clone, Copy)]
+struct Linear<'a, D: Dim> {
+    law: Law<'a, D>,
+    tolerance: f64,
+}
+
+impl<D: Dim> Linear<'_, D> {
+    /// The elastic K to the scene's tolerance: a linear scene's load step.
+    fn elastic(world: &World<D>) -> Self {
+        Linear {
+            law: Law::Elastic,
+            tolerance: world.settings.tolerance,
+        }
+    }
+}
+
+/// The time at the end of the load step being solved.
+fn end_time<D: Dim>(world: &World<D>) -> f64 {
+    (world.step + 1) as f64 * world.settings.dt
+}
+
 /// Most solves a load step's contact active set may take: each round closes the pairs
 /// that overlap and opens those that pull, and a few rounds settle a face.
 const CONTACT_ROUNDS: usize = 50;
 
-/// Equilibrium with the unknowns `dofs`: K u_f = f - K u_c on the free components (u_c
-/// the moving supports' displacement `held`), the rigid motions K leaves free taken out,
-/// from `guess` (every entry's displacement) or from zero; returns every entry's
-/// displacement u_f + u_c (tied entries given their partners').
+/// Equilibrium with the unknowns `dofs` (and their `frame`) under `linear`'s K: K u_f =
+/// load - K u_c on the free components (`load` per grid entry, u_c the moving supports'
+/// displacement `held`), the rigid motions K leaves free taken out, from `guess` (every
+/// entry's displacement) or from zero; returns every entry's displacement u_f + u_c (tied
+/// entries given their partners'). Refuses a load that would move a free body as a whole.
 fn equilibrium<D: Dim>(
     world: &World<D>,
     dofs: &Unknowns<D>,
+    frame: &Frame<D>,
+    linear: Linear<D>,
+    mut load: Vec<D::Vec>,
     held: Option<&[D::Vec]>,
     guess: Option<&[D::Vec]>,
-    t_end: f64,
 ) -> Result<(Vec<D::Vec>, Solved), Unstable> {
+    let t_end = end_time(world);
     let free = &dofs.free;
-    let diag = diagonal(world, dofs);
-    let largest = (diag.iter().zip(free))
-        .flat_map(|(d, k)| (0..D::D).filter(|&a| k[a] != 0.0).map(|a| d[a]))
-        .fold(0.0, f64::max);
-    let mut f_ext = world.grid.force.clone();
     if let Some(u_c) = held {
         let mut k_c = vec![D::zero(); u_c.len()];
-        stiffness(world, u_c, dofs, &mut k_c);
-        f_ext.iter_mut().zip(&k_c).for_each(|(f, &k)| *f -= k);
+        stiffness(world, linear.law, u_c, dofs, &mut k_c);
+        load.iter_mut().zip(&k_c).for_each(|(f, &k)| *f -= k);
     }
-    dofs.fold(&mut f_ext);
-    for (f, &k) in f_ext.iter_mut().zip(free) {
+    dofs.fold(&mut load);
+    for (f, &k) in load.iter_mut().zip(free) {
         *f = mask::<D>(*f, k);
     }
-    dofs.project(&mut f_ext);
-    let ghost = ghost_stiffness(world, &diag);
-    let modes = rigid::free_motions(world, dofs, &ghost, largest);
-    let norm = dot::<D>(&f_ext, &f_ext).sqrt();
-    rigid::deflate::<D>(&mut f_ext, &modes);
+    dofs.project(&mut load);
+    let modes = &frame.modes;
+    let norm = dot::<D>(&load, &load).sqrt();
+    rigid::deflate::<D>(&mut load, modes);
     let imbalance = if norm > 0.0 {
-        1.0 - dot::<D>(&f_ext, &f_ext).sqrt() / norm
+        1.0 - dot::<D>(&load, &load).sqrt() / norm
     } else {
         0.0
     };
@@ -205,13 +258,20 @@ fn equilibrium<D: Dim>(
             .map(|(e, &x)| mask::<D>(x - held.map_or(D::zero(), |h| h[e]), free[e]))
             .collect();
         dofs.project(&mut s);
-        rigid::deflate::<D>(&mut s, &modes);
+        rigid::deflate::<D>(&mut s, modes);
         s
     });
-    let (mut u, mut solved) =
-        conjugate_gradients(world, &f_ext, &ghost, &diag, dofs, &modes, start)?;
+    let (mut u, mut solved) = conjugate_gradients(
+        world,
+        linear.law,
+        frame,
+        dofs,
+        &load,
+        start,
+        linear.tolerance,
+    )?;
     dofs.expand(&mut u);
-    leans_on_ghost(world, &u, &ghost, dofs, &f_ext, t_end)?;
+    leans_on_ghost(world, &u, &frame.ghost, dofs, &load, t_end)?;
     if let Some(u_c) = held {
         u.iter_mut().zip(u_c).for_each(|(u, &c)| *u += c);
     }
@@ -231,7 +291,7 @@ fn faces_round<D: Dim>(
 ) -> faces::Changes {
     let loose = Unknowns::new(world, &[], &[]);
     let mut r = vec![D::zero(); u.len()];
-    stiffness(world, u, &loose, &mut r);
+    stiffness(world, Law::Elastic, u, &loose, &mut r);
     let largest = |v: &[D::Vec]| {
         (v.iter())
             .map(|x| D::dot(*x, *x).sqrt())
@@ -244,252 +304,16 @@ fn faces_round<D: Dim>(
     faces::update::<D>(pairs, closed, u, &r, 1e-9 * largest(u), force_tol)
 }
 
-/// `v` with the components `keep` has at 0 cleared.
-#[inline(always)]
-fn mask<D: Dim>(v: D::Vec, keep: D::Vec) -> D::Vec {
-    let mut out = v;
-    for a in 0..D::D {
-        out[a] *= keep[a];
-    }
-    out
-}
-
-/// The stress C : sym(l) of material `m`.
-#[inline(always)]
-fn elastic<D: Dim>(m: &Material, plane: Plane, l: &D::Mat) -> D::Sym {
-    let mut s = Sym3::default();
-    m.update(plane, D::sym_part(l), &mut s);
-    D::Sym::from_sym3(s)
-}
-
-/// y = K x, particle by particle: grad x gathered at each particle (tied entries taking
-/// the value of the entry they move with), the stress it gives, and that stress's nodal
-/// force, tile by tile in colour classes (the same scatter, in the same order, for any
-/// thread count), tied entries' forces folded into their partners'.
-fn stiffness<D: Dim>(world: &World<D>, x: &[D::Vec], dofs: &Unknowns<D>, y: &mut [D::Vec]) {
-    let expanded;
-    let x = if dofs.ties.is_empty() && dofs.normal_ties.is_empty() {
-        x
-    } else {
-        let mut e = x.to_vec();
-        dofs.expand(&mut e);
-        expanded = e;
-        &expanded[..]
-    };
-    y.par_chunks_mut(CHUNK).for_each(|c| c.fill(D::zero()));
-    let (shape, plane) = (world.settings.shape, world.settings.plane);
-    let stride = &world.grid.geom.stride;
-    let (p, materials, tiles) = (&world.particles, &world.materials, &world.tiles);
-    let fields = fields(world);
-    let y_w = Disjoint::new(y);
-    tiles.for_each_coloured(|t| {
-        let mine = tiles.particles(t).iter().map(|&i| i as usize);
-        for_each_free_particle!(D, shape, &tiles.stencils, fields, mine, |i, st| {
-            let rows = st.rows::<D>(stride);
-            let l = velocity_gradient::<D, N>(&st, &rows, x);
-            let s = elastic::<D>(&materials[p.material[i] as usize], plane, &l);
-            // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
-            // tile is handled by one thread. Given -V, the internal-force scatter adds
-            // +V sigma . grad S: the rows of K x.
-            unsafe { add_internal_force::<D, N>(&st, &rows, &s, -p.volume[i], &y_w) };
-        })
-    });
-    // The particles near a crack, on their sides' entries, in particle order.
-    for &i in fields.map_or(&[][..], |f| &f.coded[..]) {
-        let i = i as usize;
-        let l = gradient(world, i, x);
-        let s = elastic::<D>(&materials[p.material[i] as usize], plane, &l);
-        each_entry(world, i, |n, _, g| {
-            y[n] += D::stress_dot(&s, g) * p.volume[i]
-        });
-    }
-    dofs.fold(y);
-}
-
-/// y = K x on the free components ([`stiffness`]), with `ghost`'s stiffness (per
-/// component) times x added when given.
-fn apply<D: Dim>(
-    world: &World<D>,
-    x: &[D::Vec],
-    dofs: &Unknowns<D>,
-    ghost: Option<&[D::Vec]>,
-    y: &mut [D::Vec],
-) {
-    stiffness(world, x, dofs, y);
-    y.par_chunks_mut(CHUNK)
-        .zip(dofs.free.par_chunks(CHUNK))
-        .zip(x.par_chunks(CHUNK))
-        .enumerate()
-        .for_each(|(c, ((y, k), x))| {
-            for (j, (y, &k)) in y.iter_mut().zip(k).enumerate() {
-                *y = mask::<D>(*y, k);
-                if let Some(g) = ghost {
-                    let g = g[c * CHUNK + j];
-                    for a in 0..D::D {
-                        y[a] += g[a] * x[j][a] * k[a];
-                    }
-                }
-            }
-        });
-    dofs.project(y);
-}
-
-/// The diagonal of K (its free components; 1 elsewhere, so the preconditioner leaves the
-/// fixed ones alone): for node n and axis a, sum over particles of V e_a . (C : sym(e_a ⊗
-/// grad S_n)) . grad S_n. A tied entry adds its own to its partner's: a particle reaches
-/// one entry of a node, so the two share no particle and K has no term between them.
-fn diagonal<D: Dim>(world: &World<D>, dofs: &Unknowns<D>) -> Vec<D::Vec> {
-    let free = &dofs.free;
-    let mut d = vec![D::zero(); free.len()];
-    let plane = world.settings.plane;
-    let p = &world.particles;
-    for i in 0..p.len() {
-        let m = &world.materials[p.material[i] as usize];
-        each_entry(world, i, |n, _, grad| {
-            for a in 0..D::D {
-                let mut e = D::zero();
-                e[a] = 1.0;
-                let s = elastic::<D>(m, plane, &D::outer(e, grad));
-                d[n][a] += p.volume[i] * D::stress_dot(&s, grad)[a];
-            }
-        });
-    }
-    dofs.fold(&mut d);
-    for (d, &k) in d.iter_mut().zip(free) {
-        for a in 0..D::D {
-            if k[a] == 0.0 || d[a] <= 0.0 {
-                d[a] = 1.0;
-            }
-        }
-    }
-    d
-}
-
-/// The sum of a * b over all components, in fixed chunks (the same bits for any thread
-/// count).
-fn dot<D: Dim>(a: &[D::Vec], b: &[D::Vec]) -> f64 {
-    let parts: Vec<f64> = a
-        .par_chunks(CHUNK)
-        .zip(b.par_chunks(CHUNK))
-        .map(|(a, b)| a.iter().zip(b).map(|(&x, &y)| D::dot(x, y)).sum())
-        .collect();
-    parts.iter().sum()
-}
-
-/// Solves K u = f on the free components from u = 0 by preconditioned conjugate gradients
-/// (Hestenes & Stiefel 1952), to a residual of the scene's tolerance times |f|.
-fn conjugate_gradients<D: Dim>(
-    world: &World<D>,
-    f: &[D::Vec],
-    ghost: &[D::Vec],
-    diag: &[D::Vec],
-    dofs: &Unknowns<D>,
-    modes: &[Vec<D::Vec>],
-    start: Option<Vec<D::Vec>>,
-) -> Result<(Vec<D::Vec>, Solved), Unstable> {
-    let n = f.len();
-    let norm_f = dot::<D>(f, f).sqrt();
-    if norm_f == 0.0 {
-        return Ok((vec![D::zero(); n], Solved::default()));
-    }
-    let precondition = |r: &[D::Vec]| -> Vec<D::Vec> {
-        r.par_iter()
-            .zip(diag.par_iter())
-            .map(|(&r, &d)| {
-                let mut z = r;
-                for a in 0..D::D {
-                    z[a] /= d[a];
-                }
-                z
-            })
-            .collect()
-    };
-    let mut r = f.to_vec();
-    let mut u = match start {
-        Some(u) => {
-            let mut q = vec![D::zero(); n];
-            apply(world, &u, dofs, Some(ghost), &mut q);
-            r.iter_mut().zip(&q).for_each(|(r, &q)| *r -= q);
-            u
-        }
-        None => vec![D::zero(); n],
-    };
-    let residual = dot::<D>(&r, &r).sqrt() / norm_f;
-    if residual <= world.settings.tolerance {
-        let solved = Solved {
-            residual,
-            ..Solved::default()
-        };
-        return Ok((u, solved));
-    }
-    let mut z = precondition(&r);
-    dofs.project(&mut z);
-    rigid::deflate::<D>(&mut z, modes);
-    let mut dir = z.clone();
-    let mut rz = dot::<D>(&r, &z);
-    let mut q = vec![D::zero(); n];
-    let cells = world.grid.geom.cells;
-    let most = ITERATIONS_PER_NODE * (cells[0].max(cells[1]).max(cells[2]) + 1);
-    for k in 1..=most {
-        apply(world, &dir, dofs, Some(ghost), &mut q);
-        let pq = dot::<D>(&dir, &q);
-        // A direction of no stiffness (or NaN): K is singular on what the loads start.
-        if pq.is_nan() || pq <= 0.0 {
-            return Err(not_converged(world, k, dot::<D>(&r, &r).sqrt() / norm_f));
-        }
-        let alpha = rz / pq;
-        u.par_iter_mut()
-            .zip(r.par_iter_mut())
-            .zip(dir.par_iter().zip(q.par_iter()))
-            .for_each(|((u, r), (&p, &q))| {
-                *u += p * alpha;
-                *r -= q * alpha;
-            });
-        let residual = dot::<D>(&r, &r).sqrt() / norm_f;
-        if residual <= world.settings.tolerance {
-            return Ok((
-                u,
-                Solved {
-                    iterations: k,
-                    residual,
-                    ..Solved::default()
-                },
-            ));
-        }
-        z = precondition(&r);
-        dofs.project(&mut z);
-        rigid::deflate::<D>(&mut z, modes);
-        let rz_next = dot::<D>(&r, &z);
-        let beta = rz_next / rz;
-        rz = rz_next;
-        dir.par_iter_mut()
-            .zip(z.par_iter())
-            .for_each(|(p, &z)| *p = z + *p * beta);
-    }
-    Err(not_converged(world, most, dot::<D>(&r, &r).sqrt() / norm_f))
-}
-
-fn not_converged<D: Dim>(world: &World<D>, iterations: usize, residual: f64) -> Unstable {
-    Unstable {
-        step: world.step + 1,
-        time: (world.step + 1) as f64 * world.settings.dt,
-        what: format!(
-            "the static solve did not converge: relative residual {residual:.3e} after \
-             {iterations} conjugate-gradient iterations (is the body held against every rigid \
-             motion the loads would start?)"
-        ),
-    }
-}
-
-/// Each support's reaction on the body, K u - f_ext on its held components (the grid's
+/// Each support's reaction on the body, f_int - f_ext on its held components (f_int the
+/// product of `law` with `u`: K u, or the internal force of the given stresses; the grid's
 /// force column still holds f_ext; a node's entries are summed, so a tied entry's force
 /// counts once, wherever it sits).
-fn reactions<D: Dim>(world: &mut World<D>, dofs: &Unknowns<D>, u: &[D::Vec]) {
+fn reactions<D: Dim>(world: &mut World<D>, dofs: &Unknowns<D>, law: Law<D>, u: &[D::Vec]) {
     if world.bcs.is_empty() {
         return;
     }
     let mut ku = vec![D::zero(); u.len()];
-    stiffness(world, u, dofs, &mut ku);
+    stiffness(world, law, u, dofs, &mut ku);
     let force = &world.grid.force;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     for bc in &mut world.bcs {

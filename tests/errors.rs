@@ -1077,7 +1077,7 @@ fn plastic_steel(keys: &str) -> String {
 #[test]
 fn bad_plasticity_parameters_name_the_key() {
     let j2 = "model = \"j2\"\n";
-    let cases: [(String, &str, usize, &str); 7] = [
+    let cases: [(String, &str, usize, &str); 10] = [
         (j2.into(), "material[0].model", 15, "sigma_y"),
         (
             format!("{j2}sigma_y = -1.0\n"),
@@ -1112,6 +1112,24 @@ fn bad_plasticity_parameters_name_the_key() {
         (
             "sigma_y = 250e6\n".into(),
             "material[0].sigma_y",
+            15,
+            "model = \"j2\"",
+        ),
+        (
+            format!("{j2}sigma_y = 250e6\nn = 10\nalpha = -1.0\n"),
+            "material[0].alpha",
+            18,
+            "positive",
+        ),
+        (
+            format!("{j2}sigma_y = 250e6\nalpha = 1.0\n"),
+            "material[0].alpha",
+            17,
+            "exponent",
+        ),
+        (
+            "alpha = 1.0\n".into(),
+            "material[0].alpha",
             15,
             "model = \"j2\"",
         ),

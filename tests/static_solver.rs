@@ -89,7 +89,10 @@ fn static_solve_is_the_same_on_any_thread_count() {
         "[simulation]",
         "[simulation]\nsolver = \"static\"\nload_steps = 1",
     );
-    for text in [read("cantilever_static_2d"), enf] {
+    let cylinder = read("cylinder_plastic_2d")
+        .replace("cell = [0.0025, 0.0025]", "cell = [0.0075, 0.0075]")
+        .replace("[simulation]", "[simulation]\nsolver = \"static\"");
+    for text in [read("cantilever_static_2d"), enf, cylinder] {
         let one = final_world::<D2>(&text, 1);
         let two = final_world::<D2>(&text, 2);
         assert!(one.particles.x != one.particles.x0, "the beam bent");
@@ -101,8 +104,9 @@ fn static_solve_is_the_same_on_any_thread_count() {
     }
 }
 
-/// Stuck crack faces, crack growth and a plastic material are refused in a static scene,
-/// naming the key; load steps and a tolerance in an explicit scene too, and a tolerance
+/// Stuck crack faces, crack growth, plasticity in plane stress and plasticity with
+/// crack-face contact are refused in a static scene, naming the key (3D plasticity is
+/// taken); load steps and a tolerance in an explicit scene too, and a tolerance
 /// outside 1e-12 to 1e-2.
 #[test]
 fn what_the_static_solver_does_not_take_is_refused() {
@@ -128,8 +132,31 @@ fn what_the_static_solver_does_not_take_is_refused() {
         "rho = 8000.0",
         "rho = 8000.0\nmodel = \"j2\"\nsigma_y = 250e6",
     );
-    let e = err(plastic);
-    assert!(e.contains("material[0]") && e.contains("plasticity"), "{e}");
+    assert_eq!(err(plastic.clone()), "", "3D plasticity is taken");
+    let e = err(format!(
+        "{plastic}\n{crack}\ncontact = {{ law = \"frictionless\" }}"
+    ));
+    assert!(
+        e.contains("crack[0].contact") && e.contains("plastic"),
+        "{e}"
+    );
+    let stress = common::strip_2d(
+        "plane = \"stress\"\nsolver = \"static\"",
+        3e-5,
+        common::GRIPPED_BAR,
+    )
+    .replace(
+        "rho = 2700.0",
+        "rho = 2700.0\nmodel = \"j2\"\nsigma_y = 250e6",
+    );
+    let e = match build::<D2>(&source(&stress)) {
+        Ok(_) => String::new(),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains("material[0]") && e.contains("plane stress"),
+        "{e}"
+    );
     let explicit = column("").replace("solver = \"static\"\n", "");
     let e = err(explicit);
     assert!(e.contains("simulation.load_steps"), "{e}");
@@ -398,6 +425,126 @@ fn a_load_on_a_mechanism_is_refused() {
     };
     assert!(
         e.contains("ghost stiffness") && e.contains("particle"),
+        "{e}"
+    );
+}
+
+/// A steel bar 20 x 4 x 4 mm (1 mm cells, 2,560 particles; a quarter of a 20 x 8 x 8 mm
+/// bar, with symmetry planes at y = 0 and z = 0) between two grips that hold x only, the
+/// right one pulled 0.1 mm (5 times the yield strain) in 10 load steps, J2 with linear
+/// hardening `h` (Pa). The state is uniaxial and uniform, its deviator's direction fixed,
+/// and for linear hardening the radial return is exact along such a path: the grip's force
+/// is A (sigma_0 + E H / (E + H) (eps - eps_0)) past yield and A E eps before it, to the
+/// Newton tolerance (1e-8 of the force: 1e-6 holds it), and the plastic work is V
+/// (sigma_0 eps_p + H eps_p^2 / 2) with eps_p = eps - sigma / E (the return's trapezoidal
+/// dissipation is exact for linear hardening).
+fn plastic_bar(h: f64) -> String {
+    format!(
+        r#"
+[simulation]
+dimension = 3
+duration = 1.0
+solver = "static"
+load_steps = 10
+[grid]
+min = [-0.002, -0.002, -0.002]
+max = [0.026, 0.006, 0.006]
+cell = [0.001, 0.001, 0.001]
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 7800.0
+model = "j2"
+sigma_y = 250e6
+H = {h:e}
+[[body]]
+material = "steel"
+box = {{ min = [0.002, 0.0, 0.0], max = [0.022, 0.004, 0.004] }}
+[[boundary]]
+region = {{ min = [-0.002, -0.002, -0.002], max = [0.002, 0.006, 0.006] }}
+fix = ["x"]
+[[boundary]]
+region = {{ min = [0.022, -0.002, -0.002], max = [0.026, 0.006, 0.006] }}
+fix = ["x"]
+velocity = [1e-4, 0.0, 0.0]
+[[boundary]]
+region = {{ min = [-0.002, -0.002, -0.002], max = [0.026, 0.0, 0.006] }}
+fix = ["y"]
+[[boundary]]
+region = {{ min = [-0.002, -0.002, -0.002], max = [0.026, 0.006, 0.0] }}
+fix = ["z"]
+[[probe]]
+name = "grip"
+region = {{ min = [0.022, -0.002, -0.002], max = [0.026, 0.006, 0.006] }}
+quantity = "reaction"
+component = "x"
+[output]
+history_interval = 0.1
+"#
+    )
+}
+
+#[test]
+fn a_plastic_bar_follows_the_uniaxial_hardening_law() {
+    let (e, s0, area, length) = (200e9, 250e6, 1.6e-5, 0.02);
+    for h in [0.0, 10e9] {
+        let out = history(&plastic_bar(h));
+        let mut yielded = 0;
+        for (row, &force) in out.rows.iter().zip(&out.probes[0]).skip(1) {
+            let eps = 1e-4 * row.time / length;
+            let sigma = if eps <= s0 / e {
+                e * eps
+            } else {
+                yielded += 1;
+                s0 + e * h / (e + h) * (eps - s0 / e)
+            };
+            assert!(
+                (force - area * sigma).abs() <= 1e-6 * area * sigma,
+                "H = {h:e} at eps = {eps:e}: {force} vs {}",
+                area * sigma
+            );
+            let eps_p = (eps - sigma / e).max(0.0);
+            let work = area * length * (s0 * eps_p + 0.5 * h * eps_p * eps_p);
+            let plastic = row.energies.plastic_work;
+            assert!(
+                (plastic - work).abs() <= 1e-6 * work.max(1e-3),
+                "H = {h:e} at eps = {eps:e}: plastic work {plastic} vs {work}"
+            );
+        }
+        assert!(yielded >= 7, "the bar yields in most steps");
+    }
+}
+
+/// The same bar, perfectly plastic, under an end force that rises to 1.2 times its limit
+/// load sigma_0 A over 10 load steps: the eight steps below the limit solve, the ninth
+/// (1.08 times it) has no equilibrium, and the run stops there naming the step and what
+/// failed instead of returning an answer.
+#[test]
+fn a_load_past_the_limit_load_stops_the_run() {
+    let pulled = plastic_bar(0.0)
+        .replace(
+            r#"[[boundary]]
+region = { min = [0.022, -0.002, -0.002], max = [0.026, 0.006, 0.006] }
+fix = ["x"]
+velocity = [1e-4, 0.0, 0.0]"#,
+            r#"[[load]]
+region = { min = [0.021, 0.0, 0.0], max = [0.022, 0.004, 0.004] }
+force = [4800.0, 0.0, 0.0]
+time = { kind = "ramp", rise = 1.0 }"#,
+        )
+        .replace(
+            "region = { min = [0.022, -0.002, -0.002], max = [0.026, 0.006, 0.006] }\nquantity",
+            "region = { min = [-0.002, -0.002, -0.002], max = [0.002, 0.006, 0.006] }\nquantity",
+        );
+    assert!(pulled.contains("force = [4800.0"));
+    let opts = fissure::app::run::RunOptions::default();
+    let e = match fissure::app::run::run(&source(&pulled), &opts) {
+        Ok(o) => format!("ran to {:?}", o.summary.status),
+        Err(e) => format!("{e:#}"),
+    };
+    assert!(
+        e.contains("step 9") && e.contains("did not converge"),
         "{e}"
     );
 }

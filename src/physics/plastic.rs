@@ -24,6 +24,16 @@ pub enum Hardening {
         /// Hardening exponent n (> 1).
         exponent: f64,
     },
+    /// The Ramberg-Osgood law in the form of the EPRI handbook (Kumar, German & Shih
+    /// 1981): eps / eps_0 = sigma / sigma_0 + alpha (sigma / sigma_0)^n in uniaxial
+    /// tension, so eps_p = alpha eps_0 (sigma_y / sigma_0)^n from the first load (no
+    /// elastic limit: sigma_0 is a reference stress, not a yield stress).
+    Handbook {
+        /// The coefficient alpha (> 0).
+        alpha: f64,
+        /// Hardening exponent n (> 1).
+        exponent: f64,
+    },
 }
 
 /// A von Mises material's plastic parameters (the elastic ones are the material's).
@@ -62,6 +72,11 @@ const MAX_ITERATIONS: usize = 60;
 /// Relative tolerance of the scalar solves.
 const TOLERANCE: f64 = 1e-13;
 
+/// A stress lies on the yield surface when its effective stress is within this fraction
+/// of the yield stress: far above the returns' round-off, far below an elastic unloading
+/// step's departure.
+const ON_SURFACE: f64 = 1e-9;
+
 /// r^e, by squaring when e is a small whole number (the usual Ramberg-Osgood exponents):
 /// a few multiplications inline, where `powf` (or `powi`'s library call) costs several
 /// times more in the return map's Newton iterations.
@@ -91,9 +106,22 @@ impl J2 {
     pub fn flow_stress(&self, h: &Hardened) -> f64 {
         if h.equivalent > 0.0 {
             h.flow_stress
+        } else if let Hardening::Handbook { .. } = self.hardening {
+            0.0
         } else {
             self.yield_stress
         }
+    }
+
+    /// The handbook law's equivalent plastic strain at yield stress `y`, and its
+    /// derivative d(eps_p)/dy.
+    #[inline]
+    fn handbook_strain(&self, alpha: f64, n: f64, y: f64) -> (f64, f64) {
+        let s0 = self.yield_stress;
+        let scale = alpha * s0 / self.youngs;
+        let r = y / s0;
+        let p = power(r, n - 1.0);
+        (scale * p * r, scale * n * p / s0)
     }
 
     /// Solves the consistency condition q - 3 G dl - sigma_y(eps_p + dl) = 0 (Eq. 55) for
@@ -141,6 +169,22 @@ impl J2 {
                 }
                 ((strain - h.equivalent).max(0.0), y)
             }
+            Hardening::Handbook { alpha, exponent: n } => {
+                // f(y) = q - y - 3G (eps_p(y) - eps_p) is concave and decreasing on [y0, q]
+                // (eps_p is convex in y): Newton from y0 lands right of the root and falls
+                // monotonically onto it.
+                let mut y = y0;
+                for _ in 0..MAX_ITERATIONS {
+                    let (e, de) = self.handbook_strain(alpha, n, y);
+                    let step = (q - y - g3 * (e - h.equivalent)) / (1.0 + g3 * de);
+                    y = (y + step).clamp(y0, q);
+                    if step.abs() <= TOLERANCE * y {
+                        break;
+                    }
+                }
+                let strain = self.handbook_strain(alpha, n, y).0;
+                ((strain - h.equivalent).max(0.0), y)
+            }
         }
     }
 
@@ -174,6 +218,66 @@ impl J2 {
         h.work += 0.5 * (y0 + y) * dl;
         h.equivalent += dl;
         h.flow_stress = y;
+    }
+
+    /// The radial return of [`Self::radial_return`] with its algorithmic tangent, for a
+    /// Newton solve: None when the trial lies inside the yield surface (the tangent is then
+    /// the elastic one).
+    pub fn radial_return_tangent(
+        &self,
+        trial: &mut Sym3,
+        plastic: &mut Sym3,
+        h: &mut Hardened,
+    ) -> Option<Tangent> {
+        if !self.yields(trial, h) {
+            return None;
+        }
+        let s = trial.deviator();
+        let norm = s.ddot(&s).sqrt();
+        // q = sqrt(3/2) |s|.
+        let q = 1.5f64.sqrt() * norm;
+        self.radial_return(trial, plastic, h);
+        let theta = h.flow_stress / q;
+        Some(Tangent {
+            theta,
+            theta_bar: theta - self.hardening_share(h.flow_stress),
+            normal: s * (1.0 / norm),
+        })
+    }
+
+    /// The continuum elastoplastic tangent at a stress on the yield surface of state `h`
+    /// (the algorithmic one's limit for a vanishing increment: theta = 1, theta_bar = 3 mu
+    /// / (3 mu + H'); Simo & Hughes 1998, Eq. 3.3.12): None inside the surface or before
+    /// first yield. A Newton step's first solve starts from it, on the state alone.
+    pub fn continuum_tangent(&self, stress: &Sym3, h: &Hardened) -> Option<Tangent> {
+        let y = self.flow_stress(h);
+        let s = stress.deviator();
+        let norm = s.ddot(&s).sqrt();
+        let on_surface = 1.5f64.sqrt() * norm >= (1.0 - ON_SURFACE) * y;
+        if h.equivalent <= 0.0 || !on_surface {
+            return None;
+        }
+        Some(Tangent {
+            theta: 1.0,
+            theta_bar: 1.0 - self.hardening_share(y),
+            normal: s * (1.0 / norm),
+        })
+    }
+
+    /// H' / (3 mu + H') at yield stress `y`, H' = d(sigma_y)/d(eps_p) the hardening slope,
+    /// written as 1 / (1 + 3 mu d(eps_p)/d(sigma_y)) for the Ramberg-Osgood laws (Eq. 63
+    /// of Mashayekhi et al. 2011 differentiated, and the handbook form's), whose slope is
+    /// unbounded where their plastic compliance vanishes.
+    pub fn hardening_share(&self, y: f64) -> f64 {
+        let s0 = self.yield_stress;
+        let compliance = match self.hardening {
+            Hardening::Linear { modulus } => return modulus / (3.0 * self.mu + modulus),
+            Hardening::RambergOsgood { exponent: n } => {
+                s0 / self.youngs * (n * power(y / s0, n - 1.0) - 1.0) / s0
+            }
+            Hardening::Handbook { alpha, exponent: n } => self.handbook_strain(alpha, n, y).1,
+        };
+        1.0 / (1.0 + 3.0 * self.mu * compliance)
     }
 
     /// Returns the plane-stress elastic trial `trial` (sigma_zz = 0) to the yield surface in
@@ -229,9 +333,16 @@ impl J2 {
                             let p = power(r, n - 1.0);
                             (eps0 * (p * r - r) - h.equivalent, eps0 / s0 * (n * p - 1.0))
                         }
+                        Hardening::Handbook { alpha, exponent: n } => {
+                            let (e, de) = self.handbook_strain(alpha, n, y);
+                            (e - h.equivalent, de)
+                        }
                     }
                 };
-                let (mut lo, mut hi, mut y) = (y0, q_trial, y0);
+                // The handbook law starts from y0 = 0, where dg(y) = 3 eps_p / (2 y) is 0/0:
+                // it starts mid-bracket instead.
+                let start = if y0 > 0.0 { y0 } else { 0.5 * q_trial };
+                let (mut lo, mut hi, mut y) = (y0, q_trial, start);
                 let mut last = f64::NAN;
                 for _ in 0..MAX_ITERATIONS {
                     let (e, de) = strain(y);
@@ -280,6 +391,34 @@ impl J2 {
         h.work += 0.5 * (y0 + y) * dl;
         h.equivalent += dl;
         h.flow_stress = y;
+    }
+}
+
+/// The algorithmic (consistent) tangent of a radial return, d(sigma)/d(eps) of the
+/// discrete update rather than of the rate equations, which keeps Newton's iterations
+/// quadratic (Simo & Taylor 1985; Simo & Hughes 1998, Box 3.2): C = K 1 (x) 1 + 2 mu theta
+/// I_dev - 2 mu theta_bar N (x) N, with theta = sigma_y / q_trial, theta_bar = theta -
+/// H' / (3 mu + H'), N the unit trial deviator and H' the hardening slope at the returned
+/// state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tangent {
+    /// sigma_y / q_trial: how much of the trial deviator the return keeps.
+    pub theta: f64,
+    /// theta - H' / (3 mu + H'): the stiffness lost along the flow direction.
+    pub theta_bar: f64,
+    /// The unit trial deviator N (N : N = 1).
+    pub normal: Sym3,
+}
+
+impl Tangent {
+    /// C : `de` for material `m` (its bulk and shear moduli).
+    #[inline(always)]
+    pub fn apply(&self, lambda: f64, mu: f64, de: &Sym3) -> Sym3 {
+        let bulk = lambda + 2.0 / 3.0 * mu;
+        let m2 = 2.0 * mu;
+        de.deviator() * (m2 * self.theta)
+            + Sym3::identity() * (bulk * de.trace())
+            + self.normal * (-m2 * self.theta_bar * self.normal.ddot(de))
     }
 }
 
@@ -365,6 +504,124 @@ mod tests {
         }
     }
 
+    /// The algorithmic tangent is the derivative of the return map: against central
+    /// differences of the update from a yielded state (truncation ~h^2, round-off of the
+    /// 1e-13 scalar solves over h ~ 1e-7 of the increment: 1e-6 of the stress change is
+    /// far above both and far below a wrong term, which moves it by percent).
+    #[test]
+    fn tangent_is_the_derivative_of_the_return() {
+        for hardening in [
+            Hardening::Linear { modulus: 0.0 },
+            Hardening::Linear { modulus: 2e9 },
+            Hardening::RambergOsgood { exponent: 10.0 },
+            Hardening::RambergOsgood { exponent: 3.0 },
+            Hardening::Handbook {
+                alpha: 1.0,
+                exponent: 10.0,
+            },
+        ] {
+            let m = steel(hardening);
+            let j2 = m.j2.expect("plastic");
+            let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
+            let pre = Sym3 {
+                xx: 2e-3,
+                yy: -5e-4,
+                zz: -4e-4,
+                xy: 6e-4,
+                ..Sym3::default()
+            };
+            step(&m, Plane::None, pre, &mut st);
+            let de = Sym3 {
+                xx: 1e-3,
+                yy: 2e-4,
+                zz: -3e-4,
+                yz: 1e-4,
+                xz: -2e-4,
+                xy: 5e-4,
+            };
+            let returned = |d: Sym3| {
+                let mut s = st;
+                m.update(Plane::None, d, &mut s.0);
+                let t = j2.radial_return_tangent(&mut s.0, &mut s.1, &mut s.2);
+                (s.0, t)
+            };
+            let (_, t) = returned(de);
+            let t = t.expect("the increment yields");
+            for dir in [
+                Sym3 {
+                    xx: 1.0,
+                    ..Sym3::default()
+                },
+                Sym3 {
+                    yy: 1.0,
+                    zz: -0.5,
+                    ..Sym3::default()
+                },
+                Sym3 {
+                    xy: 1.0,
+                    ..Sym3::default()
+                },
+                Sym3 {
+                    yz: 0.7,
+                    xx: 0.2,
+                    ..Sym3::default()
+                },
+            ] {
+                let h = 1e-7 * 1e-3;
+                let (plus, _) = returned(de + dir * h);
+                let (minus, _) = returned(de + dir * -h);
+                let fd = (plus + minus * -1.0) * (0.5 / h);
+                let exact = t.apply(m.lambda, m.mu, &dir);
+                let err = (fd + exact * -1.0).max_abs();
+                assert!(
+                    err <= 1e-6 * exact.max_abs(),
+                    "{hardening:?} along {dir:?}: {err:e} of {:e}",
+                    exact.max_abs()
+                );
+            }
+        }
+    }
+
+    /// The continuum tangent at a yielded state is the algorithmic tangent's limit for an
+    /// increment that vanishes along the flow: the two agree to the increment's relative
+    /// size (1e-9 here), and an unloaded state has none.
+    #[test]
+    fn continuum_tangent_is_the_small_increment_limit() {
+        for hardening in [
+            Hardening::Linear { modulus: 0.0 },
+            Hardening::Linear { modulus: 2e9 },
+            Hardening::RambergOsgood { exponent: 5.0 },
+            Hardening::Handbook {
+                alpha: 0.5,
+                exponent: 5.0,
+            },
+        ] {
+            let m = steel(hardening);
+            let j2 = m.j2.expect("plastic");
+            let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
+            let pre = Sym3 {
+                xx: 3e-3,
+                yy: -1e-3,
+                zz: -5e-4,
+                xy: 1e-3,
+                ..Sym3::default()
+            };
+            step(&m, Plane::None, pre, &mut st);
+            let c = j2.continuum_tangent(&st.0, &st.2).expect("on the surface");
+            let mut next = st;
+            m.update(Plane::None, pre * 1e-9, &mut next.0);
+            let a = (j2.radial_return_tangent(&mut next.0, &mut next.1, &mut next.2))
+                .expect("still yielding");
+            for (x, y) in [(c.theta, a.theta), (c.theta_bar, a.theta_bar)] {
+                assert!((x - y).abs() <= 1e-6 * x.abs(), "{hardening:?}: {x} vs {y}");
+            }
+            assert!((c.normal + a.normal * -1.0).max_abs() <= 1e-6);
+            let mut unloaded = st;
+            m.update(Plane::None, pre * -0.1, &mut unloaded.0);
+            assert!(j2.continuum_tangent(&unloaded.0, &unloaded.2).is_none());
+        }
+    }
+
     /// Uniaxial stress by iterating the lateral strain (3D: yy = zz; plane stress: yy) until
     /// the lateral stress vanishes; returns sigma_xx.
     fn uniaxial(m: &Material, plane: Plane, dx: f64, st: &mut (Sym3, Sym3, Hardened)) -> f64 {
@@ -399,7 +656,8 @@ mod tests {
 
     /// Loading past yield follows the uniaxial hardening law in 3D and in plane stress, and
     /// unloading follows the elastic slope E: for linear hardening sigma = sigma_0 +
-    /// E H/(E + H) (eps - eps_0); for Ramberg-Osgood eps/eps_0 = (sigma/sigma_0)^n.
+    /// E H/(E + H) (eps - eps_0); for Ramberg-Osgood eps/eps_0 = (sigma/sigma_0)^n; for the
+    /// handbook's form eps/eps_0 = sigma/sigma_0 + alpha (sigma/sigma_0)^n from the start.
     #[test]
     fn uniaxial_cycle_follows_the_hardening_law() {
         let (e, s0) = (200e9, 250e6);
@@ -409,6 +667,10 @@ mod tests {
                 Hardening::Linear { modulus: 0.0 },
                 Hardening::Linear { modulus: 10e9 },
                 Hardening::RambergOsgood { exponent: 10.0 },
+                Hardening::Handbook {
+                    alpha: 1.0,
+                    exponent: 5.0,
+                },
             ] {
                 let m = steel(hardening);
                 let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
@@ -418,6 +680,16 @@ mod tests {
                     sigma = uniaxial(&m, plane, peak / steps as f64, &mut st);
                     let eps = peak * k as f64 / steps as f64;
                     let expect = match hardening {
+                        Hardening::Handbook { alpha, exponent: n } => {
+                            // Invert eps/eps0 = r + alpha r^n by Newton in r, from above
+                            // (the right side is convex).
+                            let mut r: f64 = eps / eps0;
+                            for _ in 0..50 {
+                                r -= (r + alpha * r.powf(n) - eps / eps0)
+                                    / (1.0 + alpha * n * r.powf(n - 1.0));
+                            }
+                            s0 * r
+                        }
                         _ if eps <= eps0 => e * eps,
                         Hardening::Linear { modulus: h } => s0 + e * h / (e + h) * (eps - eps0),
                         Hardening::RambergOsgood { exponent: n } => {

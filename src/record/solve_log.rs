@@ -17,6 +17,8 @@ pub struct Solved {
     pub closed_faces: usize,
     /// Solves the contact active set took (1 without contact).
     pub contact_rounds: usize,
+    /// Newton iterations (plastic scenes; 0 for a linear step, which solves once).
+    pub newton: usize,
 }
 
 /// What a static scene's load steps took: counts, iterations and the worst residual.
@@ -38,6 +40,10 @@ pub struct SolveLog {
     pub closed_faces: usize,
     /// Most solves one load step's contact active set took.
     pub most_contact_rounds: usize,
+    /// Newton iterations, all load steps (plastic scenes).
+    pub newton_iterations: u64,
+    /// Most Newton iterations in one load step.
+    pub most_newton: u64,
 }
 
 impl SolveLog {
@@ -51,5 +57,7 @@ impl SolveLog {
         self.largest_imbalance = self.largest_imbalance.max(s.imbalance);
         self.closed_faces = s.closed_faces;
         self.most_contact_rounds = self.most_contact_rounds.max(s.contact_rounds);
+        self.newton_iterations += s.newton as u64;
+        self.most_newton = self.most_newton.max(s.newton as u64);
     }
 }

@@ -5,8 +5,10 @@
 //! solution along them. The solve removes that imbalance and keeps its iterates clear of
 //! them (deflation), and reports the part of the load it removed.
 
+use super::cg::dot;
+use super::entry_node;
+use super::operator::{Law, apply};
 use super::unknowns::Unknowns;
-use super::{apply, dot, entry_node};
 use crate::base::dim::Dim;
 use crate::store::world::{CHUNK, World};
 use rayon::prelude::*;
@@ -36,7 +38,7 @@ pub(super) fn free_motions<D: Dim>(
     let mut q = vec![D::zero(); free.len()];
     let mut g = [[0.0; 6]; 6];
     for (j, bj) in basis.iter().enumerate() {
-        apply(world, bj, dofs, Some(ghost), &mut q);
+        apply(world, Law::Elastic, bj, dofs, Some(ghost), &mut q);
         // K is symmetric: the upper triangle, mirrored.
         for (i, bi) in basis.iter().enumerate().take(j + 1) {
             let v = dot::<D>(bi, &q);

@@ -69,6 +69,7 @@ fn material(src: &Source, i: usize, m: &MaterialSpec) -> R<Material> {
             ("sigma_y", m.sigma_y.is_some()),
             ("H", m.hardening.is_some()),
             ("n", m.n.is_some()),
+            ("alpha", m.alpha.is_some()),
         ] {
             if given {
                 return Err(src.error(
@@ -122,8 +123,25 @@ fn material(src: &Source, i: usize, m: &MaterialSpec) -> R<Material> {
                     ),
                 ));
             }
-            Hardening::RambergOsgood { exponent: n }
+            match m.alpha {
+                None => Hardening::RambergOsgood { exponent: n },
+                Some(alpha) if alpha.is_finite() && alpha > 0.0 => {
+                    Hardening::Handbook { alpha, exponent: n }
+                }
+                Some(alpha) => {
+                    return Err(src.error(
+                        &key("alpha"),
+                        format!("the Ramberg-Osgood alpha must be positive, got {alpha}"),
+                    ));
+                }
+            }
         }
     };
+    if m.alpha.is_some() && m.n.is_none() {
+        return Err(src.error(
+            &key("alpha"),
+            "`alpha` belongs to the Ramberg-Osgood law: give its exponent `n` too",
+        ));
+    }
     Ok(e.with_j2(sigma_y, hardening))
 }

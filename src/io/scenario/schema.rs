@@ -138,6 +138,9 @@ pub struct MaterialSpec {
     pub hardening: Option<f64>,
     /// j2: modified Ramberg-Osgood exponent n (> 1), instead of `H`.
     pub n: Option<f64>,
+    /// j2 with `n`: the handbook's Ramberg-Osgood form eps/eps_0 = sigma/sigma_0 + alpha
+    /// (sigma/sigma_0)^n (Kumar, German & Shih 1981), `sigma_y` its reference stress.
+    pub alpha: Option<f64>,
 }
 
 /// A material's constitutive model.

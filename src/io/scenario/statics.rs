@@ -1,7 +1,9 @@
 //! What a static scene (`solver = "static"`) may hold so far: linear elastic bodies held
 //! by their boundaries (still, or moved by a prescribed velocity's displacement), under
-//! loads and gravity, with open cracks or faces in frictionless contact. Stick and friction,
-//! growth and plasticity are refused by name until the static solver takes them.
+//! loads and gravity, with open cracks or faces in frictionless contact, elastic or J2
+//! plastic (3D and plane strain; plastic scenes with open faces). Stick and friction, growth,
+//! plane-stress plasticity and contact with plasticity are refused by name until the static
+//! solver takes them.
 
 use super::check::R;
 use super::source::Source;
@@ -58,11 +60,23 @@ pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()
         }
     }
     if let Some(k) = (0..materials.len()).find(|&k| used[k] && materials[k].j2.is_some()) {
-        return Err(src.error(
-            &format!("material[{k}]"),
-            "the static solver does not take J2 plasticity yet (it needs Newton iterations): \
-             run this scene with solver = \"explicit\"",
-        ));
+        if sc.simulation.plane.as_deref() == Some("stress") {
+            return Err(src.error(
+                &format!("material[{k}]"),
+                "the static solver takes J2 plasticity in 3D and plane strain, not in plane \
+                 stress yet: run this scene with solver = \"explicit\"",
+            ));
+        }
+        if let Some(c) =
+            (sc.cracks.iter()).position(|c| c.contact.as_ref().is_some_and(|k| k.law != "none"))
+        {
+            return Err(src.error(
+                &format!("crack[{c}].contact"),
+                "the static solver takes crack-face contact in elastic scenes only, not with \
+                 a J2 plastic material yet: drop the contact (open faces) or run this scene \
+                 with solver = \"explicit\"",
+            ));
+        }
     }
     Ok(())
 }

@@ -1,0 +1,158 @@
+//! Preconditioned conjugate gradients (Hestenes & Stiefel 1952) on a static scene's K,
+//! matrix-free, with sums in fixed chunks so that every thread count gives the same bits.
+
+use super::ghost_stiffness;
+use super::operator::{Law, apply, diagonal};
+use super::rigid;
+use super::unknowns::Unknowns;
+use crate::base::dim::Dim;
+use crate::base::error::Unstable;
+use crate::record::solve_log::Solved;
+use crate::store::world::{CHUNK, World};
+use rayon::prelude::*;
+
+/// Most iterations per load step, per unknown along the grid's longest axis: conjugate
+/// gradients on a well-supported grid converge in a small multiple of it.
+const ITERATIONS_PER_NODE: usize = 50;
+
+/// The sum of a * b over all components, in fixed chunks (the same bits for any thread
+/// count).
+pub(super) fn dot<D: Dim>(a: &[D::Vec], b: &[D::Vec]) -> f64 {
+    let parts: Vec<f64> = a
+        .par_chunks(CHUNK)
+        .zip(b.par_chunks(CHUNK))
+        .map(|(a, b)| a.iter().zip(b).map(|(&x, &y)| D::dot(x, y)).sum())
+        .collect();
+    parts.iter().sum()
+}
+
+/// What every solve on one set of unknowns shares: K's diagonal (the Jacobi
+/// preconditioner, from the elastic K), the ghost stiffness and the free rigid motions.
+pub(super) struct Frame<D: Dim> {
+    /// K's diagonal on the free components (1 elsewhere).
+    pub diag: Vec<D::Vec>,
+    /// The ghost stiffness per component ([`super::ghost_stiffness`]).
+    pub ghost: Vec<D::Vec>,
+    /// An orthonormal basis of the rigid motions K leaves free.
+    pub modes: Vec<Vec<D::Vec>>,
+}
+
+impl<D: Dim> Frame<D> {
+    /// The frame of the unknowns `dofs`.
+    pub fn new(world: &World<D>, dofs: &Unknowns<D>) -> Self {
+        let diag = diagonal(world, dofs);
+        let largest = (diag.iter().zip(&dofs.free))
+            .flat_map(|(d, k)| (0..D::D).filter(|&a| k[a] != 0.0).map(|a| d[a]))
+            .fold(0.0, f64::max);
+        let ghost = ghost_stiffness(world, &diag);
+        let modes = rigid::free_motions(world, dofs, &ghost, largest);
+        Frame { diag, ghost, modes }
+    }
+}
+
+/// Solves K u = f on the free components (K the stiffness of `law`, plus the ghost's) from
+/// `start` or from u = 0 by preconditioned conjugate gradients (Hestenes & Stiefel 1952),
+/// to a residual of `tolerance` times |f|.
+pub(super) fn conjugate_gradients<D: Dim>(
+    world: &World<D>,
+    law: Law<D>,
+    frame: &Frame<D>,
+    dofs: &Unknowns<D>,
+    f: &[D::Vec],
+    start: Option<Vec<D::Vec>>,
+    tolerance: f64,
+) -> Result<(Vec<D::Vec>, Solved), Unstable> {
+    let Frame { diag, ghost, modes } = frame;
+    let n = f.len();
+    let norm_f = dot::<D>(f, f).sqrt();
+    if norm_f == 0.0 {
+        return Ok((vec![D::zero(); n], Solved::default()));
+    }
+    let precondition = |r: &[D::Vec]| -> Vec<D::Vec> {
+        r.par_iter()
+            .zip(diag.par_iter())
+            .map(|(&r, &d)| {
+                let mut z = r;
+                for a in 0..D::D {
+                    z[a] /= d[a];
+                }
+                z
+            })
+            .collect()
+    };
+    let mut r = f.to_vec();
+    let mut u = match start {
+        Some(u) => {
+            let mut q = vec![D::zero(); n];
+            apply(world, law, &u, dofs, Some(ghost), &mut q);
+            r.iter_mut().zip(&q).for_each(|(r, &q)| *r -= q);
+            u
+        }
+        None => vec![D::zero(); n],
+    };
+    let residual = dot::<D>(&r, &r).sqrt() / norm_f;
+    if residual <= tolerance {
+        let solved = Solved {
+            residual,
+            ..Solved::default()
+        };
+        return Ok((u, solved));
+    }
+    let mut z = precondition(&r);
+    dofs.project(&mut z);
+    rigid::deflate::<D>(&mut z, modes);
+    let mut dir = z.clone();
+    let mut rz = dot::<D>(&r, &z);
+    let mut q = vec![D::zero(); n];
+    let cells = world.grid.geom.cells;
+    let most = ITERATIONS_PER_NODE * (cells[0].max(cells[1]).max(cells[2]) + 1);
+    for k in 1..=most {
+        apply(world, law, &dir, dofs, Some(ghost), &mut q);
+        let pq = dot::<D>(&dir, &q);
+        // A direction of no stiffness (or NaN): K is singular on what the loads start.
+        if pq.is_nan() || pq <= 0.0 {
+            return Err(not_converged(world, k, dot::<D>(&r, &r).sqrt() / norm_f));
+        }
+        let alpha = rz / pq;
+        u.par_iter_mut()
+            .zip(r.par_iter_mut())
+            .zip(dir.par_iter().zip(q.par_iter()))
+            .for_each(|((u, r), (&p, &q))| {
+                *u += p * alpha;
+                *r -= q * alpha;
+            });
+        let residual = dot::<D>(&r, &r).sqrt() / norm_f;
+        if residual <= tolerance {
+            return Ok((
+                u,
+                Solved {
+                    iterations: k,
+                    residual,
+                    ..Solved::default()
+                },
+            ));
+        }
+        z = precondition(&r);
+        dofs.project(&mut z);
+        rigid::deflate::<D>(&mut z, modes);
+        let rz_next = dot::<D>(&r, &z);
+        let beta = rz_next / rz;
+        rz = rz_next;
+        dir.par_iter_mut()
+            .zip(z.par_iter())
+            .for_each(|(p, &z)| *p = z + *p * beta);
+    }
+    Err(not_converged(world, most, dot::<D>(&r, &r).sqrt() / norm_f))
+}
+
+fn not_converged<D: Dim>(world: &World<D>, iterations: usize, residual: f64) -> Unstable {
+    Unstable {
+        step: world.step + 1,
+        time: (world.step + 1) as f64 * world.settings.dt,
+        what: format!(
+            "the static solve did not converge: relative residual {residual:.3e} after \
+             {iterations} conjugate-gradient iterations (is the body held against every rigid \
+             motion the loads would start?)"
+        ),
+    }
+}

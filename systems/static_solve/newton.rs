@@ -1,0 +1,267 @@
+//! A static load step of a scene with J2 plastic materials: Newton-Raphson on the grid
+//! entries' displacement increment. Each iterate gives every particle its stress from the
+//! state the last load step committed, by the return map (backward Euler: the same update
+//! the explicit solver makes, in one increment), and each linear solve uses the return's
+//! algorithmic tangent (Simo & Taylor 1985), which keeps the iteration quadratic. The
+//! particles' state changes only when the step converges.
+
+use super::cg::{Frame, conjugate_gradients, dot};
+use super::operator::{Law, mask, stiffness};
+use super::unknowns::Unknowns;
+use super::{Linear, equilibrium, gradient, rigid};
+use crate::base::dim::Dim;
+use crate::base::error::Unstable;
+use crate::base::sym::SymTensor;
+use crate::physics::plastic::{Hardened, Tangent};
+use crate::record::solve_log::Solved;
+use crate::store::world::World;
+use rayon::prelude::*;
+
+/// Most Newton iterations in a load step: with the consistent tangent a step that
+/// converges at all does so in a handful; one that has not by then is past a limit load
+/// or needs smaller steps.
+const NEWTON_ITERATIONS: usize = 30;
+
+/// Most halvings of a Newton correction that raises the residual (a backtracking line
+/// search): a return map that switches many particles between elastic and plastic at once
+/// can overshoot; a correction that helps at none of these lengths is not a descent.
+const HALVINGS: usize = 6;
+
+/// The loosest and tightest relative tolerance of a Newton iteration's linear solve
+/// (inexact Newton, Eisenstat & Walker 1996): loose while the residual is far above the
+/// goal (an exact solve of a wrong tangent buys nothing), tight enough near it that the
+/// next residual is the tangent's, not the solver's.
+const LINEAR_TOLERANCE: (f64, f64) = (1e-2, 1e-1);
+
+/// The particles' state at a trial increment: each one's stress, plastic strain and
+/// hardening from its committed state by the return map, and the return's tangent (None
+/// where the particle stays elastic).
+pub(super) struct Returned<D: Dim> {
+    /// Stress (Pa).
+    pub stress: Vec<D::Sym>,
+    /// Plastic strain.
+    pub plastic: Vec<D::Sym>,
+    /// Hardening state.
+    pub hardened: Vec<Hardened>,
+    /// Algorithmic tangent of the return.
+    pub tangents: Vec<Option<Tangent>>,
+}
+
+/// A converged plastic load step.
+pub(super) struct Step<D: Dim> {
+    /// Every grid entry's displacement increment over the step.
+    pub du: Vec<D::Vec>,
+    /// The particles' state at it.
+    pub returned: Returned<D>,
+    /// What the solves took.
+    pub solved: Solved,
+}
+
+/// Solves the load step on the unknowns `dofs`: the loads now in the grid's force column,
+/// the moving supports' displacement increment `held` over the step.
+pub(super) fn solve<D: Dim>(
+    world: &World<D>,
+    dofs: &Unknowns<D>,
+    held: Option<&[D::Vec]>,
+    t_end: f64,
+) -> Result<Step<D>, Unstable> {
+    let frame = Frame::new(world, dofs);
+    let entries = world.grid.mass.len();
+    // The first correction: the continuum tangent of the committed state (which a resumed
+    // run finds the same) on the load less the committed stresses' force, with the
+    // supports' increment.
+    let mut f_int = vec![D::zero(); entries];
+    let none = vec![D::zero(); entries];
+    let committed = Law::Given(&world.particles.stress);
+    stiffness(world, committed, &none, dofs, &mut f_int);
+    let load = (world.grid.force.iter().zip(&f_int))
+        .map(|(&f, &q)| f - q)
+        .collect();
+    let tolerance = world.settings.tolerance;
+    let tangents = continuum(world);
+    let first = Linear {
+        law: Law::Tangent(&tangents),
+        tolerance: LINEAR_TOLERANCE.0,
+    };
+    let (mut du, mut solved) = equilibrium(world, dofs, &frame, first, load, held, None)?;
+    let mut now = residual(world, dofs, &frame, &du);
+    let mut history = vec![now.relative()];
+    for newton in 1..=NEWTON_ITERATIONS {
+        if now.relative() <= tolerance {
+            solved.newton = newton;
+            solved.residual = now.relative();
+            return Ok(Step {
+                du,
+                returned: now.returned,
+                solved,
+            });
+        }
+        let eta = (0.1 * tolerance / now.relative()).clamp(LINEAR_TOLERANCE.0, LINEAR_TOLERANCE.1);
+        let law = Law::Tangent(&now.returned.tangents);
+        let (mut delta, linear) = conjugate_gradients(world, law, &frame, dofs, &now.r, None, eta)?;
+        solved.iterations += linear.iterations;
+        dofs.expand(&mut delta);
+        let mut length = 1.0;
+        let next = loop {
+            let trial: Vec<D::Vec> = (du.iter().zip(&delta))
+                .map(|(&u, &d)| u + d * length)
+                .collect();
+            let then = residual(world, dofs, &frame, &trial);
+            if then.norm < now.norm || length < 0.5f64.powi(HALVINGS as i32) {
+                du = trial;
+                break then;
+            }
+            length *= 0.5;
+        };
+        if next.norm >= now.norm {
+            history.push(next.relative());
+            return Err(diverged(world, t_end, &history));
+        }
+        now = next;
+        history.push(now.relative());
+    }
+    Err(diverged(world, t_end, &history))
+}
+
+/// The error of a load step whose Newton iteration did not converge, with its residuals.
+fn diverged<D: Dim>(world: &World<D>, t_end: f64, history: &[f64]) -> Unstable {
+    let list: Vec<String> = history.iter().map(|r| format!("{r:.2e}")).collect();
+    Unstable {
+        step: world.step + 1,
+        time: t_end,
+        what: format!(
+            "the plastic load step did not converge in {} Newton iterations (relative \
+             residuals {}): past a limit load, or too large a load step (give more \
+             `load_steps`)",
+            history.len() - 1,
+            list.join(", ")
+        ),
+    }
+}
+
+/// The out-of-balance force at an increment, with the state it came from.
+struct Residual<D: Dim> {
+    /// f_ext - f_int on the free components, rigid motions taken out.
+    r: Vec<D::Vec>,
+    /// |r|.
+    norm: f64,
+    /// The force it is measured against: the larger of |f_ext| and |f_int| (which holds
+    /// the supports' reactions, and so measures a scene driven by moving supports).
+    scale: f64,
+    /// The particles' state at the increment.
+    returned: Returned<D>,
+}
+
+impl<D: Dim> Residual<D> {
+    /// |r| over the scale (0 for a scene with no force at all).
+    fn relative(&self) -> f64 {
+        if self.scale > 0.0 {
+            self.norm / self.scale
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The residual at the increment `du` (every entry's).
+fn residual<D: Dim>(
+    world: &World<D>,
+    dofs: &Unknowns<D>,
+    frame: &Frame<D>,
+    du: &[D::Vec],
+) -> Residual<D> {
+    let returned = return_map(world, du);
+    let mut f_int = vec![D::zero(); du.len()];
+    stiffness(world, Law::Given(&returned.stress), du, dofs, &mut f_int);
+    let mut f_ext = world.grid.force.clone();
+    dofs.fold(&mut f_ext);
+    let scale = dot::<D>(&f_ext, &f_ext)
+        .max(dot::<D>(&f_int, &f_int))
+        .sqrt();
+    let mut r: Vec<D::Vec> = (f_ext.iter().zip(&f_int).zip(&dofs.free))
+        .map(|((&f, &q), &k)| mask::<D>(f - q, k))
+        .collect();
+    dofs.project(&mut r);
+    rigid::deflate::<D>(&mut r, &frame.modes);
+    let norm = dot::<D>(&r, &r).sqrt();
+    Residual {
+        r,
+        norm,
+        scale,
+        returned,
+    }
+}
+
+/// Each particle's continuum tangent at its committed state (None: elastic).
+fn continuum<D: Dim>(world: &World<D>) -> Vec<Option<Tangent>> {
+    let p = &world.particles;
+    (0..p.len())
+        .into_par_iter()
+        .map(|i| {
+            let m = &world.materials[p.material[i] as usize];
+            (m.j2.as_ref())
+                .and_then(|j2| j2.continuum_tangent(&p.stress[i].to_sym3(), &p.hardened[i]))
+        })
+        .collect()
+}
+
+/// Every particle's state at the increment `du`: the committed stress plus the elastic
+/// increment of sym(grad du), returned to the yield surface of the committed hardening.
+fn return_map<D: Dim>(world: &World<D>, du: &[D::Vec]) -> Returned<D> {
+    let p = &world.particles;
+    let plane = world.settings.plane;
+    let states: Vec<_> = (0..p.len())
+        .into_par_iter()
+        .map(|i| {
+            let m = &world.materials[p.material[i] as usize];
+            let l = gradient(world, i, du);
+            let mut s = p.stress[i].to_sym3();
+            m.update(plane, D::sym_part(&l), &mut s);
+            let mut plastic = p.plastic_strain[i].to_sym3();
+            let mut h = p.hardened[i];
+            let tangent = (m.j2.as_ref())
+                .and_then(|j2| j2.radial_return_tangent(&mut s, &mut plastic, &mut h));
+            (D::Sym::from_sym3(s), D::Sym::from_sym3(plastic), h, tangent)
+        })
+        .collect();
+    let mut out = Returned {
+        stress: Vec::with_capacity(states.len()),
+        plastic: Vec::with_capacity(states.len()),
+        hardened: Vec::with_capacity(states.len()),
+        tangents: Vec::with_capacity(states.len()),
+    };
+    for (s, e, h, t) in states {
+        out.stress.push(s);
+        out.plastic.push(e);
+        out.hardened.push(h);
+        out.tangents.push(t);
+    }
+    out
+}
+
+/// Commits the converged step to the particles: their new stress, plastic strain and
+/// hardening, grad u advanced by grad du (when kept), x = x0 + `disp`, at rest.
+pub(super) fn commit<D: Dim>(world: &mut World<D>, step: Step<D>, disp: &[D::Vec]) {
+    let keep = !world.particles.grad_u.is_empty();
+    if keep {
+        let grads: Vec<D::Mat> = (0..disp.len())
+            .into_par_iter()
+            .map(|i| gradient(world, i, &step.du))
+            .collect();
+        let p = &mut world.particles;
+        p.grad_u
+            .iter_mut()
+            .zip(grads)
+            .for_each(|(g, l)| *g = *g + l);
+    }
+    let p = &mut world.particles;
+    let r = step.returned;
+    p.stress = r.stress;
+    p.plastic_strain = r.plastic;
+    p.hardened = r.hardened;
+    for (i, &d) in disp.iter().enumerate() {
+        p.x[i] = p.x0[i] + d;
+        p.v[i] = D::zero();
+    }
+    world.tiles.fresh = false;
+}

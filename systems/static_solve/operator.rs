@@ -1,0 +1,169 @@
+//! Products with the stiffness K of a static scene, matrix-free: particle by particle, the
+//! stress a displacement gradient gives under a [`Law`], scattered as nodal forces.
+
+use super::unknowns::Unknowns;
+use super::{each_entry, fields, gradient};
+use crate::base::dim::Dim;
+use crate::base::sym::{Sym3, SymTensor};
+use crate::physics::material::{Material, Plane};
+use crate::physics::plastic::Tangent;
+use crate::store::disjoint::Disjoint;
+use crate::store::world::{CHUNK, World};
+use crate::systems::p2g::add_internal_force;
+use crate::systems::stress::velocity_gradient;
+use rayon::prelude::*;
+
+/// Which stress a particle's displacement gradient gives, in a product with K.
+#[derive(Clone, Copy)]
+pub(super) enum Law<'a, D: Dim> {
+    /// The material's elastic C : sym(grad u).
+    Elastic,
+    /// Each particle's algorithmic tangent from its last return map (None: elastic) :
+    /// sym(grad u): the Newton iteration's K.
+    Tangent(&'a [Option<Tangent>]),
+    /// The given stresses, whatever the displacement: the internal force they make.
+    Given(&'a [D::Sym]),
+}
+
+impl<D: Dim> Law<'_, D> {
+    /// Particle `i`'s stress from its displacement gradient `l`.
+    #[inline(always)]
+    fn stress(&self, m: &Material, plane: Plane, i: usize, l: &D::Mat) -> D::Sym {
+        match self {
+            Law::Elastic => elastic::<D>(m, plane, l),
+            Law::Tangent(t) => match &t[i] {
+                Some(t) => D::Sym::from_sym3(t.apply(m.lambda, m.mu, &D::sym_part(l))),
+                None => elastic::<D>(m, plane, l),
+            },
+            Law::Given(s) => s[i],
+        }
+    }
+}
+
+/// `v` with the components `keep` has at 0 cleared.
+#[inline(always)]
+pub(super) fn mask<D: Dim>(v: D::Vec, keep: D::Vec) -> D::Vec {
+    let mut out = v;
+    for a in 0..D::D {
+        out[a] *= keep[a];
+    }
+    out
+}
+
+/// The stress C : sym(l) of material `m`.
+#[inline(always)]
+pub(super) fn elastic<D: Dim>(m: &Material, plane: Plane, l: &D::Mat) -> D::Sym {
+    let mut s = Sym3::default();
+    m.update(plane, D::sym_part(l), &mut s);
+    D::Sym::from_sym3(s)
+}
+
+/// y = K x, particle by particle: grad x gathered at each particle (tied entries taking
+/// the value of the entry they move with), the stress it gives under `law`, and that stress's nodal
+/// force, tile by tile in colour classes (the same scatter, in the same order, for any
+/// thread count), tied entries' forces folded into their partners'.
+pub(super) fn stiffness<D: Dim>(
+    world: &World<D>,
+    law: Law<D>,
+    x: &[D::Vec],
+    dofs: &Unknowns<D>,
+    y: &mut [D::Vec],
+) {
+    let expanded;
+    let x = if dofs.ties.is_empty() && dofs.normal_ties.is_empty() {
+        x
+    } else {
+        let mut e = x.to_vec();
+        dofs.expand(&mut e);
+        expanded = e;
+        &expanded[..]
+    };
+    y.par_chunks_mut(CHUNK).for_each(|c| c.fill(D::zero()));
+    let (shape, plane) = (world.settings.shape, world.settings.plane);
+    let stride = &world.grid.geom.stride;
+    let (p, materials, tiles) = (&world.particles, &world.materials, &world.tiles);
+    let fields = fields(world);
+    let y_w = Disjoint::new(y);
+    tiles.for_each_coloured(|t| {
+        let mine = tiles.particles(t).iter().map(|&i| i as usize);
+        for_each_free_particle!(D, shape, &tiles.stencils, fields, mine, |i, st| {
+            let rows = st.rows::<D>(stride);
+            let l = velocity_gradient::<D, N>(&st, &rows, x);
+            let s = law.stress(&materials[p.material[i] as usize], plane, i, &l);
+            // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
+            // tile is handled by one thread. Given -V, the internal-force scatter adds
+            // +V sigma . grad S: the rows of K x.
+            unsafe { add_internal_force::<D, N>(&st, &rows, &s, -p.volume[i], &y_w) };
+        })
+    });
+    // The particles near a crack, on their sides' entries, in particle order.
+    for &i in fields.map_or(&[][..], |f| &f.coded[..]) {
+        let i = i as usize;
+        let l = gradient(world, i, x);
+        let s = law.stress(&materials[p.material[i] as usize], plane, i, &l);
+        each_entry(world, i, |n, _, g| {
+            y[n] += D::stress_dot(&s, g) * p.volume[i]
+        });
+    }
+    dofs.fold(y);
+}
+
+/// y = K x on the free components ([`stiffness`]), with `ghost`'s stiffness (per
+/// component) times x added when given.
+pub(super) fn apply<D: Dim>(
+    world: &World<D>,
+    law: Law<D>,
+    x: &[D::Vec],
+    dofs: &Unknowns<D>,
+    ghost: Option<&[D::Vec]>,
+    y: &mut [D::Vec],
+) {
+    stiffness(world, law, x, dofs, y);
+    y.par_chunks_mut(CHUNK)
+        .zip(dofs.free.par_chunks(CHUNK))
+        .zip(x.par_chunks(CHUNK))
+        .enumerate()
+        .for_each(|(c, ((y, k), x))| {
+            for (j, (y, &k)) in y.iter_mut().zip(k).enumerate() {
+                *y = mask::<D>(*y, k);
+                if let Some(g) = ghost {
+                    let g = g[c * CHUNK + j];
+                    for a in 0..D::D {
+                        y[a] += g[a] * x[j][a] * k[a];
+                    }
+                }
+            }
+        });
+    dofs.project(y);
+}
+
+/// The diagonal of K (its free components; 1 elsewhere, so the preconditioner leaves the
+/// fixed ones alone): for node n and axis a, sum over particles of V e_a . (C : sym(e_a ⊗
+/// grad S_n)) . grad S_n. A tied entry adds its own to its partner's: a particle reaches
+/// one entry of a node, so the two share no particle and K has no term between them.
+pub(super) fn diagonal<D: Dim>(world: &World<D>, dofs: &Unknowns<D>) -> Vec<D::Vec> {
+    let free = &dofs.free;
+    let mut d = vec![D::zero(); free.len()];
+    let plane = world.settings.plane;
+    let p = &world.particles;
+    for i in 0..p.len() {
+        let m = &world.materials[p.material[i] as usize];
+        each_entry(world, i, |n, _, grad| {
+            for a in 0..D::D {
+                let mut e = D::zero();
+                e[a] = 1.0;
+                let s = elastic::<D>(m, plane, &D::outer(e, grad));
+                d[n][a] += p.volume[i] * D::stress_dot(&s, grad)[a];
+            }
+        });
+    }
+    dofs.fold(&mut d);
+    for (d, &k) in d.iter_mut().zip(free) {
+        for a in 0..D::D {
+            if k[a] == 0.0 || d[a] <= 0.0 {
+                d[a] = 1.0;
+            }
+        }
+    }
+    d
+}
