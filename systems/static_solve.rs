@@ -4,9 +4,10 @@
 //! the node more than one: Guo & Nairn 2D (2004) Eqs. 3 and 6 with the stress from the
 //! strain), solved without assembling K by conjugate gradients with a Jacobi
 //! preconditioner; then each particle takes the displacement, its gradient and the stress
-//! they give. Particles are the quadrature points with their volumes and the scene's shape
-//! functions, at their initial positions (small strain: neither the stiffness nor the
-//! cracks move), each particle near a crack on its own side's entries.
+//! they give. A scene with J2 plastic materials takes Newton iterations instead (newton.rs).
+//! Particles are the quadrature points with their volumes and the scene's shape functions,
+//! at their initial positions (small strain: neither the stiffness nor the cracks move),
+//! each particle near a crack on its own side's entries.
 
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
@@ -24,10 +25,12 @@ mod operator;
 mod rigid;
 mod supports;
 mod unknowns;
+mod vectors;
 
-use cg::{Frame, conjugate_gradients, dot};
+use cg::{Frame, conjugate_gradients};
 use operator::{Law, elastic, mask, stiffness};
 use unknowns::Unknowns;
+use vectors::dot;
 
 /// Most of the load (as a fraction of its norm) a body free to move may leave unbalanced:
 /// the discrete imbalance of balanced tractions is far below it; a load that would

@@ -5,26 +5,16 @@ use super::ghost_stiffness;
 use super::operator::{Law, apply, diagonal};
 use super::rigid;
 use super::unknowns::Unknowns;
+use super::vectors::dot;
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::record::solve_log::Solved;
-use crate::store::world::{CHUNK, World};
+use crate::store::world::World;
 use rayon::prelude::*;
 
 /// Most iterations per load step, per unknown along the grid's longest axis: conjugate
 /// gradients on a well-supported grid converge in a small multiple of it.
 const ITERATIONS_PER_NODE: usize = 50;
-
-/// The sum of a * b over all components, in fixed chunks (the same bits for any thread
-/// count).
-pub(super) fn dot<D: Dim>(a: &[D::Vec], b: &[D::Vec]) -> f64 {
-    let parts: Vec<f64> = a
-        .par_chunks(CHUNK)
-        .zip(b.par_chunks(CHUNK))
-        .map(|(a, b)| a.iter().zip(b).map(|(&x, &y)| D::dot(x, y)).sum())
-        .collect();
-    parts.iter().sum()
-}
 
 /// What every solve on one set of unknowns shares: K's diagonal (the Jacobi
 /// preconditioner, from the elastic K), the ghost stiffness and the free rigid motions.

@@ -5,9 +5,10 @@
 //! algorithmic tangent (Simo & Taylor 1985), which keeps the iteration quadratic. The
 //! particles' state changes only when the step converges.
 
-use super::cg::{Frame, conjugate_gradients, dot};
+use super::cg::{Frame, conjugate_gradients};
 use super::operator::{Law, mask, stiffness};
 use super::unknowns::Unknowns;
+use super::vectors::dot;
 use super::{Linear, equilibrium, gradient, rigid};
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;

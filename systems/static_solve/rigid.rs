@@ -5,10 +5,10 @@
 //! solution along them. The solve removes that imbalance and keeps its iterates clear of
 //! them (deflation), and reports the part of the load it removed.
 
-use super::cg::dot;
 use super::entry_node;
 use super::operator::{Law, apply};
 use super::unknowns::Unknowns;
+use super::vectors::dot;
 use crate::base::dim::Dim;
 use crate::store::world::{CHUNK, World};
 use rayon::prelude::*;
