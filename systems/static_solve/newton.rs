@@ -75,7 +75,7 @@ pub(super) fn solve<D: Dim>(
     let none = vec![D::zero(); entries];
     let committed = Law::Given(&world.particles.stress);
     stiffness(world, committed, &none, dofs, &mut f_int);
-    let load = (world.grid.force.iter().zip(&f_int))
+    let unbalanced = (world.grid.force.iter().zip(&f_int))
         .map(|(&f, &q)| f - q)
         .collect();
     let tolerance = world.settings.tolerance;
@@ -84,8 +84,9 @@ pub(super) fn solve<D: Dim>(
         law: Law::Tangent(&tangents),
         tolerance: LINEAR_TOLERANCE.0,
     };
-    let (mut du, mut solved) = equilibrium(world, dofs, &frame, first, load, held, None)?;
-    let mut now = residual(world, dofs, &frame, &du);
+    let (mut du, mut solved) = equilibrium(world, dofs, &frame, first, unbalanced, held, None)?;
+    let load = Load::new(world, dofs);
+    let mut now = residual(world, dofs, &frame, &load, &du);
     let mut history = vec![now.relative()];
     for newton in 1..=NEWTON_ITERATIONS {
         if now.relative() <= tolerance {
@@ -107,7 +108,7 @@ pub(super) fn solve<D: Dim>(
             let trial: Vec<D::Vec> = (du.iter().zip(&delta))
                 .map(|(&u, &d)| u + d * length)
                 .collect();
-            let then = residual(world, dofs, &frame, &trial);
+            let then = residual(world, dofs, &frame, &load, &trial);
             if then.norm < now.norm || length < 0.5f64.powi(HALVINGS as i32) {
                 du = trial;
                 break then;
@@ -140,6 +141,22 @@ fn diverged<D: Dim>(world: &World<D>, t_end: f64, history: &[f64]) -> Unstable {
     }
 }
 
+/// The step's external force, folded onto the unknowns, and its squared norm.
+struct Load<D: Dim> {
+    force: Vec<D::Vec>,
+    norm2: f64,
+}
+
+impl<D: Dim> Load<D> {
+    /// The loads now in the grid's force column, on `dofs`.
+    fn new(world: &World<D>, dofs: &Unknowns<D>) -> Self {
+        let mut force = world.grid.force.clone();
+        dofs.fold(&mut force);
+        let norm2 = dot::<D>(&force, &force);
+        Load { force, norm2 }
+    }
+}
+
 /// The out-of-balance force at an increment, with the state it came from.
 struct Residual<D: Dim> {
     /// f_ext - f_int on the free components, rigid motions taken out.
@@ -169,17 +186,14 @@ fn residual<D: Dim>(
     world: &World<D>,
     dofs: &Unknowns<D>,
     frame: &Frame<D>,
+    load: &Load<D>,
     du: &[D::Vec],
 ) -> Residual<D> {
     let returned = return_map(world, du);
     let mut f_int = vec![D::zero(); du.len()];
     stiffness(world, Law::Given(&returned.stress), du, dofs, &mut f_int);
-    let mut f_ext = world.grid.force.clone();
-    dofs.fold(&mut f_ext);
-    let scale = dot::<D>(&f_ext, &f_ext)
-        .max(dot::<D>(&f_int, &f_int))
-        .sqrt();
-    let mut r: Vec<D::Vec> = (f_ext.iter().zip(&f_int).zip(&dofs.free))
+    let scale = load.norm2.max(dot::<D>(&f_int, &f_int)).sqrt();
+    let mut r: Vec<D::Vec> = (load.force.iter().zip(&f_int).zip(&dofs.free))
         .map(|((&f, &q), &k)| mask::<D>(f - q, k))
         .collect();
     dofs.project(&mut r);
