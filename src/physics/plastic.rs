@@ -504,6 +504,16 @@ mod tests {
         }
     }
 
+    /// Steel with `hardening` after the 3D strain `pre` from rest: its material, J2
+    /// parameters and state (stress, plastic strain, hardening).
+    fn yielded(hardening: Hardening, pre: Sym3) -> (Material, J2, (Sym3, Sym3, Hardened)) {
+        let m = steel(hardening);
+        let j2 = m.j2.expect("plastic");
+        let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
+        step(&m, Plane::None, pre, &mut st);
+        (m, j2, st)
+    }
+
     /// The algorithmic tangent is the derivative of the return map: against central
     /// differences of the update from a yielded state (truncation ~h^2, round-off of the
     /// 1e-13 scalar solves over h ~ 1e-7 of the increment: 1e-6 of the stress change is
@@ -520,9 +530,6 @@ mod tests {
                 exponent: 10.0,
             },
         ] {
-            let m = steel(hardening);
-            let j2 = m.j2.expect("plastic");
-            let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
             let pre = Sym3 {
                 xx: 2e-3,
                 yy: -5e-4,
@@ -530,7 +537,7 @@ mod tests {
                 xy: 6e-4,
                 ..Sym3::default()
             };
-            step(&m, Plane::None, pre, &mut st);
+            let (m, j2, st) = yielded(hardening, pre);
             let de = Sym3 {
                 xx: 1e-3,
                 yy: 2e-4,
@@ -596,9 +603,6 @@ mod tests {
                 exponent: 5.0,
             },
         ] {
-            let m = steel(hardening);
-            let j2 = m.j2.expect("plastic");
-            let mut st = (Sym3::default(), Sym3::default(), Hardened::default());
             let pre = Sym3 {
                 xx: 3e-3,
                 yy: -1e-3,
@@ -606,7 +610,7 @@ mod tests {
                 xy: 1e-3,
                 ..Sym3::default()
             };
-            step(&m, Plane::None, pre, &mut st);
+            let (m, j2, st) = yielded(hardening, pre);
             let c = j2.continuum_tangent(&st.0, &st.2).expect("on the surface");
             let mut next = st;
             m.update(Plane::None, pre * 1e-9, &mut next.0);
