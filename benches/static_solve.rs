@@ -1,8 +1,10 @@
 //! The first static load step of a scene (`systems::static_solve`: classification, the
-//! loads, conjugate gradients to the scene's tolerance, the particles set to the answer), in
-//! particle-iterations per second: each conjugate-gradient iteration is one pass over the
-//! particles (K applied without assembling it), so the time per iteration is the load
-//! step's time over its iterations (printed). Scenes: the shipped static cantilever
+//! loads, the linear solve to the scene's tolerance, the particles set to the answer). By
+//! conjugate gradients (`/cg`) in particle-iterations per second: each iteration is one
+//! pass over the particles (K applied without assembling it), so the time per iteration is
+//! the load step's time over its iterations (printed); by the sparse direct solver
+//! (`/direct`: pattern, symbolic analysis, assembly, factorization, solve) in particles
+//! per second. Scenes: the shipped static cantilever
 //! (`scenarios/cantilever_static_2d.toml`, 16,000 particles, no crack), the DCB
 //! (`scenarios/dcb_2d.toml`, 9,600 particles, a crack: its fields are unknowns) and the
 //! ENF (`scenarios/enf_2d.toml`, frictionless faces: an active set of solves) switched to
@@ -18,19 +20,21 @@ use fissure::io::scenario::{Source, build};
 use fissure::systems::{DimSystems, static_solve};
 use std::time::{Duration, Instant};
 
-/// The scenario at `scenarios/{name}.toml`, switched to static in one load step.
-fn source(name: &str) -> Source {
+/// The scenario at `scenarios/{name}.toml`, switched to static in one load step, solved by
+/// the `linear` solver.
+fn source(name: &str, linear: &str) -> Source {
     let path = format!("{}/scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
     let set = [
         "simulation.solver=\"static\"".to_string(),
         "simulation.load_steps=1".to_string(),
+        format!("simulation.linear=\"{linear}\""),
     ];
     Source::load(std::path::Path::new(&path), &set).expect("the scenario loads")
 }
 
 fn bench<D: DimSystems>(c: &mut Criterion, label: &str, src: &Source) {
     let world = build::<D>(src).expect("the scenario builds").world;
-    let solved = static_solve::run(&mut world.clone()).expect("the load step solves");
+    let solved = static_solve::run(&mut world.clone(), &mut None).expect("the load step solves");
     let iterations = solved.iterations.max(1);
     println!(
         "{label}: {} particles, {iterations} iterations in {} solves",
@@ -58,7 +62,7 @@ fn bench<D: DimSystems>(c: &mut Criterion, label: &str, src: &Source) {
                 let mut fresh = world.clone();
                 spent += pool.install(|| {
                     let t0 = Instant::now();
-                    static_solve::run(&mut fresh).expect("the load step solves");
+                    static_solve::run(&mut fresh, &mut None).expect("the load step solves");
                     t0.elapsed()
                 });
             }
@@ -70,9 +74,15 @@ fn bench<D: DimSystems>(c: &mut Criterion, label: &str, src: &Source) {
 
 fn static_solve(c: &mut Criterion) {
     use fissure::base::dim::{D2, D3};
-    bench::<D2>(c, "cantilever", &source("cantilever_static_2d"));
-    bench::<D2>(c, "dcb", &source("dcb_2d"));
-    bench::<D2>(c, "enf", &source("enf_2d"));
+    for linear in ["cg", "direct"] {
+        bench::<D2>(
+            c,
+            &format!("cantilever/{linear}"),
+            &source("cantilever_static_2d", linear),
+        );
+        bench::<D2>(c, &format!("dcb/{linear}"), &source("dcb_2d", linear));
+        bench::<D2>(c, &format!("enf/{linear}"), &source("enf_2d", linear));
+    }
     let set = [
         "simulation.solver=\"static\"".to_string(),
         "simulation.load_steps=1".to_string(),

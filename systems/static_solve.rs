@@ -2,8 +2,9 @@
 //! equilibrium K u = f_ext(t) of the particles' small-strain linear elastic stiffness on
 //! the grid entries (a node's own, and one per crack field where the classification gives
 //! the node more than one: Guo & Nairn 2D (2004) Eqs. 3 and 6 with the stress from the
-//! strain), solved without assembling K by conjugate gradients with a Jacobi
-//! preconditioner; then each particle takes the displacement, its gradient and the stress
+//! strain), solved by a sparse Cholesky factorization of the assembled K (direct.rs) or
+//! matrix-free by conjugate gradients with a Jacobi preconditioner (cg.rs), as
+//! `[simulation] linear` and the scene's dimension choose (frame.rs); then each particle takes the displacement, its gradient and the stress
 //! they give. A scene with J2 plastic materials takes Newton iterations instead (newton.rs).
 //! Particles are the quadrature points with their volumes and the scene's shape functions,
 //! at their initial positions (small strain: neither the stiffness nor the cracks move),
@@ -19,7 +20,9 @@ use crate::systems::{bin, classify, crack_advect, p2g};
 use crate::with_shape;
 
 mod cg;
+mod direct;
 mod faces;
+mod frame;
 mod newton;
 mod operator;
 mod rigid;
@@ -27,7 +30,8 @@ mod supports;
 mod unknowns;
 mod vectors;
 
-use cg::{Frame, conjugate_gradients};
+pub use direct::Analysis;
+use frame::Frame;
 use operator::{Law, elastic, mask, stiffness};
 use unknowns::Unknowns;
 use vectors::dot;
@@ -56,8 +60,8 @@ const LIGHT: f64 = 0.1;
 /// Solves the load step ending at the next step's time and sets the particles to it: x =
 /// x0 + u, v = 0, grad u and the stress it gives; adds the work of the loads and the moving
 /// supports over the step (trapezoidal, exact for a linear response). Refuses a solve that
-/// does not converge.
-pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
+/// does not converge. `kept` carries the direct solver's analysis from step to step.
+pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Option<Analysis>) -> Result<Solved, Unstable> {
     let t_end = end_time(world);
     let before: Vec<D::Vec> = (world.particles.x.iter())
         .zip(&world.particles.x0)
@@ -82,9 +86,10 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
     let held = supports::prescribed(world, t_end);
     let start_forces = supports::start_forces(world, t_start);
     if !world.particles.hardened.is_empty() {
-        return plastic_step(world, held, &start_forces, &before, t_start, t_end);
+        let ends = (t_start, t_end);
+        return plastic_step(world, kept, held, &start_forces, &before, ends);
     }
-    let Solution { u, dofs, solved } = with_contact(world, held.as_deref(), t_end)?;
+    let Solution { u, dofs, solved } = with_contact(world, kept, held.as_deref(), t_end)?;
     reactions(world, &dofs, Law::Elastic, &u);
     let after = gather(world, &u);
     move_cracks(world, &before, &after);
@@ -100,11 +105,11 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<Solved, Unstable> {
 /// over the step, from `held` (their displacement at the step's end).
 fn plastic_step<D: Dim>(
     world: &mut World<D>,
+    kept: &mut Option<Analysis>,
     held: Option<Vec<D::Vec>>,
     start_forces: &[Vec<D::Vec>],
     before: &[D::Vec],
-    t_start: f64,
-    t_end: f64,
+    (t_start, t_end): (f64, f64),
 ) -> Result<Solved, Unstable> {
     let increment = held.map(|mut end| {
         let start = supports::prescribed(world, t_start).unwrap_or_default();
@@ -112,7 +117,7 @@ fn plastic_step<D: Dim>(
         end
     });
     let dofs = Unknowns::new(world, &[], &[]);
-    let step = newton::solve(world, &dofs, increment.as_deref(), t_end)?;
+    let step = newton::solve(world, kept, &dofs, increment.as_deref(), t_end)?;
     reactions(world, &dofs, Law::Given(&step.returned.stress), &step.du);
     let after: Vec<D::Vec> = (before.iter().zip(gather(world, &step.du)))
         .map(|(&b, d)| b + d)
@@ -140,6 +145,7 @@ struct Solution<D: Dim> {
 /// active set of closed face pairs changes no more (one solve without such faces).
 fn with_contact<D: Dim>(
     world: &World<D>,
+    kept: &mut Option<Analysis>,
     held: Option<&[D::Vec]>,
     t_end: f64,
 ) -> Result<Solution<D>, Unstable> {
@@ -150,7 +156,7 @@ fn with_contact<D: Dim>(
     let mut last: Option<Vec<D::Vec>> = None;
     let (u, dofs, mut solved) = loop {
         let dofs = Unknowns::new(world, &pairs, &closed);
-        let frame = Frame::new(world, &dofs);
+        let frame = Frame::new(world, &dofs, kept)?;
         let load = world.grid.force.clone();
         let linear = Linear::elastic(world);
         let (u, solved) = equilibrium(world, &dofs, &frame, linear, load, held, last.as_deref())?;
@@ -264,15 +270,8 @@ fn equilibrium<D: Dim>(
         rigid::deflate::<D>(&mut s, modes);
         s
     });
-    let (mut u, mut solved) = conjugate_gradients(
-        world,
-        linear.law,
-        frame,
-        dofs,
-        &load,
-        start,
-        linear.tolerance,
-    )?;
+    let (mut u, mut solved) =
+        frame.solve(world, linear.law, dofs, &load, start, linear.tolerance)?;
     dofs.expand(&mut u);
     leans_on_ghost(world, &u, &frame.ghost, dofs, &load, t_end)?;
     if let Some(u_c) = held {

@@ -76,8 +76,9 @@ fn column_under_its_own_weight() {
     );
 }
 
-/// The cantilever of scenarios/cantilever_static_2d.toml, and the ENF specimen with its
-/// faces in contact, on one thread and on two: the same bits in every particle's position
+/// The cantilever of scenarios/cantilever_static_2d.toml (solved directly and by conjugate
+/// gradients), the ENF specimen with its faces in contact and the plastic cylinder, on one
+/// thread and on two: the same bits in every particle's position
 /// and stress.
 #[test]
 fn static_solve_is_the_same_on_any_thread_count() {
@@ -92,7 +93,11 @@ fn static_solve_is_the_same_on_any_thread_count() {
     let cylinder = read("cylinder_plastic_2d")
         .replace("cell = [0.0025, 0.0025]", "cell = [0.0075, 0.0075]")
         .replace("[simulation]", "[simulation]\nsolver = \"static\"");
-    for text in [read("cantilever_static_2d"), enf, cylinder] {
+    let cg = read("cantilever_static_2d").replace(
+        "solver = \"static\"",
+        "solver = \"static\"\nlinear = \"cg\"",
+    );
+    for text in [read("cantilever_static_2d"), cg, enf, cylinder] {
         let one = final_world::<D2>(&text, 1);
         let two = final_world::<D2>(&text, 2);
         assert!(one.particles.x != one.particles.x0, "the beam bent");
@@ -168,6 +173,20 @@ fn what_the_static_solver_does_not_take_is_refused() {
         e.contains("simulation.tolerance") && e.contains("static"),
         "{e}"
     );
+    let explicit = column("")
+        .replace("solver = \"static\"\n", "")
+        .replace("load_steps = 2", "linear = \"direct\"");
+    let e = err(explicit);
+    assert!(
+        e.contains("simulation.linear") && e.contains("static"),
+        "{e}"
+    );
+    let unknown = column("").replace("load_steps = 2", "load_steps = 2\nlinear = \"lu\"");
+    let e = match fissure::io::scenario::Source::parse("test.toml", &unknown, &[]) {
+        Ok(_) => String::new(),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("simulation.linear") && e.contains("`lu`"), "{e}");
     for t in ["1e-14", "0.5", "-1e-8"] {
         let e = err(column("").replace(
             "load_steps = 2",
@@ -251,8 +270,9 @@ fn explicit_only_keys_are_ignored_by_name() {
 /// within 1e-3.
 #[test]
 fn the_tolerance_is_the_scenes() {
-    let exact = common::run_text(&column(""));
-    let loose = column("").replace("load_steps = 2", "load_steps = 2\ntolerance = 1e-4");
+    let cg = |text: String| text.replace("load_steps = 2", "load_steps = 2\nlinear = \"cg\"");
+    let exact = common::run_text(&cg(column("")));
+    let loose = cg(column("")).replace("load_steps = 2", "load_steps = 2\ntolerance = 1e-4");
     let loose = common::run_text(&loose);
     let (a, b) = (
         exact.summary.static_solve.unwrap(),
@@ -299,13 +319,56 @@ fn a_body_free_to_move_is_refused_by_the_solve() {
 
 /// A shipped scene switched to static in one load step, as a user would (`--set`).
 fn switched(name: &str) -> fissure::io::scenario::Source {
+    switched_with(name, &[])
+}
+
+/// As [`switched`], with more `--set` overrides.
+fn switched_with(name: &str, more: &[&str]) -> fissure::io::scenario::Source {
     let path = format!("{}/scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(&path).unwrap();
-    let set = [
+    let mut set = vec![
         "simulation.solver=\"static\"".to_string(),
         "simulation.load_steps=1".to_string(),
     ];
+    set.extend(more.iter().map(|s| s.to_string()));
     fissure::io::scenario::Source::parse(&path, &text, &set).unwrap()
+}
+
+/// The same equilibrium by the two linear solvers: the sparse Cholesky factorization and
+/// conjugate gradients (stopped at 1e-8 of the load) give every tip's K to 1e-6 (they agree
+/// to 1e-9), on a free body under balanced tractions (williams_2d: three rigid motions,
+/// pinned by the direct solve and taken out), a body on pins (ct_2d) and faces in contact
+/// (enf_2d: frictionless ties along the crack's normal); the direct solve's residual is
+/// round-off's (below 1e-10 of the load).
+#[test]
+fn direct_and_iterative_solves_agree() {
+    let opts = fissure::app::run::RunOptions::default();
+    for name in ["williams_2d", "ct_2d", "enf_2d"] {
+        let direct = fissure::app::run::run(
+            &switched_with(name, &["simulation.linear=\"direct\""]),
+            &opts,
+        )
+        .unwrap();
+        let cg = fissure::app::run::run(&switched_with(name, &["simulation.linear=\"cg\""]), &opts)
+            .unwrap();
+        let (d, c) = (
+            direct.summary.static_solve.unwrap(),
+            cg.summary.static_solve.unwrap(),
+        );
+        assert!(d.factorizations > 0 && d.iterations == 0, "{d:?}");
+        assert!(c.factorizations == 0 && c.iterations > 0, "{c:?}");
+        assert!(d.worst_residual < 1e-10, "{name}: {d:?}");
+        let k = |o: &fissure::app::run::Outcome| {
+            let t = o.history.fracture.last().unwrap();
+            (t.k[0], t.k[1])
+        };
+        let ((d1, d2), (c1, c2)) = (k(&direct), k(&cg));
+        let scale = d1.hypot(d2);
+        assert!(
+            (d1 - c1).abs() <= 1e-6 * scale && (d2 - c2).abs() <= 1e-6 * scale,
+            "{name}: ({d1}, {d2}) vs ({c1}, {c2})"
+        );
+    }
 }
 
 /// The centre crack in a finite plate (scenarios/centre_crack_2d.toml) solved static in one

@@ -96,6 +96,9 @@ pub struct Schedule {
     grows: bool,
     /// A static scene's solves so far.
     pub solves: SolveLog,
+    /// The direct solver's last symbolic analysis (static scenes), reused while K's
+    /// pattern holds.
+    analysis: Option<static_solve::Analysis>,
 }
 
 impl Schedule {
@@ -120,6 +123,7 @@ impl Schedule {
                 fracture,
                 grows: false,
                 solves: SolveLog::default(),
+                analysis: None,
             };
         }
         let bc = !world.bcs.is_empty();
@@ -183,6 +187,7 @@ impl Schedule {
             fracture,
             grows,
             solves: SolveLog::default(),
+            analysis: None,
         }
     }
 
@@ -304,7 +309,7 @@ impl Schedule {
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),
                 System::StaticSolve => {
-                    let solved = static_solve::run(world)?;
+                    let solved = static_solve::run(world, &mut self.analysis)?;
                     self.solves.add(solved);
                 }
                 System::Fracture | System::Grow => continue,

@@ -19,6 +19,10 @@ pub struct Solved {
     pub contact_rounds: usize,
     /// Newton iterations (plastic scenes; 0 for a linear step, which solves once).
     pub newton: usize,
+    /// Sparse factorizations (the direct solver; 0 under conjugate gradients).
+    pub factorizations: usize,
+    /// Entries of the last factor (the direct solver's fill).
+    pub factor_entries: usize,
 }
 
 /// What a static scene's load steps took: counts, iterations and the worst residual.
@@ -44,6 +48,10 @@ pub struct SolveLog {
     pub newton_iterations: u64,
     /// Most Newton iterations in one load step.
     pub most_newton: u64,
+    /// Sparse factorizations, all load steps (0: conjugate gradients throughout).
+    pub factorizations: u64,
+    /// Most entries of one factor (its memory: 8 bytes each).
+    pub factor_entries: u64,
 }
 
 impl SolveLog {
@@ -59,5 +67,7 @@ impl SolveLog {
         self.most_contact_rounds = self.most_contact_rounds.max(s.contact_rounds);
         self.newton_iterations += s.newton as u64;
         self.most_newton = self.most_newton.max(s.newton as u64);
+        self.factorizations += s.factorizations as u64;
+        self.factor_entries = self.factor_entries.max(s.factor_entries as u64);
     }
 }

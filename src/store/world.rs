@@ -36,6 +36,22 @@ pub enum Solver {
     Static,
 }
 
+/// How a static scene's linear systems are solved (`[simulation] linear`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum LinearSolver {
+    /// The sparse direct factorization in 2D (when its factor fits in memory),
+    /// conjugate gradients in 3D, where a grid's factor fills in far faster (nested
+    /// dissection: n^(4/3) entries and n^2 operations against n log n and n^(3/2) in 2D)
+    /// and conjugate gradients won at every size measured (docs/static-solver.md).
+    #[default]
+    Auto,
+    /// Sparse Cholesky factorization of the assembled K.
+    Direct,
+    /// Matrix-free conjugate gradients with a Jacobi preconditioner.
+    Cg,
+}
+
 /// The default residual, relative to the external force, at which a static load step has
 /// converged (`[simulation] tolerance`): four orders below the discretisation's own error
 /// (1e-4 at best in the shipped scenes), and above the floor the iteration's round-off
@@ -50,6 +66,8 @@ pub struct Settings<D: Dim> {
     /// A static scene's convergence tolerance: the residual relative to the external force
     /// at which a load step has converged.
     pub tolerance: f64,
+    /// A static scene's linear solver.
+    pub linear: LinearSolver,
     /// Shape function.
     pub shape: ShapeKind,
     /// Stress-update order.

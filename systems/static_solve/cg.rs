@@ -1,8 +1,8 @@
 //! Preconditioned conjugate gradients (Hestenes & Stiefel 1952) on a static scene's K,
 //! matrix-free, with sums in fixed chunks so that every thread count gives the same bits.
 
-use super::ghost_stiffness;
-use super::operator::{Law, apply, diagonal};
+use super::frame::Frame;
+use super::operator::{Law, apply};
 use super::rigid;
 use super::unknowns::Unknowns;
 use super::vectors::dot;
@@ -16,30 +16,6 @@ use rayon::prelude::*;
 /// gradients on a well-supported grid converge in a small multiple of it.
 const ITERATIONS_PER_NODE: usize = 50;
 
-/// What every solve on one set of unknowns shares: K's diagonal (the Jacobi
-/// preconditioner, from the elastic K), the ghost stiffness and the free rigid motions.
-pub(super) struct Frame<D: Dim> {
-    /// K's diagonal on the free components (1 elsewhere).
-    pub diag: Vec<D::Vec>,
-    /// The ghost stiffness per component ([`super::ghost_stiffness`]).
-    pub ghost: Vec<D::Vec>,
-    /// An orthonormal basis of the rigid motions K leaves free.
-    pub modes: Vec<Vec<D::Vec>>,
-}
-
-impl<D: Dim> Frame<D> {
-    /// The frame of the unknowns `dofs`.
-    pub fn new(world: &World<D>, dofs: &Unknowns<D>) -> Self {
-        let diag = diagonal(world, dofs);
-        let largest = (diag.iter().zip(&dofs.free))
-            .flat_map(|(d, k)| (0..D::D).filter(|&a| k[a] != 0.0).map(|a| d[a]))
-            .fold(0.0, f64::max);
-        let ghost = ghost_stiffness(world, &diag);
-        let modes = rigid::free_motions(world, dofs, &ghost, largest);
-        Frame { diag, ghost, modes }
-    }
-}
-
 /// Solves K u = f on the free components (K the stiffness of `law`, plus the ghost's) from
 /// `start` or from u = 0 by preconditioned conjugate gradients (Hestenes & Stiefel 1952),
 /// to a residual of `tolerance` times |f|.
@@ -52,7 +28,9 @@ pub(super) fn conjugate_gradients<D: Dim>(
     start: Option<Vec<D::Vec>>,
     tolerance: f64,
 ) -> Result<(Vec<D::Vec>, Solved), Unstable> {
-    let Frame { diag, ghost, modes } = frame;
+    let Frame {
+        diag, ghost, modes, ..
+    } = frame;
     let n = f.len();
     let norm_f = dot::<D>(f, f).sqrt();
     if norm_f == 0.0 {

@@ -5,7 +5,8 @@
 //! algorithmic tangent (Simo & Taylor 1985), which keeps the iteration quadratic. The
 //! particles' state changes only when the step converges.
 
-use super::cg::{Frame, conjugate_gradients};
+use super::Analysis;
+use super::frame::Frame;
 use super::operator::{Law, mask, stiffness};
 use super::unknowns::Unknowns;
 use super::vectors::dot;
@@ -62,11 +63,12 @@ pub(super) struct Step<D: Dim> {
 /// the moving supports' displacement increment `held` over the step.
 pub(super) fn solve<D: Dim>(
     world: &World<D>,
+    kept: &mut Option<Analysis>,
     dofs: &Unknowns<D>,
     held: Option<&[D::Vec]>,
     t_end: f64,
 ) -> Result<Step<D>, Unstable> {
-    let frame = Frame::new(world, dofs);
+    let frame = Frame::new(world, dofs, kept)?;
     let entries = world.grid.mass.len();
     // The first correction: the continuum tangent of the committed state (which a resumed
     // run finds the same) on the load less the committed stresses' force, with the
@@ -100,8 +102,9 @@ pub(super) fn solve<D: Dim>(
         }
         let eta = (0.1 * tolerance / now.relative()).clamp(LINEAR_TOLERANCE.0, LINEAR_TOLERANCE.1);
         let law = Law::Tangent(&now.returned.tangents);
-        let (mut delta, linear) = conjugate_gradients(world, law, &frame, dofs, &now.r, None, eta)?;
+        let (mut delta, linear) = frame.solve(world, law, dofs, &now.r, None, eta)?;
         solved.iterations += linear.iterations;
+        solved.factorizations += linear.factorizations;
         dofs.expand(&mut delta);
         let mut length = 1.0;
         let next = loop {

@@ -28,7 +28,7 @@ pub(super) enum Law<'a, D: Dim> {
 impl<D: Dim> Law<'_, D> {
     /// Particle `i`'s stress from its displacement gradient `l`.
     #[inline(always)]
-    fn stress(&self, m: &Material, plane: Plane, i: usize, l: &D::Mat) -> D::Sym {
+    pub fn stress(&self, m: &Material, plane: Plane, i: usize, l: &D::Mat) -> D::Sym {
         match self {
             Law::Elastic => elastic::<D>(m, plane, l),
             Law::Tangent(t) => match &t[i] {

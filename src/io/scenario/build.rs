@@ -74,6 +74,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         settings: Settings {
             solver: s.solver,
             tolerance: s.tolerance.unwrap_or(STATIC_TOLERANCE),
+            linear: s.linear.unwrap_or_default(),
             shape: s.shape,
             update: s.update,
             plane: sim.plane,

@@ -2,7 +2,7 @@
 
 use crate::physics::shape::ShapeKind;
 use crate::physics::timefn::TimeFn;
-use crate::store::world::{Solver, Update};
+use crate::store::world::{LinearSolver, Solver, Update};
 use serde::Deserialize;
 
 /// A whole scenario file.
@@ -86,6 +86,8 @@ pub struct Simulation {
     /// A static scene's residual, relative to the external force, at which a load step has
     /// converged (default 1e-8).
     pub tolerance: Option<f64>,
+    /// A static scene's linear solver: "auto" (default), "direct" or "cg".
+    pub linear: Option<LinearSolver>,
 }
 
 /// `[grid]`.

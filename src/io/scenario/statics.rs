@@ -36,6 +36,12 @@ pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()
         }
     }
     if sc.simulation.solver != Solver::Static {
+        if sc.simulation.linear.is_some() {
+            return Err(src.error(
+                "simulation.linear",
+                "a linear solver belongs to a static scene (solver = \"static\")",
+            ));
+        }
         return Ok(());
     }
     for (c, crack) in sc.cracks.iter().enumerate() {
