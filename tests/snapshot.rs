@@ -143,6 +143,17 @@ fn restart_is_bit_exact_with_a_growing_crack() {
     restart_is_bit_exact(&text, 330, 2, "growing");
 }
 
+/// A crack growing under fatigue in a static scene (a check every fourth load step)
+/// resumes bit for bit: stopped after 13 of its 28 load steps, between two extensions.
+#[test]
+fn restart_is_bit_exact_with_quasi_static_growth() {
+    let text = common::edge_plate(common::PARIS_GROWTH, 2.8e-5).replace(
+        "[simulation]",
+        "[simulation]\nsolver = \"static\"\nload_steps = 28",
+    ) + "interval = 4.0e-6\n[checkpoint]\nevery_steps = 4\n";
+    restart_is_bit_exact(&text, 13, 2, "static_growing");
+}
+
 /// A 3D front growing under fatigue resumes bit for bit: the front's state, the vertices
 /// and triangles it added and the strip's surfaces travel in the snapshot.
 #[test]

@@ -117,11 +117,15 @@ impl Schedule {
             if fracture.is_some() {
                 systems.push(Fracture);
             }
+            let grows = grows(world);
+            if grows {
+                systems.push(Grow);
+            }
             return Schedule {
                 seconds: vec![0.0; systems.len()],
                 systems,
                 fracture,
-                grows: false,
+                grows,
                 solves: SolveLog::default(),
                 analysis: None,
             };
@@ -173,10 +177,7 @@ impl Schedule {
         if fracture.is_some() {
             s.push(Fracture);
         }
-        let grows = world
-            .cracks
-            .as_ref()
-            .is_some_and(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()));
+        let grows = grows(world);
         if grows {
             s.push(Grow);
         }
@@ -330,4 +331,9 @@ impl Schedule {
         }
         out
     }
+}
+
+/// Whether some crack of the world grows.
+fn grows<D: Dim>(world: &World<D>) -> bool {
+    (world.cracks.as_ref()).is_some_and(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()))
 }

@@ -1,9 +1,9 @@
 //! What a static scene (`solver = "static"`) may hold so far: linear elastic bodies held
 //! by their boundaries (still, or moved by a prescribed velocity's displacement), under
-//! loads and gravity, with open cracks or faces in frictionless contact, elastic or J2
-//! plastic (3D and plane strain; plastic scenes with open faces). Stick and friction, growth,
-//! plane-stress plasticity and contact with plasticity are refused by name until the static
-//! solver takes them.
+//! loads and gravity, with open cracks or faces in frictionless contact, growing or not,
+//! elastic or J2 plastic (3D and plane strain; plastic scenes with open faces). Stick and
+//! friction, plane-stress plasticity and contact with plasticity are refused by name until
+//! the static solver takes them.
 
 use super::check::R;
 use super::source::Source;
@@ -55,13 +55,6 @@ pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()
                     "the static solver takes frictionless crack faces, not `{law}` yet: run \
                      this scene with solver = \"explicit\""
                 ),
-            ));
-        }
-        if crack.growth.is_some() {
-            return Err(src.error(
-                &format!("crack[{c}].growth"),
-                "the static solver does not grow cracks yet: run this scene with solver = \
-                 \"explicit\"",
             ));
         }
     }
