@@ -644,3 +644,44 @@ fn quasi_static_growth_reads_the_k_of_the_cut_plate() {
         );
     }
 }
+
+/// solver.csv: one row per load step (numbered 1 to n), each under the scene's tolerance,
+/// their Newton iterations adding up to summary.json's total; the file holds the rows the
+/// history keeps (and a resumed run rewrites them: `tests/snapshot.rs`).
+#[test]
+fn each_load_step_writes_its_solve_row() {
+    let path = format!(
+        "{}/scenarios/cylinder_plastic_2d.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("cell = [0.0025, 0.0025]", "cell = [0.0075, 0.0075]")
+        .replace("[simulation]", "[simulation]\nsolver = \"static\"");
+    let dir = std::env::temp_dir().join(format!("fissure-solver-csv-{}", std::process::id()));
+    let opts = fissure::app::run::RunOptions {
+        out: Some(dir.clone()),
+        ..Default::default()
+    };
+    let out = fissure::app::run::run(&source(&text), &opts).unwrap_or_else(|e| panic!("{e:#}"));
+    let rows = &out.history.solves;
+    let log = out.summary.static_solve.unwrap();
+    assert_eq!(rows.len() as u64, log.load_steps);
+    for (k, r) in rows.iter().enumerate() {
+        assert_eq!(r.step, k as u64 + 1);
+        assert!(r.solved.residual <= 1e-8 && r.solved.newton >= 1, "{r:?}");
+    }
+    let newton: usize = rows.iter().map(|r| r.solved.newton).sum();
+    assert_eq!(newton as u64, log.newton_iterations);
+    let file = std::fs::read_to_string(dir.join("solver.csv")).unwrap();
+    let lines: Vec<&str> = file.lines().collect();
+    assert!(lines[0].starts_with("step,time,newton,iterations,factorizations,residual"));
+    assert_eq!(lines.len(), rows.len() + 1);
+    for (line, r) in lines[1..].iter().zip(rows) {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(cells[0], r.step.to_string());
+        assert_eq!(cells[2], r.solved.newton.to_string());
+        assert_eq!(cells[4], r.solved.factorizations.to_string());
+    }
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -4,7 +4,7 @@ use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::fracture::plan::{FracturePlan, Measured};
 use crate::pipeline::warm::with_warm_workers;
-use crate::record::solve_log::SolveLog;
+use crate::record::solve_log::Solved;
 use crate::store::world::{Solver, Update, World};
 use crate::systems::{
     DimSystems, bin, classify, contact, crack_advect, g2p, grid_update, grow, p2g, static_solve,
@@ -94,8 +94,8 @@ pub struct Schedule {
     fracture: Option<FracturePlan>,
     /// Whether some crack grows.
     grows: bool,
-    /// A static scene's solves so far.
-    pub solves: SolveLog,
+    /// What the last load step's solves took (static scenes), until taken.
+    solved: Option<Solved>,
     /// The direct solver's last symbolic analysis (static scenes), reused while K's
     /// pattern holds.
     analysis: Option<static_solve::Analysis>,
@@ -126,7 +126,7 @@ impl Schedule {
                 systems,
                 fracture,
                 grows,
-                solves: SolveLog::default(),
+                solved: None,
                 analysis: None,
             };
         }
@@ -187,9 +187,15 @@ impl Schedule {
             seconds,
             fracture,
             grows,
-            solves: SolveLog::default(),
+            solved: None,
             analysis: None,
         }
+    }
+
+    /// What the last load step's solves took (a static scene; None once taken, and in an
+    /// explicit scene).
+    pub fn take_solved(&mut self) -> Option<Solved> {
+        self.solved.take()
     }
 
     /// Whether the schedule measures J and K.
@@ -310,8 +316,7 @@ impl Schedule {
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),
                 System::StaticSolve => {
-                    let solved = static_solve::run(world, &mut self.analysis)?;
-                    self.solves.add(solved);
+                    self.solved = Some(static_solve::run(world, &mut self.analysis)?);
                 }
                 System::Fracture | System::Grow => continue,
             }

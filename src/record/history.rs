@@ -4,6 +4,7 @@
 
 use crate::fracture::plan::{PathResult, TipResult};
 use crate::physics::growth::GrowthRow;
+use crate::record::solve_log::SolveRow;
 use crate::store::world::Energies;
 use std::collections::HashMap;
 
@@ -39,6 +40,8 @@ pub struct History {
     pub paths: Vec<PathResult>,
     /// The growing tips' new segments.
     pub growth: Vec<GrowthRow>,
+    /// A static scene's load steps: what each one's solves took.
+    pub solves: Vec<SolveRow>,
 }
 
 /// How far the energy balance E = K + W + W_p - W_ext + W_damp + W_f strays from its start:

@@ -1,4 +1,5 @@
-//! What a static scene's solves took, for summary.json.
+//! What a static scene's solves took: one row per load step (solver.csv, kept in the
+//! history and the snapshot) and their totals for summary.json.
 
 use serde::Serialize;
 
@@ -54,7 +55,68 @@ pub struct SolveLog {
     pub factor_entries: u64,
 }
 
+/// One load step's solve, as solver.csv and the snapshot keep it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolveRow {
+    /// The load step (its step number).
+    pub step: u64,
+    /// Its end time (s): the load factor's time.
+    pub time: f64,
+    /// What its solves took.
+    pub solved: Solved,
+}
+
+impl SolveRow {
+    /// Numbers per row in a snapshot.
+    pub const VALUES: usize = 10;
+
+    /// The row's numbers for a snapshot (its step apart), in solver.csv's column order.
+    pub fn values(&self) -> [f64; Self::VALUES] {
+        let s = &self.solved;
+        [
+            self.time,
+            s.newton as f64,
+            s.iterations as f64,
+            s.factorizations as f64,
+            s.residual,
+            s.contact_rounds as f64,
+            s.closed_faces as f64,
+            s.free_motions as f64,
+            s.imbalance,
+            s.factor_entries as f64,
+        ]
+    }
+
+    /// The row of step `step` from a snapshot's `values` (counts are whole numbers well
+    /// inside f64's integers).
+    pub fn from_values(step: u64, v: &[f64]) -> Self {
+        let count = |x: f64| x as usize;
+        SolveRow {
+            step,
+            time: v[0],
+            solved: Solved {
+                newton: count(v[1]),
+                iterations: count(v[2]),
+                factorizations: count(v[3]),
+                residual: v[4],
+                contact_rounds: count(v[5]),
+                closed_faces: count(v[6]),
+                free_motions: count(v[7]),
+                imbalance: v[8],
+                factor_entries: count(v[9]),
+            },
+        }
+    }
+}
+
 impl SolveLog {
+    /// The totals of the load steps `rows`.
+    pub fn from_rows(rows: &[SolveRow]) -> Self {
+        let mut log = SolveLog::default();
+        rows.iter().for_each(|r| log.add(r.solved));
+        log
+    }
+
     /// Counts one load step's solve.
     pub fn add(&mut self, s: Solved) {
         self.load_steps += 1;

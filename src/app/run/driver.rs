@@ -4,7 +4,7 @@
 
 use super::checkpoint::Checkpointer;
 use super::reports;
-use super::writers::Writers;
+use super::writers::{Contents, Writers};
 use super::{Outcome, RunOptions, Stop, check_finite, check_snapshot, row_due, step_count};
 use crate::base::error::UsageError;
 use crate::fracture::plan::{FracturePlan, Measured};
@@ -14,6 +14,7 @@ use crate::io::scenario::{MAX_STEPS, OutputPlan, Scene, Source};
 use crate::pipeline::schedule::Schedule;
 use crate::record::expect::Expect;
 use crate::record::probe::Probe;
+use crate::record::solve_log::{SolveLog, SolveRow};
 use crate::record::state::RunState;
 use crate::store::world::World;
 use crate::systems::DimSystems;
@@ -100,10 +101,13 @@ impl<'a, D: DimSystems> Run<'a, D> {
             Some(dir) => Some(Writers::open(
                 dir,
                 &names,
-                crack_names.as_deref(),
-                fracture.as_ref().is_some_and(|f| !f.compare.is_empty()),
-                D::D == 3,
-                growing.as_ref().map(|(n, f)| (n.as_slice(), *f)),
+                Contents {
+                    cracks: crack_names.as_deref(),
+                    paths: fracture.as_ref().is_some_and(|f| !f.compare.is_empty()),
+                    front_vertices: D::D == 3,
+                    growing: growing.as_ref().map(|(n, f)| (n.as_slice(), *f)),
+                    solves: world.settings.solver == crate::store::world::Solver::Static,
+                },
                 &state.history,
             )?),
             None => None,
@@ -199,6 +203,17 @@ impl<'a, D: DimSystems> Run<'a, D> {
             .map_err(Stop::Unstable)?;
         self.state.sample(&self.world, &self.probes);
         self.report(measured).map_err(Stop::Output)?;
+        if let Some(solved) = self.schedule.take_solved() {
+            let row = SolveRow {
+                step: self.world.step,
+                time: self.world.time,
+                solved,
+            };
+            if let Some(w) = &mut self.writers {
+                w.solve(&row).map_err(Stop::Output)?;
+            }
+            self.state.history.solves.push(row);
+        }
         let last = self.world.step == self.steps;
         if row_due(self.world.time, self.state.next_history, last) {
             self.state.next_history += self.output.history_interval;
@@ -343,7 +358,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             particles_on_cracks: self.particles_on_cracks.clone(),
             energies: world.energies(),
             static_solve: (world.settings.solver == crate::store::world::Solver::Static)
-                .then_some(self.schedule.solves),
+                .then(|| SolveLog::from_rows(&history.solves)),
             ignored_keys: crate::io::scenario::ignored(self.src),
             probes: reports::probes(&self.probes, history),
             expects: results,

@@ -7,6 +7,7 @@ use crate::fracture::plan::{PathResult, TipResult};
 use crate::io::output::vtk;
 use crate::physics::growth::GrowthRow;
 use crate::record::history::{History, Row};
+use crate::record::solve_log::SolveRow;
 use crate::record::state::RunState;
 use crate::store::world::World;
 use anyhow::Context;
@@ -39,6 +40,21 @@ impl Write for Named {
     }
 }
 
+/// Which files beyond energy.csv and probes.csv a run writes.
+pub struct Contents<'a> {
+    /// The cracks' names when J and K are measured (fracture.csv).
+    pub cracks: Option<&'a [String]>,
+    /// J on compared contours (paths.csv).
+    pub paths: bool,
+    /// Whether the tips are 3D front vertices rather than 2D crack ends.
+    pub front_vertices: bool,
+    /// The cracks' names when some crack grows (growth.csv), and whether one grows under
+    /// fatigue (cycles.csv).
+    pub growing: Option<(&'a [String], bool)>,
+    /// A static scene's load steps (solver.csv).
+    pub solves: bool,
+}
+
 /// Open output files of a run.
 pub struct Writers {
     /// Output folder.
@@ -50,6 +66,8 @@ pub struct Writers {
     growth: Option<(Named, Vec<String>)>,
     /// cycles.csv, when some crack grows under fatigue.
     cycles: Option<Named>,
+    /// solver.csv, in a static scene.
+    solver: Option<Named>,
     /// Whether a tip is a 3D front vertex (named by its ordinal along the crack's front)
     /// rather than a 2D crack end (named start or end).
     front_vertices: bool,
@@ -59,21 +77,21 @@ pub struct Writers {
 }
 
 impl Writers {
-    /// Creates the output folder and the CSV files, holding the header and every row
-    /// already recorded in `history` (none for a fresh run).
-    /// `cracks` names the cracks when J and K are measured (then fracture.csv is written);
-    /// `paths` asks for paths.csv (J on compared contours); `front_vertices` says the tips
-    /// are 3D front vertices; `growing` names the cracks when some crack grows (then
-    /// growth.csv is written) and says whether one grows under fatigue (then cycles.csv).
+    /// Creates the output folder and the CSV files `contents` asks for, holding the header
+    /// and every row already recorded in `history` (none for a fresh run).
     pub fn open(
         dir: &Path,
         probe_names: &[String],
-        cracks: Option<&[String]>,
-        paths: bool,
-        front_vertices: bool,
-        growing: Option<(&[String], bool)>,
+        contents: Contents,
         history: &History,
     ) -> anyhow::Result<Self> {
+        let Contents {
+            cracks,
+            paths,
+            front_vertices,
+            growing,
+            solves,
+        } = contents;
         std::fs::create_dir_all(dir)
             .with_context(|| format!("cannot create output folder {}", dir.display()))?;
         let create = |name: &str| -> anyhow::Result<_> {
@@ -134,6 +152,18 @@ impl Writers {
             }
             None => None,
         };
+        let solver = match solves {
+            true => {
+                let mut f = create("solver.csv")?;
+                writeln!(
+                    f,
+                    "step,time,newton,iterations,factorizations,residual,contact_rounds,\
+                     closed_faces,free_motions,imbalance,factor_entries"
+                )?;
+                Some(f)
+            }
+            false => None,
+        };
         let mut w = Writers {
             dir: dir.to_path_buf(),
             energy,
@@ -142,6 +172,7 @@ impl Writers {
             paths,
             growth,
             cycles,
+            solver,
             front_vertices,
             earlier: None,
         };
@@ -150,7 +181,37 @@ impl Writers {
         }
         w.fracture(&history.fracture, &history.paths)?;
         w.growth(&history.growth)?;
+        for row in &history.solves {
+            w.solve(row)?;
+        }
         Ok(w)
+    }
+
+    /// Appends a load step's solve to solver.csv: its Newton iterations (0 for a linear
+    /// step), conjugate-gradient iterations, factorizations, final residual over the
+    /// external force, contact rounds and closed face pairs, free rigid motions and the
+    /// load's share along them, and the largest factor's entries.
+    pub fn solve(&mut self, row: &SolveRow) -> anyhow::Result<()> {
+        let Some(f) = &mut self.solver else {
+            return Ok(());
+        };
+        let s = &row.solved;
+        writeln!(
+            f,
+            "{},{:.9e},{},{},{},{:.6e},{},{},{},{:.6e},{}",
+            row.step,
+            row.time,
+            s.newton,
+            s.iterations,
+            s.factorizations,
+            s.residual,
+            s.contact_rounds,
+            s.closed_faces,
+            s.free_motions,
+            s.imbalance,
+            s.factor_entries
+        )?;
+        Ok(())
     }
 
     /// Appends `row` to energy.csv and the probes' samples at its step to probes.csv.
@@ -346,6 +407,9 @@ impl Writers {
             f.flush()?;
         }
         if let Some(f) = &mut self.cycles {
+            f.flush()?;
+        }
+        if let Some(f) = &mut self.solver {
             f.flush()?;
         }
         Ok(())

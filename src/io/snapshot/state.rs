@@ -12,6 +12,7 @@ use crate::io::scenario::{Scene, Source, build};
 use crate::physics::growth::{GrowthRow, TipState};
 use crate::physics::material::Material;
 use crate::record::history::{History, Row};
+use crate::record::solve_log::SolveRow;
 use crate::record::state::RunState;
 use crate::store::crack::Cracks;
 use crate::store::particles::Particles;
@@ -109,6 +110,8 @@ pub fn write<D: Dim>(
     let growth_steps: Vec<u64> = h.growth.iter().map(|g| g.step).collect();
     let growth_ids: Vec<u64> = h.growth.iter().map(|g| tip_id(g.crack, g.tip)).collect();
     let growth_data: Vec<f64> = h.growth.iter().flat_map(|g| g.values()).collect();
+    let solve_steps: Vec<u64> = h.solves.iter().map(|r| r.step).collect();
+    let solve_data: Vec<f64> = h.solves.iter().flat_map(|r| r.values()).collect();
     let probe_names: Vec<String> = (0..h.probes.len())
         .map(|k| format!("history.probe.{k}"))
         .collect();
@@ -160,6 +163,8 @@ pub fn write<D: Dim>(
     c.add("history.growth.step", &growth_steps);
     c.add("history.growth.id", &growth_ids);
     c.add("history.growth.data", &growth_data);
+    c.add("history.solves.step", &solve_steps);
+    c.add("history.solves.data", &solve_data);
     c.add("history.rows.step", &row_steps);
     c.add("history.rows.data", &rows);
     c.add("history.rows.plastic", &rows_plastic);
@@ -366,6 +371,14 @@ fn read_history(r: &mut Reader, step: u64, probes: usize) -> Result<History, Sna
         history.growth = (steps.iter().zip(&ids))
             .zip(data.chunks_exact(GrowthRow::VALUES))
             .map(|((&step, &id), d)| GrowthRow::from_values(step, (id >> 32) as u32, id as u32, d))
+            .collect();
+    }
+    // A snapshot from a build without the solve log has no load-step rows.
+    if r.offset_of("history.solves.step").is_some() {
+        let steps: Vec<u64> = r.column_any("history.solves.step")?;
+        let data: Vec<f64> = r.column("history.solves.data", steps.len() * SolveRow::VALUES)?;
+        history.solves = (steps.iter().zip(data.chunks_exact(SolveRow::VALUES)))
+            .map(|(&step, d)| SolveRow::from_values(step, d))
             .collect();
     }
     Ok(history)
