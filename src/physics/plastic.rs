@@ -238,11 +238,11 @@ impl J2 {
         let q = 1.5f64.sqrt() * norm;
         self.radial_return(trial, plastic, h);
         let theta = h.flow_stress / q;
-        Some(Tangent {
+        Some(Tangent::Radial(RadialTangent {
             theta,
             theta_bar: theta - self.hardening_share(h.flow_stress),
             normal: s * (1.0 / norm),
-        })
+        }))
     }
 
     /// The continuum elastoplastic tangent at a stress on the yield surface of state `h`
@@ -257,11 +257,11 @@ impl J2 {
         if h.equivalent <= 0.0 || !on_surface {
             return None;
         }
-        Some(Tangent {
+        Some(Tangent::Radial(RadialTangent {
             theta: 1.0,
             theta_bar: 1.0 - self.hardening_share(y),
             normal: s * (1.0 / norm),
-        })
+        }))
     }
 
     /// H' / (3 mu + H') at yield stress `y`, H' = d(sigma_y)/d(eps_p) the hardening slope,
@@ -401,7 +401,7 @@ impl J2 {
 /// H' / (3 mu + H'), N the unit trial deviator and H' the hardening slope at the returned
 /// state.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tangent {
+pub struct RadialTangent {
     /// sigma_y / q_trial: how much of the trial deviator the return keeps.
     pub theta: f64,
     /// theta - H' / (3 mu + H'): the stiffness lost along the flow direction.
@@ -410,8 +410,8 @@ pub struct Tangent {
     pub normal: Sym3,
 }
 
-impl Tangent {
-    /// C : `de` for material `m` (its bulk and shear moduli).
+impl RadialTangent {
+    /// C : `de` for a material of Lame moduli `lambda` and `mu`.
     #[inline(always)]
     pub fn apply(&self, lambda: f64, mu: f64, de: &Sym3) -> Sym3 {
         let bulk = lambda + 2.0 / 3.0 * mu;
@@ -419,6 +419,37 @@ impl Tangent {
         de.deviator() * (m2 * self.theta)
             + Sym3::identity() * (bulk * de.trace())
             + self.normal * (-m2 * self.theta_bar * self.normal.ddot(de))
+    }
+}
+
+/// A yielded particle's algorithmic tangent, for a Newton solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tangent {
+    /// The radial return's, in closed form (3D and plane strain).
+    Radial(RadialTangent),
+    /// The plane-stress return's: d(sigma_xx, sigma_yy, sigma_xy) / d(eps_xx, eps_yy,
+    /// eps_xy) (tensor shear), by central differences of the return (Miehe 1996).
+    InPlane([[f64; 3]; 3]),
+}
+
+impl Tangent {
+    /// C : `de` for a material of Lame moduli `lambda` and `mu` (in plane stress, of the
+    /// in-plane components; sigma_zz stays 0).
+    #[inline(always)]
+    pub fn apply(&self, lambda: f64, mu: f64, de: &Sym3) -> Sym3 {
+        match self {
+            Tangent::Radial(r) => r.apply(lambda, mu, de),
+            Tangent::InPlane(c) => {
+                let d = [de.xx, de.yy, de.xy];
+                let row = |r: &[f64; 3]| r[0] * d[0] + r[1] * d[1] + r[2] * d[2];
+                Sym3 {
+                    xx: row(&c[0]),
+                    yy: row(&c[1]),
+                    xy: row(&c[2]),
+                    ..Sym3::default()
+                }
+            }
+        }
     }
 }
 
@@ -616,6 +647,9 @@ mod tests {
             m.update(Plane::None, pre * 1e-9, &mut next.0);
             let a = (j2.radial_return_tangent(&mut next.0, &mut next.1, &mut next.2))
                 .expect("still yielding");
+            let (Tangent::Radial(c), Tangent::Radial(a)) = (c, a) else {
+                panic!("a radial return's tangents");
+            };
             for (x, y) in [(c.theta, a.theta), (c.theta_bar, a.theta_bar)] {
                 assert!((x - y).abs() <= 1e-6 * x.abs(), "{hardening:?}: {x} vs {y}");
             }

@@ -14,6 +14,7 @@ use super::{Linear, equilibrium, gradient, rigid};
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::base::sym::SymTensor;
+use crate::physics::material::Plane;
 use crate::physics::plastic::{Hardened, Tangent};
 use crate::record::solve_log::Solved;
 use crate::store::world::World;
@@ -213,11 +214,14 @@ fn residual<D: Dim>(
 /// Each particle's continuum tangent at its committed state (None: elastic).
 fn continuum<D: Dim>(world: &World<D>) -> Vec<Option<Tangent>> {
     let p = &world.particles;
+    // In plane stress the first correction is elastic: the line search and the iterations'
+    // tangents (of the projected return) take it from there.
+    let plane_stress = world.settings.plane == Plane::Stress;
     (0..p.len())
         .into_par_iter()
         .map(|i| {
             let m = &world.materials[p.material[i] as usize];
-            (m.j2.as_ref())
+            (m.j2.as_ref().filter(|_| !plane_stress))
                 .and_then(|j2| j2.continuum_tangent(&p.stress[i].to_sym3(), &p.hardened[i]))
         })
         .collect()
@@ -234,11 +238,15 @@ fn return_map<D: Dim>(world: &World<D>, du: &[D::Vec]) -> Returned<D> {
             let m = &world.materials[p.material[i] as usize];
             let l = gradient(world, i, du);
             let mut s = p.stress[i].to_sym3();
-            m.update(plane, D::sym_part(&l), &mut s);
             let mut plastic = p.plastic_strain[i].to_sym3();
             let mut h = p.hardened[i];
-            let tangent = (m.j2.as_ref())
-                .and_then(|j2| j2.radial_return_tangent(&mut s, &mut plastic, &mut h));
+            let de = D::sym_part(&l);
+            let tangent = if m.j2.is_some() {
+                m.update_plastic_tangent(plane, de, &mut s, &mut plastic, &mut h)
+            } else {
+                m.update(plane, de, &mut s);
+                None
+            };
             (D::Sym::from_sym3(s), D::Sym::from_sym3(plastic), h, tangent)
         })
         .collect();

@@ -58,24 +58,16 @@ pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()
             ));
         }
     }
-    if let Some(k) = (0..materials.len()).find(|&k| used[k] && materials[k].j2.is_some()) {
-        if sc.simulation.plane.as_deref() == Some("stress") {
-            return Err(src.error(
-                &format!("material[{k}]"),
-                "the static solver takes J2 plasticity in 3D and plane strain, not in plane \
-                 stress yet: run this scene with solver = \"explicit\"",
-            ));
-        }
-        if let Some(c) =
-            (sc.cracks.iter()).position(|c| c.contact.as_ref().is_some_and(|k| k.law != "none"))
-        {
-            return Err(src.error(
-                &format!("crack[{c}].contact"),
-                "the static solver takes crack-face contact in elastic scenes only, not with \
-                 a J2 plastic material yet: drop the contact (open faces) or run this scene \
-                 with solver = \"explicit\"",
-            ));
-        }
+    let plastic = (0..materials.len()).any(|k| used[k] && materials[k].j2.is_some());
+    let contact =
+        (sc.cracks.iter()).position(|c| c.contact.as_ref().is_some_and(|k| k.law != "none"));
+    if let (true, Some(c)) = (plastic, contact) {
+        return Err(src.error(
+            &format!("crack[{c}].contact"),
+            "the static solver takes crack-face contact in elastic scenes only, not with a J2 \
+             plastic material yet: drop the contact (open faces) or run this scene with \
+             solver = \"explicit\"",
+        ));
     }
     Ok(())
 }
