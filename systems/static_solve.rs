@@ -4,8 +4,9 @@
 //! the node more than one: Guo & Nairn 2D (2004) Eqs. 3 and 6 with the stress from the
 //! strain), solved by a sparse Cholesky factorization of the assembled K (direct.rs) or
 //! matrix-free by conjugate gradients with a Jacobi preconditioner (cg.rs), as
-//! `[simulation] linear` and the scene's dimension choose (frame.rs); then each particle takes the displacement, its gradient and the stress
-//! they give. A scene with J2 plastic materials takes Newton iterations instead (newton.rs).
+//! `[simulation] linear` and the scene's dimension choose (solver.rs); then each particle
+//! takes the displacement, its gradient and the stress they give. A scene with J2 plastic
+//! materials takes Newton iterations instead (newton.rs).
 //! Particles are the quadrature points with their volumes and the scene's shape functions,
 //! at their initial positions (small strain: neither the stiffness nor the cracks move),
 //! each particle near a crack on its own side's entries.
@@ -26,13 +27,14 @@ mod frame;
 mod newton;
 mod operator;
 mod rigid;
+mod solver;
 mod supports;
 mod unknowns;
 mod vectors;
 
 pub use direct::Analysis;
-use frame::Frame;
 use operator::{Law, elastic, mask, stiffness};
+use solver::Solver;
 use unknowns::Unknowns;
 use vectors::dot;
 
@@ -156,10 +158,10 @@ fn with_contact<D: Dim>(
     let mut last: Option<Vec<D::Vec>> = None;
     let (u, dofs, mut solved) = loop {
         let dofs = Unknowns::new(world, &pairs, &closed);
-        let frame = Frame::new(world, &dofs, kept)?;
+        let solver = Solver::new(world, &dofs, kept)?;
         let load = world.grid.force.clone();
         let linear = Linear::elastic(world);
-        let (u, solved) = equilibrium(world, &dofs, &frame, linear, load, held, last.as_deref())?;
+        let (u, solved) = equilibrium(world, &dofs, &solver, linear, load, held, last.as_deref())?;
         iterations += solved.iterations;
         rounds += 1;
         if pairs.is_empty() {
@@ -215,7 +217,7 @@ fn end_time<D: Dim>(world: &World<D>) -> f64 {
 /// that overlap and opens those that pull, and a few rounds settle a face.
 const CONTACT_ROUNDS: usize = 50;
 
-/// Equilibrium with the unknowns `dofs` (and their `frame`) under `linear`'s K: K u_f =
+/// Equilibrium with the unknowns `dofs` (and their `solver`) under `linear`'s K: K u_f =
 /// load - K u_c on the free components (`load` per grid entry, u_c the moving supports'
 /// displacement `held`), the rigid motions K leaves free taken out, from `guess` (every
 /// entry's displacement) or from zero; returns every entry's displacement u_f + u_c (tied
@@ -223,7 +225,7 @@ const CONTACT_ROUNDS: usize = 50;
 fn equilibrium<D: Dim>(
     world: &World<D>,
     dofs: &Unknowns<D>,
-    frame: &Frame<D>,
+    solver: &Solver<D>,
     linear: Linear<D>,
     mut load: Vec<D::Vec>,
     held: Option<&[D::Vec]>,
@@ -241,7 +243,7 @@ fn equilibrium<D: Dim>(
         *f = mask::<D>(*f, k);
     }
     dofs.project(&mut load);
-    let modes = &frame.modes;
+    let modes = &solver.frame.modes;
     let norm = dot::<D>(&load, &load).sqrt();
     rigid::deflate::<D>(&mut load, modes);
     let imbalance = if norm > 0.0 {
@@ -271,9 +273,9 @@ fn equilibrium<D: Dim>(
         s
     });
     let (mut u, mut solved) =
-        frame.solve(world, linear.law, dofs, &load, start, linear.tolerance)?;
+        solver.solve(world, linear.law, dofs, &load, start, linear.tolerance)?;
     dofs.expand(&mut u);
-    leans_on_ghost(world, &u, &frame.ghost, dofs, &load, t_end)?;
+    leans_on_ghost(world, &u, &solver.frame.ghost, dofs, &load, t_end)?;
     if let Some(u_c) = held {
         u.iter_mut().zip(u_c).for_each(|(u, &c)| *u += c);
     }

@@ -2,7 +2,8 @@
 //! particle (V B^T C B, the same stiffness the matrix-free product applies), factorized by
 //! faer's sparse Cholesky after an approximate minimum degree ordering (Amestoy, Davis &
 //! Duff 1996). The pattern and its symbolic analysis are made once per set of unknowns and
-//! serve every factorization on it (each Newton iteration, each load case on the frame).
+//! serve every factorization on it: each Newton iteration, and the next load steps while
+//! the pattern holds.
 
 use super::frame::Frame;
 use super::operator::{Law, apply};
@@ -53,9 +54,9 @@ pub struct Analysis {
 
 impl<D: Dim> Direct<D> {
     /// The pattern and symbolic analysis for the unknowns `dofs`, with one component
-    /// pinned per free rigid motion in `modes`. Refuses (with an estimate) a factor that
-    /// would take more than half the memory available.
-    /// `kept` holds the last analysis made, and takes this one's.
+    /// pinned per free rigid motion in `modes`: `kept`'s (the last analysis made) when the
+    /// pattern is its, else a new one, which `kept` then holds. Refuses (with an estimate)
+    /// a factor that would take more than half the memory available.
     pub fn new(
         world: &World<D>,
         dofs: &Unknowns<D>,

@@ -8,6 +8,7 @@
 use super::Analysis;
 use super::frame::Frame;
 use super::operator::{Law, mask, stiffness};
+use super::solver::Solver;
 use super::unknowns::Unknowns;
 use super::vectors::dot;
 use super::{Linear, equilibrium, gradient, rigid};
@@ -69,7 +70,8 @@ pub(super) fn solve<D: Dim>(
     held: Option<&[D::Vec]>,
     t_end: f64,
 ) -> Result<Step<D>, Unstable> {
-    let frame = Frame::new(world, dofs, kept)?;
+    let solver = Solver::new(world, dofs, kept)?;
+    let frame = &solver.frame;
     let entries = world.grid.mass.len();
     // The first correction: the continuum tangent of the committed state (which a resumed
     // run finds the same) on the load less the committed stresses' force, with the
@@ -87,9 +89,9 @@ pub(super) fn solve<D: Dim>(
         law: Law::Tangent(&tangents),
         tolerance: LINEAR_TOLERANCE.0,
     };
-    let (mut du, mut solved) = equilibrium(world, dofs, &frame, first, unbalanced, held, None)?;
+    let (mut du, mut solved) = equilibrium(world, dofs, &solver, first, unbalanced, held, None)?;
     let load = Load::new(world, dofs);
-    let mut now = residual(world, dofs, &frame, &load, &du);
+    let mut now = residual(world, dofs, frame, &load, &du);
     let mut history = vec![now.relative()];
     for newton in 1..=NEWTON_ITERATIONS {
         if now.relative() <= tolerance {
@@ -103,7 +105,7 @@ pub(super) fn solve<D: Dim>(
         }
         let eta = (0.1 * tolerance / now.relative()).clamp(LINEAR_TOLERANCE.0, LINEAR_TOLERANCE.1);
         let law = Law::Tangent(&now.returned.tangents);
-        let (mut delta, linear) = frame.solve(world, law, dofs, &now.r, None, eta)?;
+        let (mut delta, linear) = solver.solve(world, law, dofs, &now.r, None, eta)?;
         solved.iterations += linear.iterations;
         solved.factorizations += linear.factorizations;
         dofs.expand(&mut delta);
@@ -112,7 +114,7 @@ pub(super) fn solve<D: Dim>(
             let trial: Vec<D::Vec> = (du.iter().zip(&delta))
                 .map(|(&u, &d)| u + d * length)
                 .collect();
-            let then = residual(world, dofs, &frame, &load, &trial);
+            let then = residual(world, dofs, frame, &load, &trial);
             if then.norm < now.norm || length < 0.5f64.powi(HALVINGS as i32) {
                 du = trial;
                 break then;

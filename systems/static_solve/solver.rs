@@ -1,0 +1,78 @@
+//! The linear solver of one set of unknowns: the sparse direct factorization or conjugate
+//! gradients, as `[simulation] linear` and the scene's dimension choose, on the unknowns'
+//! [`Frame`] (with the direct solver's pattern and symbolic analysis, made once here).
+
+use super::cg::conjugate_gradients;
+use super::direct::{Analysis, Direct};
+use super::frame::Frame;
+use super::operator::Law;
+use super::unknowns::Unknowns;
+use crate::base::dim::Dim;
+use crate::base::error::Unstable;
+use crate::record::solve_log::Solved;
+use crate::store::world::{LinearSolver, World};
+
+/// The solves on one set of unknowns.
+pub(super) struct Solver<D: Dim> {
+    /// What they share.
+    pub frame: Frame<D>,
+    /// The sparse direct solver, when the scene's dimension and `linear` call for it.
+    direct: Option<Direct<D>>,
+}
+
+impl<D: Dim> Solver<D> {
+    /// The solver of the unknowns `dofs` (`kept`: the direct solver's last analysis, which
+    /// takes this one's). Refuses a direct solve (`linear = "direct"`) whose factor would
+    /// not fit in memory; under "auto" such a scene goes to conjugate gradients.
+    pub fn new(
+        world: &World<D>,
+        dofs: &Unknowns<D>,
+        kept: &mut Option<Analysis>,
+    ) -> Result<Self, Unstable> {
+        let frame = Frame::new(world, dofs);
+        let direct = match world.settings.linear {
+            LinearSolver::Cg => None,
+            LinearSolver::Auto if D::D == 3 => None,
+            LinearSolver::Auto => Direct::new(world, dofs, &frame.modes, kept).ok(),
+            LinearSolver::Direct => {
+                let direct = Direct::new(world, dofs, &frame.modes, kept);
+                Some(direct.map_err(|what| Unstable {
+                    step: world.step + 1,
+                    time: (world.step + 1) as f64 * world.settings.dt,
+                    what,
+                })?)
+            }
+        };
+        Ok(Solver { frame, direct })
+    }
+
+    /// Solves K u = f on the free components (K the stiffness of `law`, plus the ghost's,
+    /// clear of the free rigid motions) to a residual of `tolerance` times |f|: by the
+    /// direct solver when there is one, else by conjugate gradients from `start` (or
+    /// zero).
+    pub fn solve(
+        &self,
+        world: &World<D>,
+        law: Law<D>,
+        dofs: &Unknowns<D>,
+        f: &[D::Vec],
+        start: Option<Vec<D::Vec>>,
+        tolerance: f64,
+    ) -> Result<(Vec<D::Vec>, Solved), Unstable> {
+        let frame = &self.frame;
+        let Some(direct) = &self.direct else {
+            return conjugate_gradients(world, law, frame, dofs, f, start, tolerance);
+        };
+        let (u, mut solved) = direct.solve(world, law, frame, dofs, f, tolerance)?;
+        if solved.residual <= tolerance {
+            return Ok((u, solved));
+        }
+        // A K nearly singular (entries only the ghost stiffness holds) leaves round-off in
+        // the factor that refinement does not remove: conjugate gradients finish from the
+        // direct answer, or say why they cannot.
+        let (u, cg) = conjugate_gradients(world, law, frame, dofs, f, Some(u), tolerance)?;
+        solved.iterations += cg.iterations;
+        solved.residual = cg.residual;
+        Ok((u, solved))
+    }
+}
