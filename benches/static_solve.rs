@@ -37,8 +37,10 @@ fn bench<D: DimSystems>(c: &mut Criterion, label: &str, src: &Source) {
     let solved = static_solve::run(&mut world.clone(), &mut None).expect("the load step solves");
     let iterations = solved.iterations.max(1);
     println!(
-        "{label}: {} particles, {iterations} iterations in {} solves",
+        "{label}: {} particles, {} iterations and {} factorizations in {} solves",
         world.particles.len(),
+        solved.iterations,
+        solved.factorizations,
         solved.contact_rounds
     );
     let mut g = c.benchmark_group("static_solve");
