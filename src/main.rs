@@ -311,6 +311,12 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
     if let Some(note) = ignored_note(&s.ignored_keys) {
         println!("  note: {note}");
     }
+    if let Some(n) = s.static_solve.map(|l| l.too_large).filter(|&n| n > 0) {
+        println!(
+            "  note: {n} load steps went to conjugate gradients: the direct solve's factor \
+             would have taken more than half the memory available"
+        );
+    }
     if let Some(note) = k_withheld_note(s) {
         println!("  note: {note}");
     }

@@ -153,7 +153,7 @@ fn with_contact<D: Dim>(
 ) -> Result<Solution<D>, Unstable> {
     let pairs = faces::pairs(world);
     let mut closed = vec![false; pairs.len()];
-    let mut iterations = 0;
+    let (mut iterations, mut factorizations) = (0, 0);
     let mut rounds = 0;
     let mut last: Option<Vec<D::Vec>> = None;
     let (u, dofs, mut solved) = loop {
@@ -163,6 +163,7 @@ fn with_contact<D: Dim>(
         let linear = Linear::elastic(world);
         let (u, solved) = equilibrium(world, &dofs, &solver, linear, load, held, last.as_deref())?;
         iterations += solved.iterations;
+        factorizations += solved.factorizations;
         rounds += 1;
         if pairs.is_empty() {
             break (u, dofs, solved);
@@ -185,6 +186,7 @@ fn with_contact<D: Dim>(
         }
     };
     solved.iterations = iterations;
+    solved.factorizations = factorizations;
     solved.contact_rounds = rounds;
     solved.closed_faces = closed.iter().filter(|&&c| c).count();
     Ok(Solution { u, dofs, solved })

@@ -24,6 +24,9 @@ pub struct Solved {
     pub factorizations: usize,
     /// Entries of the last factor (the direct solver's fill).
     pub factor_entries: usize,
+    /// Whether "auto" chose the direct solve and went to conjugate gradients instead, its
+    /// factor being too large for the memory available.
+    pub too_large: bool,
 }
 
 /// What a static scene's load steps took: counts, iterations and the worst residual.
@@ -53,6 +56,9 @@ pub struct SolveLog {
     pub factorizations: u64,
     /// Most entries of one factor (its memory: 8 bytes each).
     pub factor_entries: u64,
+    /// Load steps whose direct solve (under "auto") was too large for the memory available
+    /// and went to conjugate gradients.
+    pub too_large: u64,
 }
 
 /// One load step's solve, as solver.csv and the snapshot keep it.
@@ -68,7 +74,7 @@ pub struct SolveRow {
 
 impl SolveRow {
     /// Numbers per row in a snapshot.
-    pub const VALUES: usize = 10;
+    pub const VALUES: usize = 11;
 
     /// The row's numbers for a snapshot (its step apart), in solver.csv's column order.
     pub fn values(&self) -> [f64; Self::VALUES] {
@@ -84,6 +90,7 @@ impl SolveRow {
             s.free_motions as f64,
             s.imbalance,
             s.factor_entries as f64,
+            s.too_large as u8 as f64,
         ]
     }
 
@@ -104,6 +111,7 @@ impl SolveRow {
                 free_motions: count(v[7]),
                 imbalance: v[8],
                 factor_entries: count(v[9]),
+                too_large: v[10] != 0.0,
             },
         }
     }
@@ -131,5 +139,6 @@ impl SolveLog {
         self.most_newton = self.most_newton.max(s.newton as u64);
         self.factorizations += s.factorizations as u64;
         self.factor_entries = self.factor_entries.max(s.factor_entries as u64);
+        self.too_large += s.too_large as u64;
     }
 }

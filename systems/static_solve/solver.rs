@@ -18,6 +18,8 @@ pub(super) struct Solver<D: Dim> {
     pub frame: Frame<D>,
     /// The sparse direct solver, when the scene's dimension and `linear` call for it.
     direct: Option<Direct<D>>,
+    /// Whether "auto" chose the direct solver and its factor was too large.
+    too_large: bool,
 }
 
 impl<D: Dim> Solver<D> {
@@ -30,20 +32,28 @@ impl<D: Dim> Solver<D> {
         kept: &mut Option<Analysis>,
     ) -> Result<Self, Unstable> {
         let frame = Frame::new(world, dofs);
-        let direct = match world.settings.linear {
-            LinearSolver::Cg => None,
-            LinearSolver::Auto if D::D == 3 => None,
-            LinearSolver::Auto => Direct::new(world, dofs, &frame.modes, kept).ok(),
+        let (direct, too_large) = match world.settings.linear {
+            LinearSolver::Cg => (None, false),
+            LinearSolver::Auto if D::D == 3 => (None, false),
+            LinearSolver::Auto => match Direct::new(world, dofs, &frame.modes, kept) {
+                Ok(d) => (Some(d), false),
+                Err(_) => (None, true),
+            },
             LinearSolver::Direct => {
                 let direct = Direct::new(world, dofs, &frame.modes, kept);
-                Some(direct.map_err(|what| Unstable {
+                let direct = direct.map_err(|what| Unstable {
                     step: world.step + 1,
                     time: (world.step + 1) as f64 * world.settings.dt,
                     what,
-                })?)
+                })?;
+                (Some(direct), false)
             }
         };
-        Ok(Solver { frame, direct })
+        Ok(Solver {
+            frame,
+            direct,
+            too_large,
+        })
     }
 
     /// Solves K u = f on the free components (K the stiffness of `law`, plus the ghost's,
@@ -61,7 +71,10 @@ impl<D: Dim> Solver<D> {
     ) -> Result<(Vec<D::Vec>, Solved), Unstable> {
         let frame = &self.frame;
         let Some(direct) = &self.direct else {
-            return conjugate_gradients(world, law, frame, dofs, f, start, tolerance);
+            let (u, mut solved) =
+                conjugate_gradients(world, law, frame, dofs, f, start, tolerance)?;
+            solved.too_large = self.too_large;
+            return Ok((u, solved));
         };
         let (u, mut solved) = direct.solve(world, law, frame, dofs, f, tolerance)?;
         if solved.residual <= tolerance {

@@ -158,7 +158,7 @@ impl Writers {
                 writeln!(
                     f,
                     "step,time,newton,iterations,factorizations,residual,contact_rounds,\
-                     closed_faces,free_motions,imbalance,factor_entries"
+                     closed_faces,free_motions,imbalance,factor_entries,too_large"
                 )?;
                 Some(f)
             }
@@ -190,7 +190,8 @@ impl Writers {
     /// Appends a load step's solve to solver.csv: its Newton iterations (0 for a linear
     /// step), conjugate-gradient iterations, factorizations, final residual over the
     /// external force, contact rounds and closed face pairs, free rigid motions and the
-    /// load's share along them, and the largest factor's entries.
+    /// load's share along them, the largest factor's entries, and 1 where the direct
+    /// solve was too large for memory.
     pub fn solve(&mut self, row: &SolveRow) -> anyhow::Result<()> {
         let Some(f) = &mut self.solver else {
             return Ok(());
@@ -198,7 +199,7 @@ impl Writers {
         let s = &row.solved;
         writeln!(
             f,
-            "{},{:.9e},{},{},{},{:.6e},{},{},{},{:.6e},{}",
+            "{},{:.9e},{},{},{},{:.6e},{},{},{},{:.6e},{},{}",
             row.step,
             row.time,
             s.newton,
@@ -209,7 +210,8 @@ impl Writers {
             s.closed_faces,
             s.free_motions,
             s.imbalance,
-            s.factor_entries
+            s.factor_entries,
+            s.too_large as u8
         )?;
         Ok(())
     }
