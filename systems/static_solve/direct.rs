@@ -400,17 +400,18 @@ fn pins<D: Dim>(dirs: &[Vec<D::Vec>], modes: &[Vec<D::Vec>]) -> Vec<usize> {
     if k == 0 {
         return Vec::new();
     }
-    let mut rows: Vec<Vec<f64>> = Vec::new();
+    // The modes' components, one row of k per unknown.
+    let mut rows: Vec<f64> = Vec::new();
     for (e, d) in dirs.iter().enumerate() {
         for &v in d {
-            rows.push(modes.iter().map(|m| D::dot(v, m[e])).collect());
+            rows.extend(modes.iter().map(|m| D::dot(v, m[e])));
         }
     }
     let mut pinned = Vec::with_capacity(k);
     let mut cols: Vec<usize> = (0..k).collect();
     for _ in 0..k {
         let (mut best, mut at) = (0.0, (0, 0));
-        for (r, row) in rows.iter().enumerate() {
+        for (r, row) in rows.chunks_exact(k).enumerate() {
             for (ci, &c) in cols.iter().enumerate() {
                 if row[c].abs() > best && !pinned.contains(&r) {
                     best = row[c].abs();
@@ -423,8 +424,8 @@ fn pins<D: Dim>(dirs: &[Vec<D::Vec>], modes: &[Vec<D::Vec>]) -> Vec<usize> {
         }
         let (r, ci) = at;
         let c = cols.swap_remove(ci);
-        let pivot = rows[r].clone();
-        for row in rows.iter_mut() {
+        let pivot = rows[r * k..(r + 1) * k].to_vec();
+        for row in rows.chunks_exact_mut(k) {
             let factor = row[c] / pivot[c];
             for &o in &cols {
                 row[o] -= factor * pivot[o];

@@ -2,7 +2,8 @@
 //! entries' displacement increment. Each iterate gives every particle its stress from the
 //! state the last load step committed, by the return map (backward Euler: the same update
 //! the explicit solver makes, in one increment), and each linear solve uses the return's
-//! algorithmic tangent (Simo & Taylor 1985), which keeps the iteration quadratic. The
+//! algorithmic tangent (Simo & Taylor 1985; in plane stress by central differences of the
+//! projected return, Miehe 1996), which keeps the iteration quadratic. The
 //! particles' state changes only when the step converges.
 
 use super::Analysis;
