@@ -155,22 +155,16 @@ fn what_the_static_solver_does_not_take_is_refused() {
     let explicit = column("").replace("solver = \"static\"\n", "");
     let e = err(explicit);
     assert!(e.contains("simulation.load_steps"), "{e}");
-    let explicit = column("")
-        .replace("solver = \"static\"\n", "")
-        .replace("load_steps = 2", "tolerance = 1e-6");
-    let e = err(explicit);
-    assert!(
-        e.contains("simulation.tolerance") && e.contains("static"),
-        "{e}"
-    );
-    let explicit = column("")
-        .replace("solver = \"static\"\n", "")
-        .replace("load_steps = 2", "linear = \"direct\"");
-    let e = err(explicit);
-    assert!(
-        e.contains("simulation.linear") && e.contains("static"),
-        "{e}"
-    );
+    for (line, key) in [
+        ("tolerance = 1e-6", "simulation.tolerance"),
+        ("linear = \"direct\"", "simulation.linear"),
+    ] {
+        let explicit = column("")
+            .replace("solver = \"static\"\n", "")
+            .replace("load_steps = 2", line);
+        let e = err(explicit);
+        assert!(e.contains(key) && e.contains("static"), "{e}");
+    }
     let unknown = column("").replace("load_steps = 2", "load_steps = 2\nlinear = \"lu\"");
     let e = match fissure::io::scenario::Source::parse("test.toml", &unknown, &[]) {
         Ok(_) => String::new(),
