@@ -145,6 +145,9 @@ pub(crate) fn tip(
     };
     let j = [main.line[0] + main.area[0], main.line[1] + main.area[1]];
     res.j = j;
+    // The tip's direction: G = J . dir (Eq. 10).
+    let xp = cracks.geometry.x[kp];
+    let dir = (xt - xp) / (xt - xp).length();
     // Path independence: J on the main and compared contours, line and area parts apart.
     let paths = if plan.compare.is_empty() {
         Vec::new()
@@ -167,14 +170,13 @@ pub(crate) fn tip(
                     contour: n as u32,
                     line,
                     area,
+                    direction: dir.to_array(),
                 })
             })
             .collect()
     };
 
     // G along the tip direction (Eq. 10), split by the opening behind the tip (Eqs. 14-22).
-    let xp = cracks.geometry.x[kp];
-    let dir = (xt - xp) / (xt - xp).length();
     let gr = DVec2::from(j).dot(dir);
     let h = geom.h[0].max(geom.h[1]);
     // With a tip at each end, the fit stays in this tip's half of the crack.

@@ -109,6 +109,7 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                             contour: (t.radius / h).round() as u32,
                             line: [p.j - p.j_volume, f64::NAN],
                             area: [p.j_volume, f64::NAN],
+                            direction: [1.0, 0.0],
                         }
                     })
                     .collect();

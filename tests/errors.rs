@@ -389,6 +389,30 @@ fn bad_fracture_requests_name_the_key() {
     assert_error(&e, "expect[0].at", None, "applies to final");
     let e = error_with_text(&expect("quantity = \"K_drift\"\n"));
     assert_error(&e, "expect[0].from", None, "give its start");
+    let e = error_with_text(&expect("quantity = \"K_drift\"\nfrom = 0.0\nat = 1e-6\n"));
+    assert_error(&e, "expect[0].at", None, "runs over a window");
+    let e = error_with_text(&expect("quantity = \"G_interaction\"\n"));
+    assert_error(&e, "expect[0].from", None, "give its start");
+    let e = error_with_text(&expect(
+        "quantity = \"G_interaction\"\nfrom = 0.0\nat = 1e-6\n",
+    ));
+    assert_error(&e, "expect[0].at", None, "runs over a window");
+    let e = error_with_text(&expect(
+        "quantity = \"G_interaction\"\nfrom = 0.0\nmaterial = \"glass\"\n",
+    ));
+    assert_error(
+        &e,
+        "expect[0].material",
+        None,
+        "no [[material]] named `glass`",
+    );
+    let e = error_with_text(&expect("quantity = \"KI\"\nmaterial = \"steel\"\n"));
+    assert_error(&e, "expect[0].material", None, "applies to G_interaction");
+    let e = error_with_text(&format!(
+        "[[material]]\nname = \"glass\"\nE = 70e9\nnu = 0.2\nrho = 2500.0\n{}",
+        expect("quantity = \"G_interaction\"\nfrom = 0.0\n")
+    ));
+    assert_error(&e, "expect[0].material", None, "several materials");
     let e = error_with_text(&expect("quantity = \"KI\"\nfrom = 1e-5\n"));
     assert_error(&e, "expect[0].from", None, "applies to K_drift");
     let e = error_with_text(&expect("quantity = \"kinetic_fraction\"\nfrom = 1.0\n"));

@@ -74,6 +74,21 @@ pub struct PathResult {
     pub line: [f64; 2],
     /// Area term (Eq. 8), global x and y.
     pub area: [f64; 2],
+    /// The tip's unit direction in global x and y, G = J . direction (Eq. 10); along a 3D
+    /// front (1, 0), J1 being J along the front's normal already.
+    pub direction: [f64; 2],
+}
+
+impl PathResult {
+    /// J along the tip's direction, the energy release rate G (Eq. 10), with or without
+    /// the area term; a zero component is skipped (along a 3D front J2 is NaN).
+    pub fn along_tip(&self, area: bool) -> f64 {
+        let a = if area { self.area } else { [0.0; 2] };
+        (0..2)
+            .filter(|&k| self.direction[k] != 0.0)
+            .map(|k| (self.line[k] + a[k]) * self.direction[k])
+            .sum()
+    }
 }
 
 /// J and K at one crack tip (2D) or front vertex (3D) at one time (SI: J/m^2, Pa sqrt(m)).

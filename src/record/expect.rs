@@ -6,6 +6,8 @@ use super::history::{
 };
 use super::probe::Probe;
 use crate::fracture::eta::EtaEstimate;
+#[cfg(test)]
+use crate::fracture::plan::PathResult;
 use crate::fracture::plan::TipResult;
 use crate::physics::growth::GrowthRow;
 use glam::DVec3;
@@ -139,6 +141,22 @@ pub enum Measure {
         tip: u32,
         /// Start of the window (s).
         from: f64,
+    },
+    /// The interaction integral's energy release rate against J at a 2D tip at rest: the
+    /// largest |G_int(t) - J(t).t| over the largest |J(t).t| from `from` on, with G_int =
+    /// (K_I^2 + K_II^2) / E' (Irwin 1957) and t the tip's unit direction. The two are
+    /// independent estimates of one G, so their gap is a measure of both one's errors.
+    GInteraction {
+        /// Crack index.
+        crack: u32,
+        /// 0 start, 1 end.
+        tip: u32,
+        /// Start of the window (s).
+        from: f64,
+        /// E' of the material at the tip (Pa).
+        modulus: f64,
+        /// The tip's unit direction.
+        direction: [f64; 2],
     },
     /// |J| at a 2D crack tip (last row) against the eta estimate from a load and a
     /// displacement probe: (|J| - J_eta) / J_eta.
@@ -308,6 +326,13 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
                 .fold(0.0, f64::max);
             finite(worst / last[0].hypot(last[1]))
         }
+        Measure::GInteraction {
+            crack,
+            tip,
+            from,
+            modulus,
+            direction,
+        } => g_interaction(h, crack, tip, from, modulus, direction),
         Measure::PathDifference {
             crack,
             tip,
@@ -361,6 +386,29 @@ fn measure(m: &Measure, h: &History, probes: &[Probe]) -> Option<f64> {
 /// `v` if finite.
 fn finite(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
+}
+
+/// [`Measure::GInteraction`]: the worst gap between the interaction integral's G and J
+/// along the tip over the rows from `from` on, relative to J's largest; None without rows
+/// or where a K is missing (no interaction domain fitted).
+fn g_interaction(
+    h: &History,
+    crack: u32,
+    tip: u32,
+    from: f64,
+    modulus: f64,
+    t: [f64; 2],
+) -> Option<f64> {
+    let rows = (h.fracture.iter()).filter(|r| r.crack == crack && r.tip == tip && r.time >= from);
+    let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
+    for r in rows {
+        let [k1, k2, _] = r.k_interaction;
+        let g = (k1 * k1 + k2 * k2) / modulus;
+        let j = r.j[0] * t[0] + r.j[1] * t[1];
+        worst = worst.max(finite((g - j).abs())?);
+        scale = scale.max(j.abs());
+    }
+    finite(worst / scale)
 }
 
 /// K_I, K_II, J_x or J_y (`qty` 0..4) at a 2D tip: the last value, or at time `at`
@@ -501,6 +549,82 @@ mod tests {
         assert_eq!(at(Some(2.0)), Some(12.0));
         assert_eq!(at(Some(2.5)), Some(12.0));
         assert_eq!(at(Some(-1.0)), None);
+    }
+
+    /// `G_interaction` at a tip pointing 30 degrees up: the J vector has G along the tip and
+    /// an arbitrary part across it; K whose (K_I^2 + K_II^2)/E' is G except one row 2 %
+    /// high reads that gap over the largest G. A row before `from` (50 % off) does not
+    /// count; a row without interaction K leaves no value.
+    #[test]
+    fn g_interaction_reads_the_worst_gap_along_the_tip() {
+        let (modulus, t) = (2.0e11, [0.75f64.sqrt(), 0.5]);
+        let mut h = History::default();
+        let mut g_at = Vec::new();
+        for step in 0..5u64 {
+            let g = 40.0 * (step + 1) as f64;
+            let off = [1.5, 1.0, 1.0, 1.02, 1.0][step as usize];
+            let k2 = -4.0e5_f64;
+            let k1 = (off * g * modulus - k2 * k2).sqrt();
+            let across = 0.7 * g;
+            h.fracture.push(TipResult {
+                step,
+                time: step as f64,
+                j: [g * t[0] - across * t[1], g * t[1] + across * t[0]],
+                k_interaction: [k1, k2, 0.0],
+                tip: 1,
+                ..TipResult::default()
+            });
+            g_at.push(g);
+        }
+        let m = Measure::GInteraction {
+            crack: 0,
+            tip: 1,
+            from: 0.5,
+            modulus,
+            direction: t,
+        };
+        let got = measure(&m, &h, &[]).unwrap();
+        let want = 0.02 * g_at[3] / g_at[4];
+        assert!((got - want).abs() < 1e-9, "{got} against {want}");
+        h.fracture[2].k_interaction = [f64::NAN, f64::NAN, 0.0];
+        assert_eq!(measure(&m, &h, &[]), None);
+    }
+
+    /// J_path at a mixed-mode tip compares G = J . t: two contours with the same G and
+    /// different J across the tip (which a contour leaves path dependent) read 0, a G 3 %
+    /// off reads 3 %; along a 3D front (direction (1, 0), J2 NaN) J1 alone is compared.
+    #[test]
+    fn j_path_compares_j_along_the_tip() {
+        let t = [0.6, -0.8];
+        let row = |contour, g: f64, across: f64, direction: [f64; 2]| PathResult {
+            step: 1,
+            time: 1.0,
+            crack: 0,
+            tip: 1,
+            contour,
+            line: [g * t[0] - across * t[1], g * t[1] + across * t[0]],
+            area: [0.0; 2],
+            direction,
+        };
+        let m = Measure::PathDifference {
+            crack: 0,
+            tip: Some(1),
+            near: None,
+            main: 2,
+            compare: vec![4],
+            from: 0.0,
+        };
+        let h = |a: PathResult, b: PathResult| History {
+            paths: vec![a, b],
+            ..History::default()
+        };
+        let same = h(row(2, 100.0, 50.0, t), row(4, 100.0, -80.0, t));
+        assert!(measure(&m, &same, &[]).unwrap().abs() < 1e-12);
+        let off = h(row(2, 100.0, 50.0, t), row(4, 103.0, 50.0, t));
+        assert!((measure(&m, &off, &[]).unwrap() - 0.03).abs() < 1e-12);
+        let (mut a, mut b) = (row(2, 0.0, 0.0, [1.0, 0.0]), row(4, 0.0, 0.0, [1.0, 0.0]));
+        (a.line, b.line) = ([10.0, f64::NAN], [10.5, f64::NAN]);
+        assert!((measure(&m, &h(a, b), &[]).unwrap() - 0.05).abs() < 1e-12);
     }
 
     /// A front expect with a reference varying as cos(theta) about a ring's centre reads

@@ -134,9 +134,11 @@ pub fn arrival(t: &[f64], s: &[f64]) -> Option<f64> {
 }
 
 /// How far J on contour `n` is from J on contour `main` at a crack tip, over the rows from
-/// time `from` on: max |J_n - J_main| / max |J_main| (J as a vector, or J1 alone where J2
-/// is not measured, as along a 3D front), with or without the area term. None without rows
-/// for both contours, or where J1 is NaN (a tube that does not fit).
+/// time `from` on: max |J_n - J_main| / max |J_main|, with or without the area term. In 2D
+/// J is compared along the tip's direction at each row (G = J . t, path independent; J_2
+/// is not in mixed mode, where it needs the integral along the crack faces that a contour
+/// leaves out); along a 3D front J1 alone (J2 is not measured). None without rows for both
+/// contours, or where J1 is NaN (a tube that does not fit).
 pub fn path_difference(
     h: &History,
     crack: u32,
@@ -146,10 +148,7 @@ pub fn path_difference(
     from: f64,
     area: bool,
 ) -> Option<f64> {
-    let j = |p: &PathResult| {
-        let a = if area { p.area } else { [0.0; 2] };
-        [p.line[0] + a[0], p.line[1] + a[1]]
-    };
+    let j = |p: &PathResult| p.along_tip(area);
     let rows = || {
         h.paths
             .iter()
@@ -159,25 +158,17 @@ pub fn path_difference(
         .filter(|p| p.contour == n)
         .map(|p| (p.step, p))
         .collect();
-    let norm = |v: [f64; 2]| {
-        if v[1].is_nan() {
-            v[0].abs()
-        } else {
-            v[0].hypot(v[1])
-        }
-    };
     let (mut diff, mut size, mut pairs) = (0.0f64, 0.0f64, 0);
     for m in rows().filter(|p| p.contour == main) {
         let Some(o) = other.get(&m.step) else {
             continue;
         };
         let (a, b) = (j(m), j(o));
-        let (d, s) = (norm([b[0] - a[0], b[1] - a[1]]), norm(a));
-        if d.is_nan() || s.is_nan() {
+        if a.is_nan() || b.is_nan() {
             return None;
         }
-        diff = diff.max(d);
-        size = size.max(s);
+        diff = diff.max((b - a).abs());
+        size = size.max(a.abs());
         pairs += 1;
     }
     (pairs > 0 && size > 0.0).then(|| diff / size)

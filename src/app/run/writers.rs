@@ -128,7 +128,7 @@ impl Writers {
             (true, Some(_)) => {
                 let mut f = create("paths.csv")?;
                 let part = if front_vertices { "volume" } else { "area" };
-                writeln!(f, "step,time,crack,tip,contour,J1,J2,J1_{part},J2_{part}")?;
+                writeln!(f, "step,time,crack,tip,contour,J1,J2,J1_{part},J2_{part},G")?;
                 Some(f)
             }
             _ => None,
@@ -243,7 +243,8 @@ impl Writers {
 
     /// Appends J and K at crack tips to fracture.csv, and J on the compared contours (with
     /// the area term, and the area term alone; in 3D tubes, with the volume term and it
-    /// alone, J2 not measured) to paths.csv (SI: J/m^2, Pa sqrt(m)).
+    /// alone, J2 not measured; then G, J along the tip) to paths.csv (SI: J/m^2, Pa
+    /// sqrt(m)).
     pub fn fracture(&mut self, tips: &[TipResult], paths: &[PathResult]) -> anyhow::Result<()> {
         let Some((f, names)) = &mut self.fracture else {
             return Ok(());
@@ -259,7 +260,7 @@ impl Writers {
             for p in paths {
                 writeln!(
                     pf,
-                    "{},{:.9e},{},{},{},{:.9e},{:.9e},{:.9e},{:.9e}",
+                    "{},{:.9e},{},{},{},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e}",
                     p.step,
                     p.time,
                     names[p.crack as usize],
@@ -268,7 +269,8 @@ impl Writers {
                     p.line[0] + p.area[0],
                     p.line[1] + p.area[1],
                     p.area[0],
-                    p.area[1]
+                    p.area[1],
+                    p.along_tip(true)
                 )?;
             }
         }

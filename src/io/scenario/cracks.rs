@@ -1,6 +1,6 @@
 //! Building the crack store from `[[crack]]` tables, with every check a crack needs.
 
-use super::check::{MIN_FOLD_ANGLE, positive, to_vec, vec3};
+use super::check::{MIN_FOLD_ANGLE, material_named, positive, to_vec, vec3};
 use super::claim::Claim;
 use super::schema::{AlongSpec, CrackSpec, ExpectSpec, FractureSpec};
 use super::source::Source;
@@ -8,9 +8,9 @@ use super::surface;
 use crate::base::dim::{D3, Dim};
 use crate::base::error::ScenarioError;
 use crate::base::geometry::Element;
-use crate::fracture::plan::{FracturePlan, KMethod};
+use crate::fracture::plan::{FracturePlan, KMethod, e_prime};
 use crate::physics::growth::TipState;
-use crate::physics::material::Material;
+use crate::physics::material::{Material, Plane};
 use crate::record::expect::{Along, Expect, Measure, Shape};
 use crate::store::crack::{COLORS, Contact, Cracks, Law, MAX_CRACKS, colors};
 use crate::store::grid::GridGeom;
@@ -925,6 +925,12 @@ fn along(src: &Source, key: &str, a: &AlongSpec) -> R<Along> {
 /// The measure of a `K_drift` expect: how far K moves at a crack tip from `from` on.
 pub(super) fn drift_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure> {
     let (crack, tip) = expect_tip(src, i, e)?;
+    if e.at.is_some() {
+        return Err(src.error(
+            &format!("expect[{i}].at"),
+            "`K_drift` runs over a window: give its start `from`",
+        ));
+    }
     let end = src.scenario.simulation.duration;
     match e.from {
         Some(from) if (0.0..end).contains(&from) => Ok(Measure::KDrift { crack, tip, from }),
@@ -933,6 +939,80 @@ pub(super) fn drift_measure(src: &Source, i: usize, e: &ExpectSpec) -> R<Measure
             format!("`K_drift` runs over a window: give its start `from`, 0 to {end:.4e} s"),
         )),
     }
+}
+
+/// The measure of a `G_interaction` expect: the interaction integral's G against J at a 2D
+/// tip at rest from `from` on, E' that of the `material` at the tip (the scene's only one
+/// by default), the tip's direction that of the crack's end segment.
+pub(super) fn g_interaction_measure<D: Dim>(
+    src: &Source,
+    i: usize,
+    e: &ExpectSpec,
+    geom: &GridGeom<D>,
+    materials: &[Material],
+    plane: Plane,
+) -> R<Measure> {
+    let key = |k: &str| format!("expect[{i}].{k}");
+    let (crack, tip) = expect_tip(src, i, e)?;
+    let spec = &src.scenario.cracks[crack as usize];
+    if spec.growth.is_some() {
+        return Err(src.error(
+            &key("quantity"),
+            "`G_interaction` compares G and J at a tip at rest: this crack grows",
+        ));
+    }
+    if e.at.is_some() {
+        return Err(src.error(
+            &key("at"),
+            "`G_interaction` runs over a window: give its start `from`",
+        ));
+    }
+    let end = src.scenario.simulation.duration;
+    let from = match e.from {
+        Some(from) if (0.0..end).contains(&from) => from,
+        _ => {
+            return Err(src.error(
+                &key("from"),
+                format!(
+                    "`G_interaction` runs over a window: give its start `from`, 0 to {end:.4e} s"
+                ),
+            ));
+        }
+    };
+    let material = match (&e.material, materials) {
+        (Some(name), _) => material_named(src, &key("material"), materials, name)?,
+        (None, [_]) => 0,
+        (None, _) => {
+            return Err(src.error(
+                &key("material"),
+                "the scene has several materials: name the one at the tip",
+            ));
+        }
+    };
+    Ok(Measure::GInteraction {
+        crack,
+        tip,
+        from,
+        modulus: e_prime(&materials[material], plane),
+        direction: tip_direction(src, crack, tip, geom)?,
+    })
+}
+
+/// The unit direction of 2D crack `crack`'s tip `tip` (0 start, 1 end): that of its end
+/// segment, pointing out of the crack.
+fn tip_direction<D: Dim>(src: &Source, crack: u32, tip: u32, geom: &GridGeom<D>) -> R<[f64; 2]> {
+    let spec = &src.scenario.cracks[crack as usize];
+    let points = vertices::<D>(src, crack as usize, spec, geom)?;
+    let n = points.len();
+    let (a, b) = if tip == 0 {
+        (points[1], points[0])
+    } else {
+        (points[n - 2], points[n - 1])
+    };
+    let (a, b) = (D::to_xyz(a), D::to_xyz(b));
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let len = d[0].hypot(d[1]);
+    Ok([d[0] / len, d[1] / len])
 }
 
 /// The measure of a `J_path` expect: J with the area term on the compared contours against

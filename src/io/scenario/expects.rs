@@ -62,19 +62,23 @@ fn crack_expect<D: Dim>(
     let tip_qty = ["KI", "KII", "J1", "J2"]
         .iter()
         .position(|q| *q == e.quantity);
-    if e.from.is_some() && !["K_drift", "kinetic_fraction", "slope"].contains(&e.quantity.as_str())
-    {
+    let windowed = ["K_drift", "G_interaction", "kinetic_fraction", "slope"];
+    if e.from.is_some() && !windowed.contains(&e.quantity.as_str()) {
         return Err(src.error(
             &key("from"),
-            "`from` applies to K_drift, kinetic_fraction and slope",
+            "`from` applies to K_drift, G_interaction, kinetic_fraction and slope",
         ));
     }
     let front_qty = ["KI_front", "KII_front", "KIII_front", "J1_front"]
         .iter()
         .position(|q| *q == e.quantity);
-    let tip_like = tip_qty.is_some() || ["K_drift", "J_eta"].contains(&e.quantity.as_str());
+    let tip_like =
+        tip_qty.is_some() || ["K_drift", "J_eta", "G_interaction"].contains(&e.quantity.as_str());
     if e.eta.is_some() && e.quantity != "J_eta" {
         return Err(src.error(&key("eta"), "`eta` applies to J_eta"));
+    }
+    if e.material.is_some() && e.quantity != "G_interaction" {
+        return Err(src.error(&key("material"), "`material` applies to G_interaction"));
     }
     if D::D == 3 && tip_like {
         return Err(src.error(
@@ -112,6 +116,9 @@ fn crack_expect<D: Dim>(
         (_, Some(qty)) => Some(super::cracks::front_measure(src, i, e, qty)?),
         _ if e.quantity == "J_path" => Some(super::cracks::path_measure::<D>(src, i, e, geom)?),
         _ if e.quantity == "K_drift" => Some(super::cracks::drift_measure(src, i, e)?),
+        _ if e.quantity == "G_interaction" => Some(super::cracks::g_interaction_measure::<D>(
+            src, i, e, geom, materials, plane,
+        )?),
         _ if e.quantity == "J_eta" => Some(super::eta::eta_measure(
             src, i, e, ids, materials, plane, thickness,
         )?),
@@ -186,7 +193,7 @@ fn history_expect(src: &Source, i: usize, e: &ExpectSpec, ids: &[usize]) -> R<Ex
                 format!(
                     "unknown quantity `{other}` (final, max, min, frequency, wave_speed, \
                      slope, momentum_drift, energy_drift, angular_momentum_drift, KI, KII, J1, J2, \
-                     J_path, K_drift, J_eta, kinetic_fraction, KI_front, KII_front, \
+                     J_path, K_drift, G_interaction, J_eta, kinetic_fraction, KI_front, KII_front, \
                      KIII_front, J1_front, kink, path_angle, turn, cycles)"
                 ),
             ));

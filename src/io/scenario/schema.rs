@@ -714,7 +714,9 @@ pub struct ExpectSpec {
     /// from the crack, degrees) and cycles (fatigue: load cycles to grow by `length`); for
     /// a growing 3D front kink (its largest turn at the first check, degrees) and cycles;
     /// J_eta (|J| at a 2D tip against the `eta` estimate from a load and a displacement
-    /// probe, relative).
+    /// probe, relative); G_interaction (at a 2D tip at rest, the largest difference of the
+    /// interaction integral's G from J along the tip from `from` on, relative to J's
+    /// largest).
     pub quantity: String,
     /// Probe(s) the quantity is measured on (wave_speed and slope take two).
     #[serde(default)]
@@ -726,7 +728,7 @@ pub struct ExpectSpec {
     /// For final, KI, KII, J1, J2: the value at this time (s) instead of the last one (a
     /// probe: its last sample at or before it).
     pub at: Option<f64>,
-    /// For K_drift, kinetic_fraction and slope: the start of the window (s).
+    /// For K_drift, G_interaction, kinetic_fraction and slope: the start of the window (s).
     pub from: Option<f64>,
     /// For cycles: the length grown (m) whose cycles are compared.
     pub length: Option<f64>,
@@ -738,6 +740,9 @@ pub struct ExpectSpec {
     pub near: Option<Vec<f64>>,
     /// For J_eta: the specimen's eta estimate of J from its load-displacement record.
     pub eta: Option<EtaSpec>,
+    /// For G_interaction: the material at the tip, whose E' turns K into G (default: the
+    /// scene's only material).
+    pub material: Option<String>,
     /// Reference value (SI).
     pub reference: f64,
     /// Where the reference comes from.

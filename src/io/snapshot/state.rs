@@ -107,6 +107,7 @@ pub fn write<D: Dim>(
     let path_ids: Vec<u64> = h.paths.iter().map(|p| tip_id(p.crack, p.tip)).collect();
     let path_contours: Vec<u64> = h.paths.iter().map(|p| u64::from(p.contour)).collect();
     let path_data: Vec<f64> = h.paths.iter().flat_map(path_data).collect();
+    let path_directions: Vec<f64> = h.paths.iter().flat_map(|p| p.direction).collect();
     let growth_steps: Vec<u64> = h.growth.iter().map(|g| g.step).collect();
     let growth_ids: Vec<u64> = h.growth.iter().map(|g| tip_id(g.crack, g.tip)).collect();
     let growth_data: Vec<f64> = h.growth.iter().flat_map(|g| g.values()).collect();
@@ -160,6 +161,7 @@ pub fn write<D: Dim>(
     c.add("history.paths.id", &path_ids);
     c.add("history.paths.contour", &path_contours);
     c.add("history.paths.data", &path_data);
+    c.add("history.paths.direction", &path_directions);
     c.add("history.growth.step", &growth_steps);
     c.add("history.growth.id", &growth_ids);
     c.add("history.growth.data", &growth_data);
@@ -438,11 +440,20 @@ fn read_paths(r: &mut Reader) -> Result<Vec<PathResult>, SnapshotError> {
     let path_ids: Vec<u64> = r.column("history.paths.id", path_steps.len())?;
     let contours: Vec<u64> = r.column("history.paths.contour", path_steps.len())?;
     let data: Vec<f64> = r.column("history.paths.data", path_steps.len() * PATH_WIDTH)?;
+    // Snapshots written before the rows kept the tip's direction: NaN (J along the tip
+    // cannot be compared for those rows; J_path reads null).
+    let directions: Vec<f64> = match r.offset_of("history.paths.direction") {
+        Some(_) => r.column("history.paths.direction", path_steps.len() * 2)?,
+        None => vec![f64::NAN; path_steps.len() * 2],
+    };
     Ok(path_steps
         .iter()
         .zip(path_ids.iter().zip(&contours))
-        .zip(data.chunks_exact(PATH_WIDTH))
-        .map(|((&step, (&id, &contour)), d)| PathResult {
+        .zip(
+            data.chunks_exact(PATH_WIDTH)
+                .zip(directions.chunks_exact(2)),
+        )
+        .map(|((&step, (&id, &contour)), (d, t))| PathResult {
             step,
             time: d[0],
             crack: (id >> 32) as u32,
@@ -450,6 +461,7 @@ fn read_paths(r: &mut Reader) -> Result<Vec<PathResult>, SnapshotError> {
             contour: contour as u32,
             line: [d[1], d[2]],
             area: [d[3], d[4]],
+            direction: [t[0], t[1]],
         })
         .collect())
 }
