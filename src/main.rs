@@ -188,6 +188,9 @@ fn cmd_sweep(
                 for note in on_particle_notes(&s.particles_on_cracks) {
                     println!("  warning: {note}");
                 }
+                for note in tip_line_notes(&s.tips_on_lines) {
+                    println!("  warning: {note}");
+                }
             }
             (None, Some(e)) => println!("[{k}/{n}] {what}: {e}"),
             (None, None) => {}
@@ -307,6 +310,17 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
     }
     for note in on_particle_notes(&s.particles_on_cracks) {
         println!("  note: {note}");
+    }
+    for note in tip_line_notes(&s.tips_on_lines) {
+        println!("  note: {note}");
+    }
+    for b in &s.split_boundaries {
+        println!(
+            "  note: boundary[{}] prescribes {} node(s) whose support a crack cut at the last \
+             step: it drives the material on both sides of the crack there (to drive one \
+             side only, stop its region one node row short of the crack)",
+            b.boundary, b.nodes
+        );
     }
     if let Some(note) = ignored_note(&s.ignored_keys) {
         println!("  note: {note}");
@@ -540,6 +554,10 @@ fn cmd_check(path: &Path, overrides: &[String]) -> ExitCode {
                     for note in on_particle_notes(&on) {
                         println!("  note: {note}");
                     }
+                    let tips = fissure::app::run::tips_on_particle_lines(w);
+                    for note in tip_line_notes(&tips) {
+                        println!("  note: {note}");
+                    }
                     if let Some(note) = ignored_note(&fissure::io::scenario::ignored(&src)) {
                         println!("  note: {note}");
                     }
@@ -686,6 +704,20 @@ fn on_particle_notes(on: &[fissure::io::output::summary::ParticlesOnReport]) -> 
                  of it, and J and K with it (a few %); set it a fraction of a particle \
                  spacing off them",
                 o.crack, o.particles
+            )
+        })
+        .collect()
+}
+
+/// What the launcher says of each crack whose tips lie on particle-node lines.
+fn tip_line_notes(on: &[fissure::io::output::summary::TipLinesReport]) -> Vec<String> {
+    on.iter()
+        .map(|o| {
+            format!(
+                "crack `{}` ends on {} line(s) from particles to their nodes: round-off \
+                 decides whether each crosses the crack, and J and K with it (about 1.5 % \
+                 in J); move its tips a fraction of a cell",
+                o.crack, o.lines
             )
         })
         .collect()

@@ -103,3 +103,47 @@ fn a_crack_inside_its_contour_is_reported() {
     assert_eq!(tips, [("c", "start", 3), ("c", "end", 3)]);
     assert!(run_text(&scene(0.01)).summary.contours.is_empty());
 }
+
+/// The struck edge of `edge_impact_2d` at 1 mm cells: a region reaching the node row at
+/// y = -0.5 mm, whose supports the crack at y = 0 cuts, prescribes some of that row's nodes
+/// with a field per side (at most the row's three nodes at x = -2, -1 and 0 mm), and
+/// summary.json says so; stopped at y = -1 mm, it drives none.
+#[test]
+fn a_boundary_driving_both_sides_of_a_crack_is_reported() {
+    let text = std::fs::read_to_string("scenarios/edge_impact_2d.toml").unwrap();
+    let text = text.replace("cell = [0.0005, 0.0005]", "cell = [0.001, 0.001]");
+    let split = run_text(&text).summary.split_boundaries;
+    assert_eq!(split.len(), 1, "{split:?}");
+    assert_eq!(split[0].boundary, 0);
+    assert!((1..=3).contains(&split[0].nodes), "{split:?}");
+    let short = text.replace("max = [0.0, -0.0005] }", "max = [0.0, -0.001] }");
+    assert_ne!(short, text);
+    assert!(run_text(&short).summary.split_boundaries.is_empty());
+}
+
+/// A centre crack along a row of cell centres (y = 6.5 mm, 1 mm cells, particles at the
+/// quarter points, uGIMP) ending at cell centres (x = 16.5 and 23.5 mm): each tip lies on
+/// the four diagonals from its cell's particles to the corners across it
+/// (`store::crack::tip_lines` derives the count), so summary.json counts 8 lines; ended
+/// 0.1 mm further out, none.
+#[test]
+fn a_tip_on_particle_node_lines_is_reported() {
+    let scene = |half: f64| {
+        common::strip_2d(
+            "plane = \"stress\"",
+            1e-7,
+            &format!(
+                "[[body]]\nmaterial = \"m\"\nbox = {{ min = [0.004, 0.002], max = [0.036, 0.010] }}\n\
+                 [[crack]]\nname = \"c\"\n\
+                 line = {{ start = [{:.4}, 0.0065], end = [{:.4}, 0.0065], spacing = 5e-4 }}\n\
+                 tips = [\"start\", \"end\"]\n",
+                0.02 - half,
+                0.02 + half
+            ),
+        )
+    };
+    let on = run_text(&scene(0.0035)).summary.tips_on_lines;
+    let found: Vec<(&str, usize)> = on.iter().map(|t| (t.crack.as_str(), t.lines)).collect();
+    assert_eq!(found, [("c", 8)]);
+    assert!(run_text(&scene(0.0036)).summary.tips_on_lines.is_empty());
+}

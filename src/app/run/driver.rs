@@ -9,7 +9,9 @@ use super::{Outcome, RunOptions, Stop, check_finite, check_snapshot, row_due, st
 use crate::base::error::UsageError;
 use crate::fracture::plan::{FracturePlan, Measured};
 use crate::io::output::figures::Figures;
-use crate::io::output::summary::{NodeLineReport, ParticlesOnReport, Status, Summary};
+use crate::io::output::summary::{
+    NodeLineReport, ParticlesOnReport, Status, Summary, TipLinesReport,
+};
 use crate::io::scenario::{MAX_STEPS, OutputPlan, Scene, Source};
 use crate::pipeline::schedule::Schedule;
 use crate::record::expect::Expect;
@@ -44,6 +46,7 @@ pub(super) struct Run<'a, D: DimSystems> {
     grows: bool,
     node_lines: Vec<NodeLineReport>,
     particles_on_cracks: Vec<ParticlesOnReport>,
+    tips_on_lines: Vec<TipLinesReport>,
     /// The step the run started from (0, or the snapshot's).
     pub first_step: u64,
 }
@@ -87,6 +90,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             .map(|c| c.topology.cracks().iter().map(|c| c.name.clone()).collect());
         let node_lines = reports::node_lines(&world);
         let particles_on_cracks = reports::particles_on_cracks(&world);
+        let tips_on_lines = reports::tips_on_particle_lines(&world);
         let growing: Option<(Vec<String>, bool)> = (world.cracks.as_ref())
             .filter(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()))
             .map(|c| {
@@ -147,6 +151,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             grows: growing.is_some(),
             node_lines,
             particles_on_cracks,
+            tips_on_lines,
             first_step,
         };
         if run.resumed_from.is_none() {
@@ -356,6 +361,8 @@ impl<'a, D: DimSystems> Run<'a, D> {
             cell_crossings: world.cell_crossings(),
             node_lines: self.node_lines.clone(),
             particles_on_cracks: self.particles_on_cracks.clone(),
+            tips_on_lines: self.tips_on_lines.clone(),
+            split_boundaries: reports::split_boundaries(world),
             energies: world.energies(),
             static_solve: (world.settings.solver == crate::store::world::Solver::Static)
                 .then(|| SolveLog::from_rows(&history.solves)),

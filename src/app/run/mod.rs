@@ -4,7 +4,7 @@
 pub mod checkpoint;
 mod driver;
 mod reports;
-pub use reports::{node_lines, particles_on_cracks};
+pub use reports::{node_lines, particles_on_cracks, tips_on_particle_lines};
 pub mod stop;
 pub mod writers;
 

@@ -5,12 +5,12 @@ use crate::base::dim::Dim;
 use crate::fracture::plan::FracturePlan;
 use crate::io::output::summary::{
     ContourReport, GrowthReport, NodeLineReport, ParticlesOnReport, PathReport, ProbeReport,
-    TubeReport,
+    SplitBoundaryReport, TipLinesReport, TubeReport,
 };
 use crate::physics::growth::Stopped;
 use crate::record::history::{History, last_rows, path_difference, path_tips};
 use crate::record::probe::Probe;
-use crate::store::crack::{on_node_lines, particles_on};
+use crate::store::crack::{on_node_lines, particles_on, tips_on_lines};
 use crate::store::world::World;
 
 /// The path-dependence report of summary.json: every crack tip against every compared
@@ -195,6 +195,23 @@ pub(super) fn growth<D: Dim>(world: &World<D>) -> Vec<GrowthReport> {
         .collect()
 }
 
+/// The velocity boundaries with nodes that carried a field per crack side at the last step
+/// (a boundary prescribes every field of its nodes).
+pub(super) fn split_boundaries<D: Dim>(world: &World<D>) -> Vec<SplitBoundaryReport> {
+    let Some(cracks) = &world.cracks else {
+        return Vec::new();
+    };
+    let fields = &cracks.scratch.fields;
+    (world.bcs.iter().enumerate())
+        .map(|(boundary, bc)| {
+            let split = |n: &&u32| !fields.rows_of(**n).is_empty();
+            let nodes = bc.nodes.iter().filter(split).count();
+            SplitBoundaryReport { boundary, nodes }
+        })
+        .filter(|r| r.nodes > 0)
+        .collect()
+}
+
 /// The cracks that lie on a line or plane of grid nodes as the world stands.
 pub fn node_lines<D: Dim>(world: &World<D>) -> Vec<NodeLineReport> {
     let Some(cracks) = &world.cracks else {
@@ -222,6 +239,27 @@ pub fn particles_on_cracks<D: Dim>(world: &World<D>) -> Vec<ParticlesOnReport> {
         .map(|(c, particles)| ParticlesOnReport {
             crack: cracks.topology.cracks()[c].name.clone(),
             particles,
+        })
+        .collect()
+}
+
+/// The cracks whose tips or front edges lie on particle-node lines as the world stands.
+pub fn tips_on_particle_lines<D: Dim>(world: &World<D>) -> Vec<TipLinesReport> {
+    let Some(cracks) = &world.cracks else {
+        return Vec::new();
+    };
+    let p = &world.particles;
+    let found = tips_on_lines(
+        cracks,
+        &p.x,
+        &p.half,
+        &world.grid.geom,
+        world.settings.shape,
+    );
+    (found.into_iter())
+        .map(|(c, lines)| TipLinesReport {
+            crack: cracks.topology.cracks()[c].name.clone(),
+            lines,
         })
         .collect()
 }

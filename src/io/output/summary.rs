@@ -88,6 +88,12 @@ pub struct Summary {
     pub node_lines: Vec<NodeLineReport>,
     /// Cracks that passed through particle centres when the run began.
     pub particles_on_cracks: Vec<ParticlesOnReport>,
+    /// Cracks whose tips (2D) or front edges (3D) lay on a line from a particle to a node
+    /// of its stencil when the run began.
+    pub tips_on_lines: Vec<TipLinesReport>,
+    /// Velocity boundaries with nodes whose support a crack cut at the last step: they
+    /// drive the material on both sides of the crack there.
+    pub split_boundaries: Vec<SplitBoundaryReport>,
     /// Energies at the end (J).
     pub energies: Energies,
     /// A static scene's solves (None in an explicit run).
@@ -174,6 +180,27 @@ pub struct ParticlesOnReport {
     pub crack: String,
     /// How many particle centres lie on it (within 1e-7 of a cell).
     pub particles: usize,
+}
+
+/// A crack whose tip or front lies on particle-node lines, whose crossing of the crack
+/// round-off decides.
+#[derive(Clone, Debug, Serialize)]
+pub struct TipLinesReport {
+    /// Crack name.
+    pub crack: String,
+    /// How many particle-node lines pass through its tips or front edges (within 1e-7 of
+    /// a cell).
+    pub lines: usize,
+}
+
+/// A velocity boundary prescribing nodes with a velocity field per crack side: it drives
+/// every field of its nodes, so the material on both sides of the crack there.
+#[derive(Clone, Debug, Serialize)]
+pub struct SplitBoundaryReport {
+    /// Index of the `[[boundary]]` table.
+    pub boundary: usize,
+    /// Its nodes that carried more than one velocity field at the last step.
+    pub nodes: usize,
 }
 
 /// A crack lying on a line or plane of grid nodes, which costs J and K accuracy.
