@@ -102,8 +102,8 @@ pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Option<Analysis>) -> Result<
     Ok(solved)
 }
 
-/// The load step of a scene with plastic materials ([`newton`]; its cracks' faces stay
-/// open: the scenario check refuses contact there): the supports move by their increment
+/// The load step of a scene with plastic materials ([`newton`]), its crack faces' contact
+/// settled by the same active set as a linear step's: the supports move by their increment
 /// over the step, from `held` (their displacement at the step's end).
 fn plastic_step<D: Dim>(
     world: &mut World<D>,
@@ -118,8 +118,42 @@ fn plastic_step<D: Dim>(
         end.iter_mut().zip(&start).for_each(|(e, &s)| *e -= s);
         end
     });
-    let dofs = Unknowns::new(world, &[], &[]);
-    let step = newton::solve(world, kept, &dofs, increment.as_deref(), t_end)?;
+    let pairs = faces::pairs(world);
+    let mut closed = vec![false; pairs.len()];
+    // The entries' displacement at the step's start, which the faces' overlap adds to.
+    let start = if pairs.is_empty() {
+        Vec::new()
+    } else {
+        entry_displacements(world, before)
+    };
+    let (mut iterations, mut factorizations, mut newton) = (0, 0, 0);
+    let mut rounds = 0;
+    let (dofs, mut step) = loop {
+        let dofs = Unknowns::new(world, &pairs, &closed);
+        let step = newton::solve(world, kept, &dofs, increment.as_deref(), t_end)?;
+        iterations += step.solved.iterations;
+        factorizations += step.solved.factorizations;
+        newton += step.solved.newton;
+        rounds += 1;
+        if pairs.is_empty() {
+            break (dofs, step);
+        }
+        let u: Vec<D::Vec> = (start.iter().zip(&step.du)).map(|(&a, &d)| a + d).collect();
+        let zero = vec![D::zero(); u.len()];
+        let law = Law::Given(&step.returned.stress);
+        let changes = faces_round(world, &pairs, &mut closed, &u, (law, &zero));
+        if changes.closed + changes.opened == 0 {
+            break (dofs, step);
+        }
+        if rounds >= CONTACT_ROUNDS {
+            return Err(unsettled(world, t_end, rounds, changes));
+        }
+    };
+    step.solved.iterations = iterations;
+    step.solved.factorizations = factorizations;
+    step.solved.newton = newton;
+    step.solved.contact_rounds = rounds;
+    step.solved.closed_faces = closed.iter().filter(|&&c| c).count();
     reactions(world, &dofs, Law::Given(&step.returned.stress), &step.du);
     let after: Vec<D::Vec> = (before.iter().zip(gather(world, &step.du)))
         .map(|(&b, d)| b + d)
@@ -131,6 +165,33 @@ fn plastic_step<D: Dim>(
     let solved = step.solved;
     newton::commit(world, step, &after);
     Ok(solved)
+}
+
+/// Each entry's mass-weighted displacement from the particles' `disp` (as the explicit
+/// contact measures it, Guo & Nairn 3D (2006) Eq. 68); zero on an entry without mass.
+fn entry_displacements<D: Dim>(world: &World<D>, disp: &[D::Vec]) -> Vec<D::Vec> {
+    let mass = &world.grid.mass;
+    let mut sums = vec![D::zero(); mass.len()];
+    for (i, &d) in disp.iter().enumerate() {
+        let md = d * world.particles.mass[i];
+        each_entry(world, i, |n, w, _| sums[n] += md * w);
+    }
+    (sums.into_iter().zip(mass))
+        .map(|(s, &m)| if m > 0.0 { s * (1.0 / m) } else { D::zero() })
+        .collect()
+}
+
+/// The error of a load step whose crack-face contact did not settle.
+fn unsettled(world: &World<impl Dim>, t_end: f64, rounds: usize, last: faces::Changes) -> Unstable {
+    Unstable {
+        step: world.step + 1,
+        time: t_end,
+        what: format!(
+            "the crack faces' contact did not settle in {rounds} solves (the last closed {} \
+             pairs and opened {})",
+            last.closed, last.opened
+        ),
+    }
 }
 
 /// A load step's answer.
@@ -168,21 +229,13 @@ fn with_contact<D: Dim>(
         if pairs.is_empty() {
             break (u, dofs, solved);
         }
-        let changes = faces_round(world, &pairs, &mut closed, &u);
+        let changes = faces_round(world, &pairs, &mut closed, &u, (Law::Elastic, &u));
         if changes.closed + changes.opened == 0 {
             break (u, dofs, solved);
         }
         last = Some(u);
         if rounds >= CONTACT_ROUNDS {
-            return Err(Unstable {
-                step: world.step + 1,
-                time: t_end,
-                what: format!(
-                    "the crack faces' contact did not settle in {rounds} solves (the last \
-                     closed {} pairs and opened {})",
-                    changes.closed, changes.opened
-                ),
-            });
+            return Err(unsettled(world, t_end, rounds, changes));
         }
     };
     solved.iterations = iterations;
@@ -286,18 +339,21 @@ fn equilibrium<D: Dim>(
     Ok((u, solved))
 }
 
-/// One active-set round on the crack-face `pairs` at the solution `u`: the overlap along
-/// each pair's normal, and the force its constraint carries (K u - f_ext on the field
-/// above). Tolerances: 1e-9 of the largest displacement, 1e-8 of the largest nodal force.
+/// One active-set round on the crack-face `pairs` at the solution `u` (every entry's
+/// displacement): the overlap along each pair's normal, and the force its constraint
+/// carries (f_int - f_ext on the field above, f_int the product of `law` with its
+/// displacement: K u, or the internal force of given stresses at zero). Tolerances: 1e-9
+/// of the largest displacement, 1e-8 of the largest nodal force.
 fn faces_round<D: Dim>(
     world: &World<D>,
     pairs: &[faces::Pair<D::Vec>],
     closed: &mut [bool],
     u: &[D::Vec],
+    (law, at): (Law<D>, &[D::Vec]),
 ) -> faces::Changes {
     let loose = Unknowns::new(world, &[], &[]);
     let mut r = vec![D::zero(); u.len()];
-    stiffness(world, Law::Elastic, u, &loose, &mut r);
+    stiffness(world, law, at, &loose, &mut r);
     let largest = |v: &[D::Vec]| {
         (v.iter())
             .map(|x| D::dot(*x, *x).sqrt())

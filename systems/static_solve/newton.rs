@@ -91,7 +91,7 @@ pub(super) fn solve<D: Dim>(
         tolerance: LINEAR_TOLERANCE.0,
     };
     let (mut du, mut solved) = equilibrium(world, dofs, &solver, first, unbalanced, held, None)?;
-    let load = Load::new(world, dofs);
+    let load = Load::new(world, dofs, held);
     let mut now = residual(world, dofs, frame, &load, &du);
     let mut history = vec![now.relative()];
     for newton in 1..=NEWTON_ITERATIONS {
@@ -148,18 +148,31 @@ fn diverged<D: Dim>(world: &World<D>, t_end: f64, history: &[f64]) -> Unstable {
     }
 }
 
-/// The step's external force, folded onto the unknowns, and its squared norm.
+/// The step's external force, folded onto the unknowns, and the squared force a residual is
+/// measured against at least.
 struct Load<D: Dim> {
     force: Vec<D::Vec>,
     norm2: f64,
 }
 
+/// The least force a residual is measured against, as a fraction of the force the
+/// supports' increment would exert on the body held still (elastic K u_c): where the body
+/// carries next to no load (a piece the supports move rigidly) the residual is round-off,
+/// and against round-off it would never converge. Any loaded scene's force is far above it.
+const DRIVE_FLOOR: f64 = 1e-3;
+
 impl<D: Dim> Load<D> {
-    /// The loads now in the grid's force column, on `dofs`.
-    fn new(world: &World<D>, dofs: &Unknowns<D>) -> Self {
+    /// The loads now in the grid's force column, on `dofs`, with the supports' increment
+    /// `held`.
+    fn new(world: &World<D>, dofs: &Unknowns<D>, held: Option<&[D::Vec]>) -> Self {
         let mut force = world.grid.force.clone();
         dofs.fold(&mut force);
-        let norm2 = dot::<D>(&force, &force);
+        let drive2 = held.map_or(0.0, |u_c| {
+            let mut k_c = vec![D::zero(); u_c.len()];
+            stiffness(world, Law::Elastic, u_c, dofs, &mut k_c);
+            dot::<D>(&k_c, &k_c)
+        });
+        let norm2 = dot::<D>(&force, &force).max(DRIVE_FLOOR * DRIVE_FLOOR * drive2);
         Load { force, norm2 }
     }
 }

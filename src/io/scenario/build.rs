@@ -41,7 +41,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     let grid = super::grid::grid::<D>(src)?;
     let materials = super::material::materials(src, &src.scenario.materials)?;
     let filled = super::bodies::bodies::<D>(src, &grid, &materials, sim.thickness, sim.tile)?;
-    super::statics::check(src, &materials, &filled.used)?;
+    super::statics::check(src)?;
     let geom = grid.geom;
     let mut particles = filled.particles;
     let (dt, dt_limit) =

@@ -1,13 +1,11 @@
 //! What a static scene (`solver = "static"`) may hold so far: linear elastic bodies held
 //! by their boundaries (still, or moved by a prescribed velocity's displacement), under
 //! loads and gravity, with open cracks or faces in frictionless contact, growing or not,
-//! elastic or J2 plastic (3D and plane strain; plastic scenes with open faces). Stick and
-//! friction, plane-stress plasticity and contact with plasticity are refused by name until
-//! the static solver takes them.
+//! elastic or J2 plastic. Stuck and rubbing faces are refused by name until the static
+//! solver takes them.
 
 use super::check::R;
 use super::source::Source;
-use crate::physics::material::Material;
 use crate::store::world::Solver;
 
 /// The convergence tolerances a static scene may ask for: below the lower, round-off
@@ -15,7 +13,7 @@ use crate::store::world::Solver;
 const TOLERANCE_RANGE: (f64, f64) = (1e-12, 1e-2);
 
 /// Refuses what the static solver does not take yet, naming the key.
-pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()> {
+pub(super) fn check(src: &Source) -> R<()> {
     let sc = &src.scenario;
     if let Some(t) = sc.simulation.tolerance {
         if sc.simulation.solver != Solver::Static {
@@ -57,17 +55,6 @@ pub(super) fn check(src: &Source, materials: &[Material], used: &[bool]) -> R<()
                 ),
             ));
         }
-    }
-    let plastic = (0..materials.len()).any(|k| used[k] && materials[k].j2.is_some());
-    let contact =
-        (sc.cracks.iter()).position(|c| c.contact.as_ref().is_some_and(|k| k.law != "none"));
-    if let (true, Some(c)) = (plastic, contact) {
-        return Err(src.error(
-            &format!("crack[{c}].contact"),
-            "the static solver takes crack-face contact in elastic scenes only, not with a J2 \
-             plastic material yet: drop the contact (open faces) or run this scene with \
-             solver = \"explicit\"",
-        ));
     }
     Ok(())
 }
