@@ -440,12 +440,7 @@ fn read_paths(r: &mut Reader) -> Result<Vec<PathResult>, SnapshotError> {
     let path_ids: Vec<u64> = r.column("history.paths.id", path_steps.len())?;
     let contours: Vec<u64> = r.column("history.paths.contour", path_steps.len())?;
     let data: Vec<f64> = r.column("history.paths.data", path_steps.len() * PATH_WIDTH)?;
-    // Snapshots written before the rows kept the tip's direction: NaN (J along the tip
-    // cannot be compared for those rows; J_path reads null).
-    let directions: Vec<f64> = match r.offset_of("history.paths.direction") {
-        Some(_) => r.column("history.paths.direction", path_steps.len() * 2)?,
-        None => vec![f64::NAN; path_steps.len() * 2],
-    };
+    let directions: Vec<f64> = r.column("history.paths.direction", path_steps.len() * 2)?;
     Ok(path_steps
         .iter()
         .zip(path_ids.iter().zip(&contours))
