@@ -293,10 +293,7 @@ fn polyline<D: Dim>(src: &Source, c: usize, spec: &CrackSpec, geom: &GridGeom<D>
 fn contact(src: &Source, c: usize, spec: &CrackSpec) -> R<Contact> {
     let key = |k: &str| format!("crack[{c}].contact.{k}");
     let Some(cs) = &spec.contact else {
-        return Ok(Contact {
-            law: Law::None,
-            approach_check: false,
-        });
+        return Ok(Contact::OPEN);
     };
     let law = match cs.law.as_str() {
         "none" => Law::None,

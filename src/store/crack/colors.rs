@@ -72,15 +72,12 @@ pub fn colors<D: Dim>(topology: &Topology<D>, x: &[D::Vec], cell: f64) -> Result
 mod tests {
     use super::*;
     use crate::base::dim::D2;
-    use crate::store::crack::{Contact, Law};
+    use crate::store::crack::Contact;
     use glam::DVec2;
 
     /// `n` short vertical cracks at x = k * `gap` (m), 1 mm long.
     fn row(n: usize, gap: f64) -> (Topology<D2>, Vec<DVec2>) {
-        let open = Contact {
-            law: Law::None,
-            approach_check: false,
-        };
+        let open = Contact::OPEN;
         let mut t = Topology::<D2>::default();
         let mut x = Vec::new();
         for k in 0..n {

@@ -25,6 +25,14 @@ pub struct Contact {
     pub approach_check: bool,
 }
 
+impl Contact {
+    /// Faces with no contact law: they pass through each other (the default).
+    pub const OPEN: Contact = Contact {
+        law: Law::None,
+        approach_check: false,
+    };
+}
+
 impl Law {
     /// The momentum change of the field above the crack (the field below gets its
     /// negative, so momentum is conserved exactly) for masses `ma`, `mb`, velocities `va`,

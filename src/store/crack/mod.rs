@@ -130,10 +130,7 @@ mod tests {
         let mut c = Cracks::<D3>::default();
         let tris: Vec<Triangle> = (0..6).map(|i| [0, 1 + i, 1 + (i + 1) % 6]).collect();
         let front = vec![(0, (1..7).collect())];
-        let open = Contact {
-            law: Law::None,
-            approach_check: false,
-        };
+        let open = Contact::OPEN;
         c.topology
             .add_crack("h".into(), open, None, 7, &tris, &front);
         let rim = (0..6).map(|i| {

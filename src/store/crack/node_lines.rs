@@ -75,16 +75,13 @@ fn node_line<D: Dim>(geom: &GridGeom<D>, p: D::Vec, a: usize) -> Option<i64> {
 mod tests {
     use super::*;
     use crate::base::dim::D2;
-    use crate::store::crack::{Contact, Law};
+    use crate::store::crack::Contact;
     use glam::DVec2;
 
     /// A straight crack of ten segments along y = `y` in a grid of 1 mm cells from -2 mm.
     fn line(y: f64) -> Cracks<D2> {
         let mut c = Cracks::<D2>::default();
-        let open = Contact {
-            law: Law::None,
-            approach_check: false,
-        };
+        let open = Contact::OPEN;
         let segments: Vec<[u32; 2]> = (0..10).map(|k| [k, k + 1]).collect();
         c.topology
             .add_crack("c".into(), open, None, 11, &segments, &[]);

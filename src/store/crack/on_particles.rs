@@ -40,13 +40,8 @@ pub fn particles_on<D: Dim>(
 mod tests {
     use super::*;
     use crate::base::dim::{D2, D3};
-    use crate::store::crack::{Contact, Law};
+    use crate::store::crack::Contact;
     use glam::{DVec2, DVec3};
-
-    const OPEN: Contact = Contact {
-        law: Law::None,
-        approach_check: false,
-    };
 
     /// Particles at the quarter points of 1 mm cells, x and y in 0..10 mm.
     fn lattice() -> Vec<DVec2> {
@@ -60,7 +55,7 @@ mod tests {
         let mut c = Cracks::<D2>::default();
         let segments: Vec<[u32; 2]> = (0..4).map(|k| [k, k + 1]).collect();
         c.topology
-            .add_crack("c".into(), OPEN, None, 5, &segments, &[]);
+            .add_crack("c".into(), Contact::OPEN, None, 5, &segments, &[]);
         c.geometry.x = (0..5)
             .map(|k| DVec2::new(1e-3 + 2e-3 * k as f64, y))
             .collect();
@@ -85,7 +80,7 @@ mod tests {
     fn an_oblique_triangle_holds_the_centres_on_its_plane() {
         let mut c = Cracks::<D3>::default();
         c.topology
-            .add_crack("t".into(), OPEN, None, 3, &[[0, 1, 2]], &[]);
+            .add_crack("t".into(), Contact::OPEN, None, 3, &[[0, 1, 2]], &[]);
         c.geometry.x = vec![
             DVec3::new(0.0, 5e-3, 0.0),
             DVec3::new(5e-3, 0.0, 0.0),

@@ -106,21 +106,22 @@ pub fn tips_on_lines<D: Dim>(
 mod tests {
     use super::*;
     use crate::base::dim::{D2, D3};
-    use crate::store::crack::{Contact, Law};
+    use crate::store::crack::Contact;
     use glam::{DVec2, DVec3};
-
-    const OPEN: Contact = Contact {
-        law: Law::None,
-        approach_check: false,
-    };
 
     /// A 2D crack along y = 4.5 mm from x = 1 mm to a tip at `tip` (mm), and the grid of 1
     /// mm cells from the origin with two particles per cell per axis (at the quarter
     /// points, half-width a quarter cell).
     fn scene(tip: f64) -> (Cracks<D2>, Vec<DVec2>, Vec<DVec2>, GridGeom<D2>) {
         let mut c = Cracks::<D2>::default();
-        c.topology
-            .add_crack("c".into(), OPEN, None, 2, &[[0, 1]], &[(1, vec![1])]);
+        c.topology.add_crack(
+            "c".into(),
+            Contact::OPEN,
+            None,
+            2,
+            &[[0, 1]],
+            &[(1, vec![1])],
+        );
         c.geometry.x = vec![DVec2::new(1e-3, 4.5e-3), DVec2::new(tip * 1e-3, 4.5e-3)];
         let x: Vec<DVec2> = (0..20)
             .flat_map(|j| (0..20).map(move |i| DVec2::new(i as f64, j as f64) * 5e-4 + 2.5e-4))
@@ -151,8 +152,14 @@ mod tests {
     #[test]
     fn a_front_edge_through_cell_centres_is_found() {
         let mut c = Cracks::<D3>::default();
-        c.topology
-            .add_crack("c".into(), OPEN, None, 3, &[[0, 1, 2]], &[(0, vec![1, 2])]);
+        c.topology.add_crack(
+            "c".into(),
+            Contact::OPEN,
+            None,
+            3,
+            &[[0, 1, 2]],
+            &[(0, vec![1, 2])],
+        );
         c.geometry.x = vec![
             DVec3::new(1e-3, 4.5e-3, 5e-3),
             DVec3::new(5.5e-3, 4.5e-3, 0.0),
