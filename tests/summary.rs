@@ -75,25 +75,34 @@ fn a_crack_on_a_node_row_is_reported() {
     assert!(n.at.abs() < 1e-12, "{}", n.at);
 }
 
+/// A 32 x 8 mm plane-stress strip at rest in 1 mm cells with a centre crack of half-length
+/// `half` (m) along y = 6.5 mm, tips at both ends, run for `duration` (s), then `rest`.
+fn centre_crack(half: f64, duration: f64, rest: &str) -> String {
+    common::strip_2d(
+        "plane = \"stress\"",
+        duration,
+        &format!(
+            "[[body]]\nmaterial = \"m\"\nbox = {{ min = [0.004, 0.002], max = [0.036, 0.010] }}\n\
+             velocity = [0.0, 0.0]\n[[crack]]\nname = \"c\"\n\
+             line = {{ start = [{:.4}, 0.0065], end = [{:.4}, 0.0065], spacing = 5e-4 }}\n\
+             tips = [\"start\", \"end\"]\n{rest}",
+            0.02 - half,
+            0.02 + half
+        ),
+    )
+}
+
 /// A centre crack 0.4 mm long in 1 mm cells lies inside the 3-cell contour of each of its
 /// tips, so neither gets J: summary.json names both tips; a 20 mm crack gets J at both
 /// and nothing is reported.
 #[test]
 fn a_crack_inside_its_contour_is_reported() {
     let scene = |half: f64| {
-        common::strip_2d(
-            "plane = \"stress\"",
+        centre_crack(
+            half,
             2e-6,
-            &format!(
-                "[[body]]\nmaterial = \"m\"\nbox = {{ min = [0.004, 0.002], max = [0.036, 0.010] }}\n\
-                 velocity = [0.0, 0.0]\n[[crack]]\nname = \"c\"\n\
-                 line = {{ start = [{:.4}, 0.0065], end = [{:.4}, 0.0065], spacing = 5e-4 }}\n\
-                 tips = [\"start\", \"end\"]\n[[load]]\n\
-                 region = {{ min = [0.004, 0.0095], max = [0.036, 0.010] }}\nforce = [0.0, 1000.0]\n\
-                 [fracture]\ncontour = 3\n[output]\nhistory_interval = 1e-6\n",
-                0.02 - half,
-                0.02 + half
-            ),
+            "[[load]]\nregion = { min = [0.004, 0.0095], max = [0.036, 0.010] }\n\
+             force = [0.0, 1000.0]\n[fracture]\ncontour = 3\n[output]\nhistory_interval = 1e-6\n",
         )
     };
     let tiny = run_text(&scene(2e-4)).summary.contours;
@@ -128,20 +137,7 @@ fn a_boundary_driving_both_sides_of_a_crack_is_reported() {
 /// 0.1 mm further out, none.
 #[test]
 fn a_tip_on_particle_node_lines_is_reported() {
-    let scene = |half: f64| {
-        common::strip_2d(
-            "plane = \"stress\"",
-            1e-7,
-            &format!(
-                "[[body]]\nmaterial = \"m\"\nbox = {{ min = [0.004, 0.002], max = [0.036, 0.010] }}\n\
-                 [[crack]]\nname = \"c\"\n\
-                 line = {{ start = [{:.4}, 0.0065], end = [{:.4}, 0.0065], spacing = 5e-4 }}\n\
-                 tips = [\"start\", \"end\"]\n",
-                0.02 - half,
-                0.02 + half
-            ),
-        )
-    };
+    let scene = |half: f64| centre_crack(half, 1e-7, "");
     let on = run_text(&scene(0.0035)).summary.tips_on_lines;
     let found: Vec<(&str, usize)> = on.iter().map(|t| (t.crack.as_str(), t.lines)).collect();
     assert_eq!(found, [("c", 8)]);
