@@ -6,8 +6,6 @@ use super::history::{
 };
 use super::probe::Probe;
 use crate::fracture::eta::EtaEstimate;
-#[cfg(test)]
-use crate::fracture::plan::PathResult;
 use crate::fracture::plan::TipResult;
 use crate::physics::growth::GrowthRow;
 use glam::DVec3;
@@ -144,8 +142,9 @@ pub enum Measure {
     },
     /// The interaction integral's energy release rate against J at a 2D tip at rest: the
     /// largest |G_int(t) - J(t).t| over the largest |J(t).t| from `from` on, with G_int =
-    /// (K_I^2 + K_II^2) / E' (Irwin 1957) and t the tip's unit direction. The two are
-    /// independent estimates of one G, so their gap is a measure of both one's errors.
+    /// (K_I^2 + K_II^2) / E' (Irwin 1957) and t the tip's unit direction (its end segment as
+    /// given). The two are independent estimates of one G: their gap shows their
+    /// discretisation errors together.
     GInteraction {
         /// Crack index.
         crack: u32,
@@ -534,6 +533,7 @@ fn nearest_row(rows: &[&TipResult], p: [f64; 3]) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fracture::plan::PathResult;
 
     /// `final` at a time reads the last sample at or before it; before the first sample
     /// there is none.
