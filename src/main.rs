@@ -191,6 +191,9 @@ fn cmd_sweep(
                 for note in tip_line_notes(&s.tips_on_lines) {
                     println!("  warning: {note}");
                 }
+                for note in split_boundary_notes(&s.split_boundaries) {
+                    println!("  warning: {note}");
+                }
             }
             (None, Some(e)) => println!("[{k}/{n}] {what}: {e}"),
             (None, None) => {}
@@ -314,13 +317,8 @@ fn finish(o: &Outcome, out: &Path) -> ExitCode {
     for note in tip_line_notes(&s.tips_on_lines) {
         println!("  note: {note}");
     }
-    for b in &s.split_boundaries {
-        println!(
-            "  note: boundary[{}] prescribes {} node(s) whose support a crack cut at the last \
-             step: it drives the material on both sides of the crack there (to drive one \
-             side only, stop its region one node row short of the crack)",
-            b.boundary, b.nodes
-        );
+    for note in split_boundary_notes(&s.split_boundaries) {
+        println!("  note: {note}");
     }
     if let Some(note) = ignored_note(&s.ignored_keys) {
         println!("  note: {note}");
@@ -704,6 +702,23 @@ fn on_particle_notes(on: &[fissure::io::output::summary::ParticlesOnReport]) -> 
                  of it, and J and K with it (a few %); set it a fraction of a particle \
                  spacing off them",
                 o.crack, o.particles
+            )
+        })
+        .collect()
+}
+
+/// What the launcher says of each boundary that drove nodes with a field per crack side.
+fn split_boundary_notes(
+    split: &[fissure::io::output::summary::SplitBoundaryReport],
+) -> Vec<String> {
+    split
+        .iter()
+        .map(|b| {
+            format!(
+                "boundary[{}] prescribes {} node(s) whose support a crack cut at the last \
+                 step: it drives the material on both sides of the crack there (to drive \
+                 one side only, stop its region one node row short of the crack)",
+                b.boundary, b.nodes
             )
         })
         .collect()
