@@ -116,7 +116,8 @@ fn a_crack_inside_its_contour_is_reported() {
 /// The struck edge of `edge_impact_2d` at 1 mm cells: a region reaching the node row at
 /// y = -0.5 mm, whose supports the crack at y = 0 cuts, prescribes some of that row's nodes
 /// with a field per side (at most the row's three nodes at x = -2, -1 and 0 mm), and
-/// summary.json says so; stopped at y = -1 mm, it drives none.
+/// summary.json says so; stopped at y = -1 mm, it drives none; held still instead of
+/// moving (as a symmetry plane or a grip is), it is not listed.
 #[test]
 fn a_boundary_driving_both_sides_of_a_crack_is_reported() {
     let text = std::fs::read_to_string("scenarios/edge_impact_2d.toml").unwrap();
@@ -128,6 +129,9 @@ fn a_boundary_driving_both_sides_of_a_crack_is_reported() {
     let short = text.replace("max = [0.0, -0.0005] }", "max = [0.0, -0.001] }");
     assert_ne!(short, text);
     assert!(run_text(&short).summary.split_boundaries.is_empty());
+    let still = text.replace("velocity = [16.5, 0.0]", "velocity = [0.0, 0.0]");
+    assert_ne!(still, text);
+    assert!(run_text(&still).summary.split_boundaries.is_empty());
 }
 
 /// A centre crack along a row of cell centres (y = 6.5 mm, 1 mm cells, particles at the

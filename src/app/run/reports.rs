@@ -195,14 +195,19 @@ pub(super) fn growth<D: Dim>(world: &World<D>) -> Vec<GrowthReport> {
         .collect()
 }
 
-/// The velocity boundaries with nodes that carried a field per crack side at the last step
-/// (a boundary prescribes every field of its nodes).
+/// The moving velocity boundaries with nodes that carried a field per crack side at the
+/// last step (a boundary prescribes every field of its nodes). A still one is left out: a
+/// symmetry plane or a grip holding both faces is what it is meant to do.
 pub(super) fn split_boundaries<D: Dim>(world: &World<D>) -> Vec<SplitBoundaryReport> {
     let Some(cracks) = &world.cracks else {
         return Vec::new();
     };
     let fields = &cracks.scratch.fields;
+    let moving = |bc: &&crate::physics::loads::VelocityBc<D>| {
+        (0..D::D).any(|a| bc.axes[a] && bc.velocity[a] != 0.0)
+    };
     (world.bcs.iter().enumerate())
+        .filter(|(_, bc)| moving(bc))
         .map(|(boundary, bc)| {
             let split = |n: &&u32| !fields.rows_of(**n).is_empty();
             let nodes = bc.nodes.iter().filter(split).count();

@@ -91,8 +91,8 @@ pub struct Summary {
     /// Cracks whose tips (2D) or front edges (3D) lay on a line from a particle to a node
     /// of its stencil when the run began.
     pub tips_on_lines: Vec<TipLinesReport>,
-    /// Velocity boundaries with nodes whose support a crack cut at the last step: they
-    /// drive the material on both sides of the crack there.
+    /// Moving velocity boundaries with nodes whose support a crack cut at the last step:
+    /// they drive the material on both sides of the crack there.
     pub split_boundaries: Vec<SplitBoundaryReport>,
     /// Energies at the end (J).
     pub energies: Energies,
