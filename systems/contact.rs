@@ -6,6 +6,7 @@
 //! booked as work.
 
 use crate::base::dim::Dim;
+use crate::base::exact_sum::ExactSum;
 use crate::base::geometry::Element;
 use crate::physics::shape::Stencil;
 use crate::store::crack::{COLORS, Cracks, ElementBins, Law};
@@ -131,7 +132,7 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
     }
     let h = D::to_xyz(g.geom.h);
     let cell = std::array::from_fn(|k| if k < D::D { h[k] } else { 1.0 });
-    let mut friction = 0.0;
+    let mut friction = ExactSum::new();
     for (r, normal_r) in normals.iter_mut().enumerate() {
         let mask = f.mask[r];
         if mask.count_ones() != 1 {
@@ -179,7 +180,11 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
         }
         let dp = contact.law.momentum_change::<D>(ma, va, mb, vb, nrm);
         if let Law::Coulomb(_) = contact.law {
-            friction += friction_work::<D>(dp, va + dp * (1.0 / ma) - (vb - dp * (1.0 / mb)), nrm);
+            friction.add(friction_work::<D>(
+                dp,
+                va + dp * (1.0 / ma) - (vb - dp * (1.0 / mb)),
+                nrm,
+            ));
         }
         if update {
             g.velocity[a] += dp * (1.0 / ma);
@@ -197,7 +202,7 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
     if !update {
         cracks.scratch.contact_dp = changes;
     }
-    world.work.friction += friction;
+    world.work.friction += friction.value();
 }
 
 /// The energy friction dissipates at a contact row: its tangential impulse against the

@@ -2,6 +2,7 @@
 //! `g2p_remap`, the same followed by the momentum remap of USL and USAVG.
 
 use crate::base::dim::Dim;
+use crate::base::exact_sum::ExactSum;
 use crate::physics::shape::{Rows, Stencil};
 use crate::store::disjoint::Disjoint;
 use crate::store::particles::Particles;
@@ -196,7 +197,7 @@ fn load_work_end<D: Dim>(world: &mut World<D>) {
     let shape = world.settings.shape;
     let grid = &world.grid;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
-    let mut work = 0.0;
+    let mut work = ExactSum::new();
     for load in &world.loads {
         let scale = load.time.at(t);
         for (&i, &f) in load.particles.iter().zip(&load.forces) {
@@ -213,8 +214,8 @@ fn load_work_end<D: Dim>(world: &mut World<D>) {
                     }),
                 }
             });
-            work += dt * scale * D::dot(f, vn);
+            work.add(dt * scale * D::dot(f, vn));
         }
     }
-    world.work.external += work;
+    world.work.external += work.value();
 }

@@ -2,6 +2,7 @@
 //! (Guo & Nairn 2D (2004) Eq. 5), gravity and prescribed velocities.
 
 use crate::base::dim::Dim;
+use crate::base::exact_sum::ExactSum;
 use crate::store::crack::Fields;
 use crate::store::grid::Grid;
 use crate::store::world::{CHUNK, World};
@@ -43,11 +44,12 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         ..
     } = &mut world.grid;
     let (mass, momentum, force) = (&*mass, &*momentum, &*force);
-    let sums: Vec<(f64, f64)> = (velocity.par_chunks_mut(CHUNK), accel.par_chunks_mut(CHUNK))
+    let (damped, weighed) = (alpha != 0.0, D::dot(gravity, gravity) != 0.0);
+    let [mut damp, mut grav] = (velocity.par_chunks_mut(CHUNK), accel.par_chunks_mut(CHUNK))
         .into_par_iter()
         .enumerate()
         .map(|(c, (vel, acc))| {
-            let (mut damp, mut grav) = (0.0, 0.0);
+            let [mut damp, mut grav] = [ExactSum::new(), ExactSum::new()];
             for k in 0..vel.len() {
                 let n = c * CHUNK + k;
                 let m = mass[n];
@@ -57,8 +59,13 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                     let a = f * (1.0 / m);
                     let v1 = v0 + a * dt;
                     let vmid = (v0 + v1) * 0.5;
-                    damp += alpha * D::dot(momentum[n], vmid) * dt;
-                    grav += m * D::dot(gravity, vmid) * dt;
+                    // Zero terms are skipped: an undamped, weightless scene pays nothing.
+                    if damped {
+                        damp.add(alpha * D::dot(momentum[n], vmid) * dt);
+                    }
+                    if weighed {
+                        grav.add(m * D::dot(gravity, vmid) * dt);
+                    }
                     vel[k] = v1;
                     acc[k] = a;
                 } else {
@@ -66,25 +73,21 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                     acc[k] = D::zero();
                 }
             }
-            (damp, grav)
+            [damp, grav]
         })
-        .collect();
-    for (damp, grav) in sums {
-        world.work.damping += damp;
-        world.work.external += grav;
-    }
+        .reduce(Default::default, |[mut d, mut g], [d2, g2]| {
+            d.merge(&d2);
+            g.merge(&g2);
+            [d, g]
+        });
     if let Some(c) = world.cracks.as_ref() {
-        merge_slivers(
-            &mut world.grid,
-            &mut world.work,
-            &c.scratch.fields,
-            &world.settings,
-        );
+        let work = [&mut damp, &mut grav];
+        merge_slivers(&mut world.grid, work, &c.scratch.fields, &world.settings);
     }
+    world.work.damping += damp.value();
     let t1 = world.time + dt;
     let g = &mut world.grid;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
-    let mut work = 0.0;
     for bc in &mut world.bcs {
         for k in 0..bc.nodes.len() {
             let (node, mut reaction) = (bc.nodes[k], D::zero());
@@ -102,7 +105,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                         let a_bc = (v1 - v0[a]) / dt;
                         let r = m * (a_bc - g.accel[n][a]);
                         reaction[a] += r;
-                        work += r * 0.5 * (v0[a] + v1) * dt;
+                        grav.add(r * 0.5 * (v0[a] + v1) * dt);
                         g.velocity[n][a] = v1;
                         g.accel[n][a] = a_bc;
                     }
@@ -111,7 +114,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             bc.reaction[k] = reaction;
         }
     }
-    world.work.external += work;
+    world.work.external += grav.value();
 }
 
 /// A node's crack field that holds a sliver of mass (at most `sliver_mass`: a particle
@@ -124,7 +127,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
 /// of a particle's share at most.
 fn merge_slivers<D: Dim>(
     grid: &mut Grid<D>,
-    work: &mut crate::store::world::Work,
+    [damping, external]: [&mut ExactSum; 2],
     fields: &Fields,
     settings: &crate::store::world::Settings<D>,
 ) {
@@ -149,8 +152,8 @@ fn merge_slivers<D: Dim>(
             // Take back the damping and gravity work booked for the entry alone.
             let (m0, p0) = (grid.mass[n], grid.momentum[n]);
             let vmid = p0 * (1.0 / m0) + grid.accel[n] * (0.5 * dt);
-            work.damping -= alpha * D::dot(p0, vmid) * dt;
-            work.external -= m0 * D::dot(gravity, vmid) * dt;
+            damping.add(-alpha * D::dot(p0, vmid) * dt);
+            external.add(-m0 * D::dot(gravity, vmid) * dt);
             m += m0;
             p += p0;
             f += grid.force[n];
@@ -158,8 +161,8 @@ fn merge_slivers<D: Dim>(
         let a = (f - p * alpha + gravity * m) * (1.0 / m);
         let v1 = p * (1.0 / m) + a * dt;
         let vmid = p * (1.0 / m) + a * (0.5 * dt);
-        work.damping += alpha * D::dot(p, vmid) * dt;
-        work.external += m * D::dot(gravity, vmid) * dt;
+        damping.add(alpha * D::dot(p, vmid) * dt);
+        external.add(m * D::dot(gravity, vmid) * dt);
         for n in group().filter(|&n| n == heavy || light(n)) {
             grid.velocity[n] = v1;
             grid.accel[n] = a;

@@ -5,5 +5,6 @@
 pub mod columnar;
 pub mod dim;
 pub mod error;
+pub mod exact_sum;
 pub mod geometry;
 pub mod sym;

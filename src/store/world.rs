@@ -1,6 +1,7 @@
 //! The World: every store, the materials, the scene settings, time and step. Nothing global.
 
 use crate::base::dim::Dim;
+use crate::base::exact_sum::ExactSum;
 use crate::base::sym::SymTensor;
 use crate::physics::loads::{Load, VelocityBc};
 use crate::physics::material::{Material, Plane};
@@ -167,24 +168,27 @@ impl<D: Dim> World<D> {
     pub fn energies(&self) -> Energies {
         let p = &self.particles;
         let mats = &self.materials;
-        let parts: Vec<[f64; 3]> = (0..p.len().div_ceil(CHUNK))
+        // Exact sums: the energies do not depend on how the particles are split up.
+        let [k, w, wp] = (0..p.len().div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
-                let (mut k, mut w, mut wp) = (0.0, 0.0, 0.0);
+                let mut s: [ExactSum; 3] = Default::default();
                 for i in c * CHUNK..((c + 1) * CHUNK).min(p.len()) {
-                    k += 0.5 * p.mass[i] * D::dot(p.v[i], p.v[i]);
-                    w += p.volume[i]
-                        * mats[p.material[i] as usize].energy_density(&p.stress[i].to_sym3());
-                    wp += p.volume[i] * p.plastic_work(i);
+                    s[0].add(0.5 * p.mass[i] * D::dot(p.v[i], p.v[i]));
+                    s[1].add(
+                        p.volume[i]
+                            * mats[p.material[i] as usize].energy_density(&p.stress[i].to_sym3()),
+                    );
+                    s[2].add(p.volume[i] * p.plastic_work(i));
                 }
-                [k, w, wp]
+                s
             })
-            .collect();
-        let sum = |k: usize| parts.iter().map(|p| p[k]).sum();
+            .reduce(Default::default, merge3)
+            .map(|s| s.value());
         Energies {
-            kinetic: sum(0),
-            strain: sum(1),
-            plastic_work: sum(2),
+            kinetic: k,
+            strain: w,
+            plastic_work: wp,
             external_work: self.work.external,
             damping_work: self.work.damping,
             friction_work: self.work.friction,
@@ -216,26 +220,35 @@ impl<D: Dim> World<D> {
         self.particles.bytes_per_particle() + 8 + 4 + 8 * params
     }
 
-    /// Total linear momentum (kg m/s).
+    /// Total linear momentum (kg m/s), summed exactly.
     pub fn momentum(&self) -> D::Vec {
         let p = &self.particles;
         let mut m = D::zero();
-        for i in 0..p.len() {
-            m += p.v[i] * p.mass[i];
+        for a in 0..D::D {
+            m[a] = ExactSum::of((0..p.len()).map(|i| p.v[i][a] * p.mass[i]));
         }
         m
     }
 
-    /// Total angular momentum about `centre` (kg m^2/s), padded to 3 components.
+    /// Total angular momentum about `centre` (kg m^2/s), padded to 3 components, summed
+    /// exactly.
     pub fn angular_momentum(&self, centre: D::Vec) -> [f64; 3] {
         let p = &self.particles;
-        let mut l = [0.0; 3];
+        let mut l: [ExactSum; 3] = Default::default();
         for i in 0..p.len() {
             let c = D::cross(p.x[i] - centre, p.v[i] * p.mass[i]);
             for a in 0..3 {
-                l[a] += c[a];
+                l[a].add(c[a]);
             }
         }
-        l
+        l.map(|s| s.value())
     }
+}
+
+/// Merges three exact sums pairwise.
+fn merge3(mut a: [ExactSum; 3], b: [ExactSum; 3]) -> [ExactSum; 3] {
+    for (a, b) in a.iter_mut().zip(&b) {
+        a.merge(b);
+    }
+    a
 }
