@@ -17,6 +17,7 @@ pub mod fracture;
 pub mod io;
 pub mod physics;
 pub mod pipeline;
+pub mod ranks;
 pub mod record;
 pub mod store;
 

@@ -11,6 +11,7 @@ use fissure::io::output::summary::{Status, Summary};
 use fissure::io::scenario::{Source, build, folder_name_problem};
 use fissure::io::snapshot::{Reader, SnapshotError};
 use fissure::pipeline::schedule::Schedule;
+use fissure::ranks::comm::start;
 use fissure::record::expect::ExpectResult;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -400,17 +401,26 @@ fn cmd_run(
         Err(e) => return bad_input(&e),
     };
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(src.name()));
+    // Under mpirun: one process per rank, the first one writing and reporting.
+    let (comm, _mpi) = match start() {
+        Ok(c) => c,
+        Err(e) => return report(e),
+    };
+    let root = comm.is_root();
     let opts = RunOptions {
         out: Some(out.clone()),
         threads,
-        progress: true,
+        progress: root,
         until,
         pause_after: None,
         stop: Some(stop_flag(StopRequests::new(&out), AFTER_THIS_STEP)),
+        comm,
     };
     match run(&src, &opts) {
-        Ok(o) => finish(&o, &out),
-        Err(e) => report(e),
+        Ok(o) if root => finish(&o, &out),
+        Err(e) if root => report(e),
+        Ok(_) => ExitCode::SUCCESS,
+        Err(_) => ExitCode::FAILURE,
     }
 }
 
@@ -422,6 +432,15 @@ fn cmd_resume(path: &Path, out: Option<PathBuf>, threads: usize, until: Option<f
             Err(e) => return report(e),
         },
     };
+    match start() {
+        Ok((c, _)) if c.is_split() => {
+            return report(anyhow::anyhow!(
+                "resuming on more than one MPI rank is not yet supported: resume without mpirun"
+            ));
+        }
+        Ok(_) => {}
+        Err(e) => return report(e),
+    }
     let opts = RunOptions {
         out: Some(out.clone()),
         threads,
@@ -429,6 +448,7 @@ fn cmd_resume(path: &Path, out: Option<PathBuf>, threads: usize, until: Option<f
         until,
         pause_after: None,
         stop: Some(stop_flag(StopRequests::new(&out), AFTER_THIS_STEP)),
+        comm: Default::default(),
     };
     match resume(path, &opts) {
         Ok(o) => finish(&o, &out),

@@ -4,6 +4,7 @@
 use crate::base::dim::Dim;
 use crate::base::exact_sum::ExactSum;
 use crate::physics::shape::{Rows, Stencil};
+use crate::ranks::ABSENT;
 use crate::store::disjoint::Disjoint;
 use crate::store::particles::Particles;
 use crate::store::world::{CHUNK, World};
@@ -69,28 +70,31 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
         Disjoint::new(&mut grid.momentum),
     );
     let stride = &grid.geom.stride;
-    let fastest = tiles.max_coloured(|t| {
-        let mut fastest = 0.0f64;
-        let free = tiles.particles(t).iter().map(|&i| i as usize);
-        for_each_free_particle!(D, shape, &tiles.stencils, fields, free, |i, st| {
-            let rows = st.rows::<D>(stride);
-            let (dv, vn) = gather::<D, N>(&st, &rows, nodal);
-            // SAFETY: every particle is in exactly one tile and each tile is handled by one
-            // thread, so no other thread touches particle i's entries; tiles of one colour
-            // class touch disjoint nodes (tiles.rs).
-            unsafe {
-                let v = flip::<D>(v_w.get(i), dv, vn, dt, alpha);
-                v_w.set(i, v);
-                x_w.set(i, x_w.get(i) + vn * dt);
-                let mv = v * pmass[i];
-                momentum_w.add_weighted::<N>(&rows, &st.w[0], mv);
-            }
-            if track {
-                fastest = fastest.max(D::dot(vn, vn));
-            }
-        });
-        fastest
-    });
+    let fastest = tiles.max_coloured_then(
+        |t| {
+            let mut fastest = 0.0f64;
+            let free = tiles.particles(t).iter().map(|&i| i as usize);
+            for_each_free_particle!(D, shape, &tiles.stencils, fields, free, |i, st| {
+                let rows = st.rows::<D>(stride);
+                let (dv, vn) = gather::<D, N>(&st, &rows, nodal);
+                // SAFETY: every particle is in exactly one tile and each tile is handled by one
+                // thread, so no other thread touches particle i's entries; tiles of one colour
+                // class touch disjoint nodes (tiles.rs).
+                unsafe {
+                    let v = flip::<D>(v_w.get(i), dv, vn, dt, alpha);
+                    v_w.set(i, v);
+                    x_w.set(i, x_w.get(i) + vn * dt);
+                    let mv = v * pmass[i];
+                    momentum_w.add_weighted::<N>(&rows, &st.w[0], mv);
+                }
+                if track {
+                    fastest = fastest.max(D::dot(vn, vn));
+                }
+            });
+            fastest
+        },
+        |c| world.domain.settle(c, &[&momentum_w]),
+    );
     let fastest = fastest.max(move_coded(world));
     if let Some(c) = world.cracks.as_ref() {
         let p = &world.particles;
@@ -201,6 +205,9 @@ fn load_work_end<D: Dim>(world: &mut World<D>) {
     for load in &world.loads {
         let scale = load.time.at(t);
         for (&i, &f) in load.particles.iter().zip(&load.forces) {
+            if i == ABSENT {
+                continue;
+            }
             let i = i as usize;
             let mut vn = D::zero();
             with_shape!(shape, S, N => {
@@ -217,5 +224,6 @@ fn load_work_end<D: Dim>(world: &mut World<D>) {
             work.add(dt * scale * D::dot(f, vn));
         }
     }
+    world.domain.sum(std::slice::from_mut(&mut work));
     world.work.external += work.value();
 }

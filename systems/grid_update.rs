@@ -45,6 +45,8 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     } = &mut world.grid;
     let (mass, momentum, force) = (&*mass, &*momentum, &*force);
     let (damped, weighed) = (alpha != 0.0, D::dot(gravity, gravity) != 0.0);
+    // Split across ranks, each node's work is booked by the rank that owns it.
+    let owned = world.domain.partition.as_ref().map(|p| &p.owned_nodes);
     let [mut damp, mut grav] = (velocity.par_chunks_mut(CHUNK), accel.par_chunks_mut(CHUNK))
         .into_par_iter()
         .enumerate()
@@ -60,10 +62,11 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                     let v1 = v0 + a * dt;
                     let vmid = (v0 + v1) * 0.5;
                     // Zero terms are skipped: an undamped, weightless scene pays nothing.
-                    if damped {
+                    let books = owned.is_none_or(|o| o[n]);
+                    if damped && books {
                         damp.add(alpha * D::dot(momentum[n], vmid) * dt);
                     }
-                    if weighed {
+                    if weighed && books {
                         grav.add(m * D::dot(gravity, vmid) * dt);
                     }
                     vel[k] = v1;
@@ -84,7 +87,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         let work = [&mut damp, &mut grav];
         merge_slivers(&mut world.grid, work, &c.scratch.fields, &world.settings);
     }
-    world.work.damping += damp.value();
+    let domain = &world.domain;
     let t1 = world.time + dt;
     let g = &mut world.grid;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
@@ -96,6 +99,8 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                 if m <= tol {
                     continue;
                 }
+                // Every rank holding the node sets it; its owner books the reaction.
+                let books = domain.owns_node(node as usize);
                 let v0 = g.momentum[n] * (1.0 / m);
                 for a in 0..D::D {
                     if bc.axes[a] {
@@ -104,8 +109,10 @@ pub fn run<D: Dim>(world: &mut World<D>) {
                         let v1 = bc.value(a, t1);
                         let a_bc = (v1 - v0[a]) / dt;
                         let r = m * (a_bc - g.accel[n][a]);
-                        reaction[a] += r;
-                        grav.add(r * 0.5 * (v0[a] + v1) * dt);
+                        if books {
+                            reaction[a] += r;
+                            grav.add(r * 0.5 * (v0[a] + v1) * dt);
+                        }
                         g.velocity[n][a] = v1;
                         g.accel[n][a] = a_bc;
                     }
@@ -114,7 +121,10 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             bc.reaction[k] = reaction;
         }
     }
-    world.work.external += grav.value();
+    let mut sums = [damp, grav];
+    domain.sum(&mut sums);
+    world.work.damping += sums[0].value();
+    world.work.external += sums[1].value();
 }
 
 /// A node's crack field that holds a sliver of mass (at most `sliver_mass`: a particle

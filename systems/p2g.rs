@@ -3,6 +3,7 @@
 
 use crate::base::dim::Dim;
 use crate::physics::shape::{Rows, ShapeKind, Stencil, StencilCache};
+use crate::ranks::ABSENT;
 use crate::store::crack::Fields;
 use crate::store::disjoint::Disjoint;
 use crate::store::grid::Grid;
@@ -50,26 +51,35 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
     let shape = world.settings.shape;
     let geom = &grid.geom;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
-    let tiles = &world.tiles;
-    tiles.for_each_coloured(|t| {
-        let free = tiles.particles(t).iter().map(|&i| i as usize);
-        for_each_free_particle!(D, shape, &tiles.stencils, fields, free, |i, st| {
-            let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
-            let rows = st.rows::<D>(&geom.stride);
-            // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
-            // tile is handled by one thread.
-            unsafe {
-                mass_w.add_weighted::<N>(&rows, &st.w[0], m);
-                momentum_w.add_weighted::<N>(&rows, &st.w[0], mv);
-            }
-            if FORCE {
-                // SAFETY: as above.
+    let (tiles, domain) = (&world.tiles, &world.domain);
+    tiles.for_each_coloured_then(
+        |t| {
+            let free = tiles.particles(t).iter().map(|&i| i as usize);
+            for_each_free_particle!(D, shape, &tiles.stencils, fields, free, |i, st| {
+                let (m, mv) = (p.mass[i], p.v[i] * p.mass[i]);
+                let rows = st.rows::<D>(&geom.stride);
+                // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
+                // tile is handled by one thread.
                 unsafe {
-                    add_internal_force::<D, N>(&st, &rows, &p.stress[i], p.volume[i], &force_w)
-                };
+                    mass_w.add_weighted::<N>(&rows, &st.w[0], m);
+                    momentum_w.add_weighted::<N>(&rows, &st.w[0], mv);
+                }
+                if FORCE {
+                    // SAFETY: as above.
+                    unsafe {
+                        add_internal_force::<D, N>(&st, &rows, &p.stress[i], p.volume[i], &force_w)
+                    };
+                }
+            })
+        },
+        |c| {
+            if FORCE {
+                domain.settle(c, &[&mass_w, &momentum_w, &force_w]);
+            } else {
+                domain.settle(c, &[&mass_w, &momentum_w]);
             }
-        })
-    });
+        },
+    );
     if let Some(f) = fields {
         scatter_coded::<D, true, true, FORCE>(f, p, shape, &world.tiles.stencils, grid);
     }
@@ -138,15 +148,66 @@ pub(crate) fn scatter_coded<D: Dim, const MASS: bool, const MOMENTUM: bool, cons
 }
 
 /// Adds external particle forces to the grid (sequential, in load order); `g2p` books
-/// their work over the step.
+/// their work over the step. Split across ranks, every rank adds every loaded particle's
+/// share, gathered from the ranks holding them, in that same order.
 fn scatter_loads<D: Dim>(world: &mut World<D>) {
+    if world.loads.is_empty() {
+        return;
+    }
+    let shares = load_shares(world);
+    let shares = if world.domain.is_split() {
+        let mine = bytemuck::cast_slice(&shares).to_vec();
+        let mut all: Vec<LoadShare<D>> = (world.domain.comm.all_gather(mine).iter())
+            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, LoadShare<D>>(b))
+            .collect();
+        // Stable: each particle's shares stay in stencil order.
+        all.sort_by_key(|s| (s.load, s.entry));
+        all
+    } else {
+        shares
+    };
+    for s in &shares {
+        world.grid.force[s.node as usize] += s.force;
+    }
+}
+
+/// One loaded particle's force on one grid entry: load `load`'s entry `entry`.
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+struct LoadShare<D: Dim> {
+    load: u32,
+    entry: u32,
+    node: u64,
+    force: D::Vec,
+}
+
+// SAFETY: two u32, a u64 and a vector of f64 (2 or 3), with no padding and no invalid bit
+// patterns.
+unsafe impl<D: Dim> bytemuck::Zeroable for LoadShare<D> {}
+// SAFETY: as above; `D::Vec` is Pod (a DVec2 or DVec3).
+unsafe impl<D: Dim> bytemuck::Pod for LoadShare<D> {}
+
+/// The loads' shares on this rank's particles, in load, entry and stencil order.
+fn load_shares<D: Dim>(world: &World<D>) -> Vec<LoadShare<D>> {
     let t = world.time;
     let geom = &world.grid.geom;
     let shape = world.settings.shape;
-    for load in &world.loads {
+    let mut out = Vec::new();
+    for (k, load) in world.loads.iter().enumerate() {
         let scale = load.time.at(t);
-        for (&i, &f) in load.particles.iter().zip(&load.forces) {
+        for (j, (&i, &f)) in load.particles.iter().zip(&load.forces).enumerate() {
+            if i == ABSENT {
+                continue;
+            }
             let (i, f) = (i as usize, f * scale);
+            let mut share = |n: usize, w: f64| {
+                out.push(LoadShare {
+                    load: k as u32,
+                    entry: j as u32,
+                    node: n as u64,
+                    force: f * w,
+                })
+            };
             let targets = world
                 .cracks
                 .as_ref()
@@ -154,12 +215,11 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
             with_shape!(shape, S, N => {
                 let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
                 match targets {
-                    Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, w, _| {
-                        world.grid.force[n] += f * w
-                    }),
-                    None => st.for_each::<D>(&geom.stride, |n, w, _| world.grid.force[n] += f * w),
+                    Some(t) => st.for_each_target::<D>(&geom.stride, t, |n, w, _| share(n, w)),
+                    None => st.for_each::<D>(&geom.stride, |n, w, _| share(n, w)),
                 }
             });
         }
     }
+    out
 }

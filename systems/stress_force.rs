@@ -37,23 +37,26 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
         ..
     } = &mut world.particles;
     let columns = StressColumns::<D>::new(stress, grad_v, grad_u, plastic_strain, hardened);
-    let (tiles, materials) = (&world.tiles, &world.materials);
+    let (tiles, materials, domain) = (&world.tiles, &world.materials, &world.domain);
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
-    tiles.for_each_coloured(|t| {
-        let free = tiles.particles(t).iter().map(|&i| i as usize);
-        for_each_free_particle!(D, shape, &tiles.stencils, fields, free, |i, st| {
-            let rows = st.rows::<D>(stride);
-            let l = velocity_gradient::<D, N>(&st, &rows, velocity);
-            let m = &materials[material[i] as usize];
-            // SAFETY: every particle is in exactly one tile and each tile is handled by one
-            // thread, so no other thread touches particle i's entries; tiles of one colour
-            // class touch disjoint nodes (tiles.rs).
-            unsafe {
-                let s = columns.update(i, l, dt, plane, m);
-                add_internal_force::<D, N>(&st, &rows, &s, volume[i], &force_w);
-            }
-        })
-    });
+    tiles.for_each_coloured_then(
+        |t| {
+            let free = tiles.particles(t).iter().map(|&i| i as usize);
+            for_each_free_particle!(D, shape, &tiles.stencils, fields, free, |i, st| {
+                let rows = st.rows::<D>(stride);
+                let l = velocity_gradient::<D, N>(&st, &rows, velocity);
+                let m = &materials[material[i] as usize];
+                // SAFETY: every particle is in exactly one tile and each tile is handled by one
+                // thread, so no other thread touches particle i's entries; tiles of one colour
+                // class touch disjoint nodes (tiles.rs).
+                unsafe {
+                    let s = columns.update(i, l, dt, plane, m);
+                    add_internal_force::<D, N>(&st, &rows, &s, volume[i], &force_w);
+                }
+            })
+        },
+        |c| domain.settle(c, &[&force_w]),
+    );
     if world.cracks.is_some() {
         update_coded(world, dt);
         let f = &world.cracks.as_ref().expect("cracks").scratch.fields;

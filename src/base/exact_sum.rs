@@ -101,6 +101,26 @@ impl ExactSum {
         s.value()
     }
 
+    /// The carried digits and the non-finite terms' sum, for adding sums held elsewhere
+    /// digit by digit (integer addition, exact in any order).
+    pub fn parts(&self) -> ([i64; DIGITS], f64) {
+        let mut s = self.clone();
+        s.carry();
+        (s.digits, s.special)
+    }
+
+    /// The sum whose digits are `digits` (sums of [`parts`](Self::parts)' digits) and
+    /// whose non-finite terms sum to `special`.
+    pub fn from_parts(digits: &[i64], special: f64) -> Self {
+        let mut s = ExactSum {
+            special,
+            ..Default::default()
+        };
+        s.digits.copy_from_slice(digits);
+        s.carry();
+        s
+    }
+
     /// Propagates carries: every digit but the last into [0, 2^32), the last signed.
     fn carry(&mut self) {
         for k in 0..DIGITS - 1 {

@@ -7,8 +7,10 @@ use num_complex::Complex64;
 /// Forces on a fixed set of particles, scaled by a time function.
 #[derive(Clone, Debug)]
 pub struct Load<D: Dim> {
-    /// Loaded particles.
+    /// Loaded particles (split across ranks: this rank's index, or `ABSENT`).
     pub particles: Vec<u32>,
+    /// Split across ranks: the loaded particles' ids in the whole scene (empty on one rank).
+    pub ids: Vec<u32>,
     /// Force on each of `particles` at full load (N).
     pub forces: Vec<D::Vec>,
     /// Time multiplier.

@@ -1,7 +1,9 @@
 //! Probes: particle averages (or a boundary's reaction) sampled every step.
 
 use crate::base::dim::Dim;
+use crate::base::exact_sum::ExactSum;
 use crate::base::sym::SymTensor;
+use crate::ranks::ABSENT;
 use crate::store::particles::Particles;
 use crate::store::world::World;
 use serde::Serialize;
@@ -38,8 +40,12 @@ pub enum ProbeQty {
 pub struct Probe {
     /// Name.
     pub name: String,
-    /// Particles averaged (none for a reaction).
+    /// Particles averaged (none for a reaction; split across ranks: this rank's index, or
+    /// `ABSENT`).
     pub particles: Vec<u32>,
+    /// Split across ranks: the averaged particles' ids in the whole scene (empty on one
+    /// rank).
+    pub ids: Vec<u32>,
     /// A reaction's nodes: (index of the boundary, the node's place in its node list).
     pub supports: Vec<(u32, u32)>,
     /// Quantity.
@@ -61,14 +67,26 @@ impl Probe {
             ProbeQty::Reaction => {
                 let bcs = &world.bcs;
                 let force = |&(b, k): &(u32, u32)| bcs[b as usize].reaction[k as usize];
-                return self.supports.iter().map(force).map(|f| f[self.comp]).sum();
+                // Only the node's owner has its reaction (split across ranks).
+                let mut sum = ExactSum::new();
+                for s in &self.supports {
+                    let node = bcs[s.0 as usize].nodes[s.1 as usize] as usize;
+                    if world.domain.owns_node(node) {
+                        sum.add(force(s)[self.comp]);
+                    }
+                }
+                world.domain.sum(std::slice::from_mut(&mut sum));
+                return sum.value();
             }
             _ => {}
         }
-        let mut sum = 0.0;
+        let mut sum = ExactSum::new();
         for &i in &self.particles {
+            if i == ABSENT {
+                continue;
+            }
             let i = i as usize;
-            sum += match self.qty {
+            sum.add(match self.qty {
                 ProbeQty::Displacement => p.displacement(i)[self.comp],
                 ProbeQty::Velocity => p.v[i][self.comp],
                 ProbeQty::Position => p.x[i][self.comp],
@@ -84,9 +102,10 @@ impl Probe {
                 ProbeQty::Opening | ProbeQty::PlasticRadius | ProbeQty::Reaction => {
                     unreachable!("sampled by their own methods")
                 }
-            };
+            });
         }
-        sum / self.particles.len() as f64
+        world.domain.sum(std::slice::from_mut(&mut sum));
+        sum.value() / self.particles.len() as f64
     }
 
     /// The [`ProbeQty::Opening`] sample.

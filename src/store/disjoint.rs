@@ -6,6 +6,8 @@
 //! without atomics or locks, in a fixed order.
 
 use crate::physics::shape::Rows;
+use crate::ranks::domain::Shared;
+use bytemuck::Pod;
 use std::marker::PhantomData;
 use std::ops::{AddAssign, Mul};
 
@@ -99,5 +101,26 @@ impl<'a, T: Copy> Disjoint<'a, T> {
                 std::array::from_fn::<_, N, _>(|a| vq * w_x[a])
             })
         }
+    }
+}
+
+/// A column shared across ranks between colour classes.
+impl<T: Pod + Send> Shared for Disjoint<'_, T> {
+    fn pack(&self, nodes: &[u32], out: &mut Vec<u8>) {
+        for &n in nodes {
+            // SAFETY: called between colour classes, when no other thread writes the column.
+            let v = unsafe { self.get(n as usize) };
+            out.extend_from_slice(bytemuck::bytes_of(&v));
+        }
+    }
+
+    fn unpack(&self, nodes: &[u32], bytes: &[u8]) -> usize {
+        let size = std::mem::size_of::<T>();
+        for (k, &n) in nodes.iter().enumerate() {
+            let v: T = bytemuck::pod_read_unaligned(&bytes[k * size..(k + 1) * size]);
+            // SAFETY: as in `pack`.
+            unsafe { self.set(n as usize, v) };
+        }
+        nodes.len() * size
     }
 }

@@ -1,5 +1,6 @@
 //! Particle component store: one column per component (struct of arrays).
 
+use crate::base::columnar::Columnar;
 use crate::base::dim::Dim;
 use crate::physics::plastic::Hardened;
 
@@ -34,6 +35,15 @@ pub struct Particles<D: Dim> {
     /// Hardening state (equivalent plastic strain, yield stress, plastic work); only
     /// allocated when a material is plastic.
     pub hardened: Vec<Hardened>,
+    /// Index in the whole scene; only allocated when the scene is split across ranks,
+    /// whose stores then hold their particles in ascending id.
+    pub id: Vec<u64>,
+}
+
+/// An operation on each particle column in turn, whatever its element type.
+pub trait ColumnOp {
+    /// Applies the operation to one column (empty when the scene does not need it).
+    fn column<T: Columnar>(&mut self, col: &mut Vec<T>);
 }
 
 impl<D: Dim> Default for Particles<D> {
@@ -51,6 +61,7 @@ impl<D: Dim> Default for Particles<D> {
             grad_u: Vec::new(),
             plastic_strain: Vec::new(),
             hardened: Vec::new(),
+            id: Vec::new(),
         }
     }
 }
@@ -106,25 +117,35 @@ impl<D: Dim> Particles<D> {
         self.hardened.get(p).map_or(0.0, |h| h.work)
     }
 
-    /// Reorders every column so that new particle `k` is old particle `order[k]`.
+    /// Applies `op` to every column.
+    pub fn for_each_column(&mut self, op: &mut impl ColumnOp) {
+        op.column(&mut self.x);
+        op.column(&mut self.v);
+        op.column(&mut self.x0);
+        op.column(&mut self.mass);
+        op.column(&mut self.volume);
+        op.column(&mut self.stress);
+        op.column(&mut self.grad_v);
+        op.column(&mut self.material);
+        op.column(&mut self.half);
+        op.column(&mut self.grad_u);
+        op.column(&mut self.plastic_strain);
+        op.column(&mut self.hardened);
+        op.column(&mut self.id);
+    }
+
+    /// Reorders every column so that new particle `k` is old particle `order[k]` (a
+    /// shorter `order` drops the particles it does not name).
     pub fn permute(&mut self, order: &[u32]) {
-        fn apply<T: Copy>(col: &mut Vec<T>, order: &[u32]) {
-            if !col.is_empty() {
-                *col = order.iter().map(|&i| col[i as usize]).collect();
+        struct Permute<'a>(&'a [u32]);
+        impl ColumnOp for Permute<'_> {
+            fn column<T: Columnar>(&mut self, col: &mut Vec<T>) {
+                if !col.is_empty() {
+                    *col = self.0.iter().map(|&i| col[i as usize]).collect();
+                }
             }
         }
-        apply(&mut self.x, order);
-        apply(&mut self.v, order);
-        apply(&mut self.x0, order);
-        apply(&mut self.mass, order);
-        apply(&mut self.volume, order);
-        apply(&mut self.stress, order);
-        apply(&mut self.grad_v, order);
-        apply(&mut self.material, order);
-        apply(&mut self.half, order);
-        apply(&mut self.grad_u, order);
-        apply(&mut self.plastic_strain, order);
-        apply(&mut self.hardened, order);
+        self.for_each_column(&mut Permute(order));
     }
 
     /// Displacement of particle `p` from its initial position (m).

@@ -129,18 +129,42 @@ impl Tiles {
     /// Runs `f` on every non-empty tile: colour classes one after another, the tiles of a
     /// class in parallel. Tiles of one class never share a node.
     pub fn for_each_coloured(&self, f: impl Fn(u32) + Sync + Send) {
-        for class in &self.colours {
+        self.for_each_coloured_then(f, |_| {});
+    }
+
+    /// As [`for_each_coloured`](Self::for_each_coloured), calling `after` with each class's
+    /// number once its tiles are done (where ranks settle the nodes they share).
+    pub fn for_each_coloured_then(
+        &self,
+        f: impl Fn(u32) + Sync + Send,
+        mut after: impl FnMut(usize),
+    ) {
+        for (c, class) in self.colours.iter().enumerate() {
             weighted_join(class, &|t| self.weight(t), &f, (), &|(), ()| ());
+            after(c);
         }
     }
 
-    /// As [`for_each_coloured`](Self::for_each_coloured), returning the largest value `f`
-    /// gives (0 when there is none); a maximum does not depend on the order of the tiles.
-    pub fn max_coloured(&self, f: impl Fn(u32) -> f64 + Sync + Send) -> f64 {
-        self.colours
-            .iter()
-            .map(|class| weighted_join(class, &|t| self.weight(t), &f, 0.0, &f64::max))
-            .fold(0.0, f64::max)
+    /// As [`for_each_coloured_then`](Self::for_each_coloured_then), returning the largest
+    /// value `f` gives (0 when there is none); a maximum does not depend on the order of
+    /// the tiles.
+    pub fn max_coloured_then(
+        &self,
+        f: impl Fn(u32) -> f64 + Sync + Send,
+        mut after: impl FnMut(usize),
+    ) -> f64 {
+        let mut most = 0.0f64;
+        for (c, class) in self.colours.iter().enumerate() {
+            most = most.max(weighted_join(
+                class,
+                &|t| self.weight(t),
+                &f,
+                0.0,
+                &f64::max,
+            ));
+            after(c);
+        }
+        most
     }
 
     /// Rebuilds `start`, `order` and `colours` from `tile_of` (counting sort).

@@ -6,6 +6,7 @@ use crate::base::sym::SymTensor;
 use crate::physics::loads::{Load, VelocityBc};
 use crate::physics::material::{Material, Plane};
 use crate::physics::shape::{ShapeKind, StencilCache};
+use crate::ranks::domain::Domain;
 use crate::store::crack::Cracks;
 use crate::store::grid::Grid;
 use crate::store::particles::Particles;
@@ -157,6 +158,8 @@ pub struct World<D: Dim> {
     pub work: Work,
     /// Explicit cracks and their velocity fields (None in a scene without cracks).
     pub cracks: Option<Cracks<D>>,
+    /// The ranks the scene is split across, and this rank's share.
+    pub domain: Domain,
 }
 
 /// Particles (or grid nodes) per chunk in parallel loops; fixed so reductions do not
@@ -169,7 +172,7 @@ impl<D: Dim> World<D> {
         let p = &self.particles;
         let mats = &self.materials;
         // Exact sums: the energies do not depend on how the particles are split up.
-        let [k, w, wp] = (0..p.len().div_ceil(CHUNK))
+        let mut sums = (0..p.len().div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
                 let mut s: [ExactSum; 3] = Default::default();
@@ -183,8 +186,9 @@ impl<D: Dim> World<D> {
                 }
                 s
             })
-            .reduce(Default::default, merge3)
-            .map(|s| s.value());
+            .reduce(Default::default, merge3);
+        self.domain.sum(&mut sums);
+        let [k, w, wp] = sums.map(|s| s.value());
         Energies {
             kinetic: k,
             strain: w,
@@ -223,9 +227,16 @@ impl<D: Dim> World<D> {
     /// Total linear momentum (kg m/s), summed exactly.
     pub fn momentum(&self) -> D::Vec {
         let p = &self.particles;
+        let mut sums: [ExactSum; 3] = Default::default();
+        for i in 0..p.len() {
+            for (a, s) in sums.iter_mut().enumerate().take(D::D) {
+                s.add(p.v[i][a] * p.mass[i]);
+            }
+        }
+        self.domain.sum(&mut sums);
         let mut m = D::zero();
         for a in 0..D::D {
-            m[a] = ExactSum::of((0..p.len()).map(|i| p.v[i][a] * p.mass[i]));
+            m[a] = sums[a].value();
         }
         m
     }
@@ -241,6 +252,7 @@ impl<D: Dim> World<D> {
                 l[a].add(c[a]);
             }
         }
+        self.domain.sum(&mut l);
         l.map(|s| s.value())
     }
 }

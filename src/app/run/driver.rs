@@ -13,6 +13,7 @@ use crate::io::output::summary::{
     NodeLineReport, ParticlesOnReport, Status, Summary, TipLinesReport,
 };
 use crate::io::scenario::{MAX_STEPS, OutputPlan, Scene, Source};
+use crate::pipeline::distribute;
 use crate::pipeline::schedule::Schedule;
 use crate::record::expect::Expect;
 use crate::record::probe::Probe;
@@ -49,6 +50,8 @@ pub(super) struct Run<'a, D: DimSystems> {
     tips_on_lines: Vec<TipLinesReport>,
     /// The step the run started from (0, or the snapshot's).
     pub first_step: u64,
+    /// Particles over all ranks.
+    particles: usize,
 }
 
 impl<'a, D: DimSystems> Run<'a, D> {
@@ -63,15 +66,26 @@ impl<'a, D: DimSystems> Run<'a, D> {
     ) -> anyhow::Result<Self> {
         let Scene {
             name,
-            world,
-            probes,
+            mut world,
+            mut probes,
             expects,
             duration,
-            output,
+            mut output,
             dt_limit,
             checkpoint,
             fracture,
         } = scene;
+        distribute::split(&mut world, &mut probes, opts.comm.clone())?;
+        let root = opts.comm.is_root();
+        if opts.comm.is_split() {
+            if root && output.vtk && opts.out.is_some() {
+                eprintln!("note: VTK frames are not yet written on more than one MPI rank");
+            }
+            output.vtk = false;
+            output.plot &= root;
+        }
+        // Only the first rank writes.
+        let out = opts.out.as_ref().filter(|_| root);
         let schedule = Schedule::for_world(&world, fracture.clone());
         let steps = end_step(&world, opts.until.unwrap_or(duration))?;
         let resumed_from = resumed.as_ref().map(|r| r.1.clone());
@@ -101,7 +115,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
                 (cracks.iter().map(|c| c.name.clone()).collect(), fatigue)
             });
         let names: Vec<String> = probes.iter().map(|p| p.name.clone()).collect();
-        let mut writers = match &opts.out {
+        let mut writers = match out {
             Some(dir) => Some(Writers::open(
                 dir,
                 &names,
@@ -122,7 +136,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
         {
             w.frames_in(run_dir, state.frames.len());
         }
-        let checkpoints = match &opts.out {
+        let checkpoints = match out.filter(|_| !opts.comm.is_split()) {
             Some(dir) => Some(Checkpointer::new(
                 dir,
                 checkpoint,
@@ -131,6 +145,12 @@ impl<'a, D: DimSystems> Run<'a, D> {
             None => None,
         };
         let first_step = world.step;
+        let particles = (opts
+            .comm
+            .all_gather(world.particles.len().to_le_bytes().to_vec()))
+        .iter()
+        .map(|b| usize::from_le_bytes(b[..].try_into().expect("a usize per rank")))
+        .sum();
         let mut run = Run {
             src,
             opts,
@@ -153,6 +173,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             particles_on_cracks,
             tips_on_lines,
             first_step,
+            particles,
         };
         if run.resumed_from.is_none() {
             run.record_start()?;
@@ -203,6 +224,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             self.state.next_history,
             next == self.steps,
         );
+        distribute::migrate(&mut self.world, &mut self.probes).map_err(Stop::Unstable)?;
         let measured = (self.schedule)
             .step_measuring(&mut self.world, ends_at_row)
             .map_err(Stop::Unstable)?;
@@ -338,7 +360,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             dimension: D::D,
             status,
             message,
-            particles: world.particles.len(),
+            particles: self.particles,
             nodes: world.grid.geom.node_count(),
             steps: world.step,
             steps_run,
@@ -346,8 +368,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             dt: world.settings.dt,
             dt_limit: self.dt_limit,
             wall_seconds: wall,
-            particle_steps_per_second: world.particles.len() as f64 * steps_run as f64
-                / wall.max(1e-12),
+            particle_steps_per_second: self.particles as f64 * steps_run as f64 / wall.max(1e-12),
             threads: rayon::current_num_threads(),
             schedule: (self.schedule.systems.iter())
                 .map(|s| s.name().to_string())

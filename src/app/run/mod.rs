@@ -15,6 +15,7 @@ use crate::io::output::summary::Summary;
 use crate::io::scenario::{Scene, Source, build};
 use crate::io::snapshot::Reader;
 use crate::io::snapshot::state::restore;
+use crate::ranks::comm::Comm;
 use crate::record::history::History;
 use crate::record::state::RunState;
 use crate::store::world::{Energies, World};
@@ -43,6 +44,8 @@ pub struct RunOptions {
     /// Shared with a signal handler: a stop asked stops the run cleanly after the current
     /// step; the run says when it begins to write.
     pub stop: Option<StopFlag>,
+    /// The MPI ranks the run is split across (one by default).
+    pub comm: Comm,
 }
 
 impl RunOptions {
@@ -174,6 +177,30 @@ enum Stop {
     Output(anyhow::Error),
 }
 
+/// A step's outcome as every rank sees it: split across ranks, an error on any rank stops
+/// them all, with the lowest failing rank's message.
+fn agree<D: Dim>(comm: &Comm, world: &World<D>, stepped: Result<(), Stop>) -> Result<(), Stop> {
+    if !comm.is_split() {
+        return stepped;
+    }
+    let mine = stepped.as_ref().err().map(|s| match s {
+        Stop::Interrupted => String::new(),
+        Stop::Unstable(u) => u.to_string(),
+        Stop::Output(e) => format!("{e:#}"),
+        Stop::Completed => String::new(),
+    });
+    match comm.first_error(mine) {
+        None => Ok(()),
+        Some(_) if stepped.is_err() => stepped,
+        Some((_, text)) if text.is_empty() => Err(Stop::Interrupted),
+        Some((rank, text)) => Err(Stop::Unstable(Unstable {
+            step: world.step,
+            time: world.time,
+            what: format!("rank {rank} stopped: {text}"),
+        })),
+    }
+}
+
 /// Runs `scene` to its end time (or `opts.until`), with a progress bar when asked, and
 /// stops cleanly on a signal, an instability or a failed output.
 fn drive<D: DimSystems>(
@@ -205,7 +232,8 @@ fn drive<D: DimSystems>(
     };
     let t0 = Instant::now();
     while !early && run.world.step < run.steps {
-        if let Err(s) = run.step() {
+        let stepped = run.step();
+        if let Err(s) = agree(&opts.comm, &run.world, stepped) {
             stop = s;
             break;
         }

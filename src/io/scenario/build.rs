@@ -7,6 +7,7 @@ use super::output::{CheckpointPlan, OutputPlan, checkpoint_plan, output_plan};
 use super::source::Source;
 use crate::base::dim::Dim;
 use crate::fracture::plan::FracturePlan;
+use crate::ranks::domain::Domain;
 use crate::record::expect::Expect;
 use crate::record::probe::Probe;
 use crate::store::grid::Grid;
@@ -91,6 +92,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         step: 0,
         work: Work::default(),
         cracks,
+        domain: Domain::single(),
     };
     Ok(Scene {
         name: src.name(),

@@ -51,6 +51,7 @@ pub(super) fn loads<D: Dim>(
         loads.push(Load {
             forces,
             particles: sel,
+            ids: Vec::new(),
             time: l.time.clone(),
         });
     }

@@ -35,6 +35,7 @@ pub(super) fn probes<D: Dim>(
             probes.push(Probe {
                 name: p.name.clone(),
                 particles: Vec::new(),
+                ids: Vec::new(),
                 supports,
                 qty,
                 comp,
@@ -86,6 +87,7 @@ pub(super) fn probes<D: Dim>(
         probes.push(Probe {
             name: p.name.clone(),
             particles: sel,
+            ids: Vec::new(),
             supports: Vec::new(),
             qty,
             comp,

@@ -1,0 +1,248 @@
+//! The processes of a run (MPI ranks) and the few collective operations the kernel needs:
+//! exact sums, byte exchanges with neighbours, gathers, and agreeing on an error. One rank
+//! (every build without the `mpi` feature) does all of them locally.
+
+use crate::base::exact_sum::ExactSum;
+use std::fmt;
+#[cfg(feature = "mpi")]
+use std::sync::Arc;
+
+/// This process's place among the run's ranks, and the channel to the others.
+#[derive(Clone, Default)]
+pub struct Comm {
+    /// This rank (0-based).
+    rank: usize,
+    /// Number of ranks.
+    size: usize,
+    /// The MPI world when there is more than one rank.
+    #[cfg(feature = "mpi")]
+    world: Option<Arc<mpi_world::World>>,
+}
+
+impl fmt::Debug for Comm {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "rank {} of {}", self.rank, self.size.max(1))
+    }
+}
+
+impl Comm {
+    /// The only rank.
+    pub fn single() -> Self {
+        Comm {
+            rank: 0,
+            size: 1,
+            #[cfg(feature = "mpi")]
+            world: None,
+        }
+    }
+
+    /// This rank (0-based).
+    pub fn rank(&self) -> usize {
+        self.rank
+    }
+
+    /// Number of ranks.
+    pub fn size(&self) -> usize {
+        self.size.max(1)
+    }
+
+    /// Whether this is the rank that writes the run's outputs.
+    pub fn is_root(&self) -> bool {
+        self.rank == 0
+    }
+
+    /// Whether the run is split across more than one rank.
+    pub fn is_split(&self) -> bool {
+        self.size() > 1
+    }
+
+    /// Adds every rank's terms into each sum, on every rank (exact: the same bits whatever
+    /// the ranks hold).
+    pub fn sum_exact(&self, sums: &mut [ExactSum]) {
+        #[cfg(feature = "mpi")]
+        if let Some(w) = &self.world {
+            w.sum_exact(sums);
+        }
+        let _ = sums;
+    }
+
+    /// Sends `out[k]` to `peers[k]` and returns what each peer sent back, in the same
+    /// order; every peer must name this rank among its own in the same round.
+    pub fn exchange(&self, peers: &[usize], out: &[Vec<u8>]) -> Vec<Vec<u8>> {
+        #[cfg(feature = "mpi")]
+        if let Some(w) = &self.world {
+            return w.exchange(peers, out);
+        }
+        debug_assert!(peers.is_empty(), "one rank has no peers");
+        let _ = out;
+        Vec::new()
+    }
+
+    /// Every rank's bytes, in rank order.
+    pub fn all_gather(&self, mine: Vec<u8>) -> Vec<Vec<u8>> {
+        #[cfg(feature = "mpi")]
+        if let Some(w) = &self.world {
+            return w.all_gather(&mine);
+        }
+        vec![mine]
+    }
+
+    /// The lowest rank's error among `mine` and the other ranks' (every rank calls it at
+    /// the same point), so that all stop together with that message.
+    pub fn first_error(&self, mine: Option<String>) -> Option<(usize, String)> {
+        if !self.is_split() {
+            return mine.map(|m| (0, m));
+        }
+        let flag = vec![u8::from(mine.is_some())];
+        let flags = self.all_gather(flag);
+        let first = flags.iter().position(|f| f[0] == 1)?;
+        let text = if self.rank == first {
+            mine.unwrap_or_default().into_bytes()
+        } else {
+            Vec::new()
+        };
+        let texts = self.all_gather(text);
+        Some((first, String::from_utf8_lossy(&texts[first]).into_owned()))
+    }
+}
+
+/// Starts MPI when the process was launched by `mpirun` (or a like launcher) and the build
+/// has the `mpi` feature; a build without it refuses more than one rank. The guard must
+/// live until the run ends (dropping it finalizes MPI).
+pub fn start() -> anyhow::Result<(Comm, Guard)> {
+    let launched = launcher_size();
+    #[cfg(feature = "mpi")]
+    if launched.is_some() {
+        return mpi_world::start();
+    }
+    if let Some(n) = launched.filter(|&n| n > 1) {
+        anyhow::bail!(
+            "started as one of {n} MPI ranks, but this build of fissure has no MPI: rebuild \
+             with `cargo build --release --features mpi` (needs an MPI library such as \
+             OpenMPI), or run without mpirun"
+        );
+    }
+    Ok((Comm::single(), Guard::default()))
+}
+
+/// The number of ranks an MPI launcher started, read from its environment (OpenMPI,
+/// MPICH and Intel MPI, MVAPICH); None when not started by one.
+fn launcher_size() -> Option<usize> {
+    ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "MV2_COMM_WORLD_SIZE"]
+        .iter()
+        .find_map(|k| std::env::var(k).ok()?.parse().ok())
+}
+
+/// Keeps MPI initialised while it lives.
+#[derive(Default)]
+pub struct Guard {
+    #[cfg(feature = "mpi")]
+    _universe: Option<mpi::environment::Universe>,
+}
+
+#[cfg(feature = "mpi")]
+mod mpi_world {
+    //! The MPI side of [`Comm`](super::Comm).
+
+    use super::{Comm, Guard};
+    use crate::base::exact_sum::ExactSum;
+    use mpi::collective::SystemOperation;
+    use mpi::datatype::PartitionMut;
+    use mpi::environment::Threading;
+    use mpi::topology::SimpleCommunicator;
+    use mpi::traits::*;
+    use std::sync::Arc;
+
+    /// The MPI world communicator.
+    pub struct World(SimpleCommunicator);
+
+    // SAFETY: MPI is initialised with MPI_THREAD_SERIALIZED and the kernel calls it only
+    // from the thread that runs the step loop, never inside a parallel region, so the
+    // handle is never used by two threads at once.
+    unsafe impl Send for World {}
+    // SAFETY: as above.
+    unsafe impl Sync for World {}
+
+    /// Initialises MPI (calls from any one thread at a time).
+    pub fn start() -> anyhow::Result<(Comm, Guard)> {
+        let (universe, _) = mpi::initialize_with_threading(Threading::Serialized)
+            .ok_or_else(|| anyhow::anyhow!("MPI was already initialised"))?;
+        let world = universe.world();
+        let (rank, size) = (world.rank() as usize, world.size() as usize);
+        let comm = Comm {
+            rank,
+            size,
+            world: (size > 1).then(|| Arc::new(World(world))),
+        };
+        let guard = Guard {
+            _universe: Some(universe),
+        };
+        Ok((comm, guard))
+    }
+
+    impl World {
+        pub fn sum_exact(&self, sums: &mut [ExactSum]) {
+            let mut mine = Vec::new();
+            let mut special = Vec::new();
+            for s in sums.iter() {
+                let (digits, sp) = s.parts();
+                mine.extend_from_slice(&digits);
+                special.push(sp);
+            }
+            let mut total = vec![0i64; mine.len()];
+            self.0
+                .all_reduce_into(&mine[..], &mut total[..], SystemOperation::sum());
+            let mut special_total = vec![0.0f64; special.len()];
+            self.0
+                .all_reduce_into(&special[..], &mut special_total[..], SystemOperation::sum());
+            let per = total.len() / sums.len().max(1);
+            for (k, s) in sums.iter_mut().enumerate() {
+                *s = ExactSum::from_parts(&total[k * per..(k + 1) * per], special_total[k]);
+            }
+        }
+
+        pub fn exchange(&self, peers: &[usize], out: &[Vec<u8>]) -> Vec<Vec<u8>> {
+            mpi::request::scope(|scope| {
+                let sends: Vec<_> = (peers.iter().zip(out))
+                    .map(|(&p, buf)| {
+                        self.0
+                            .process_at_rank(p as i32)
+                            .immediate_send(scope, &buf[..])
+                    })
+                    .collect();
+                let got = peers
+                    .iter()
+                    .map(|&p| self.0.process_at_rank(p as i32).receive_vec::<u8>().0)
+                    .collect();
+                sends.into_iter().for_each(|r| {
+                    r.wait();
+                });
+                got
+            })
+        }
+
+        pub fn all_gather(&self, mine: &[u8]) -> Vec<Vec<u8>> {
+            let n = self.0.size() as usize;
+            let mut counts = vec![0i32; n];
+            self.0
+                .all_gather_into(&(mine.len() as i32), &mut counts[..]);
+            let displs: Vec<i32> = counts
+                .iter()
+                .scan(0, |at, &c| {
+                    let d = *at;
+                    *at += c;
+                    Some(d)
+                })
+                .collect();
+            let mut all = vec![0u8; counts.iter().map(|&c| c as usize).sum()];
+            let mut part = PartitionMut::new(&mut all[..], &counts[..], &displs[..]);
+            self.0.all_gather_varcount_into(mine, &mut part);
+            (0..n)
+                .map(|r| {
+                    let d = displs[r] as usize;
+                    all[d..d + counts[r] as usize].to_vec()
+                })
+                .collect()
+        }
+    }
+}

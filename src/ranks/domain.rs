@@ -1,0 +1,78 @@
+//! A rank's share of a scene: the ranks, the partition of the tiles, and the exchanges that
+//! keep the shared nodes' sums those one rank would form.
+//!
+//! Node sums are bitwise those of one rank because one rank already adds them in a fixed
+//! order: colour class after colour class, and within a class a node hears from one tile
+//! only (`tiles.rs`). Split across ranks, each rank scatters its own tiles of a class,
+//! then sends every shared node its tiles of that class reach to the peers that reach it
+//! too, which take the value as theirs. Before each class every rank holding a shared node
+//! therefore holds the one-rank running sum, and after the last class the full sum.
+
+use crate::base::exact_sum::ExactSum;
+use crate::ranks::comm::Comm;
+use crate::ranks::partition::Partition;
+
+/// The ranks and, when there is more than one, this rank's partition.
+#[derive(Clone, Debug, Default)]
+pub struct Domain {
+    /// The ranks.
+    pub comm: Comm,
+    /// This rank's tiles and shared nodes (None on one rank).
+    pub partition: Option<Partition>,
+}
+
+/// A grid column a colour class's exchange carries.
+pub trait Shared {
+    /// Appends the values of `nodes` as bytes.
+    fn pack(&self, nodes: &[u32], out: &mut Vec<u8>);
+    /// Overwrites `nodes` with values from `bytes`; returns the bytes read.
+    fn unpack(&self, nodes: &[u32], bytes: &[u8]) -> usize;
+}
+
+impl Domain {
+    /// One rank: nothing shared.
+    pub fn single() -> Self {
+        Domain::default()
+    }
+
+    /// Whether the scene is split across ranks.
+    pub fn is_split(&self) -> bool {
+        self.partition.is_some()
+    }
+
+    /// After colour class `class`: sends the shared nodes this rank's tiles of the class
+    /// reached, in every column of `columns`, and takes the peers' (see the module doc).
+    pub fn settle(&self, class: usize, columns: &[&dyn Shared]) {
+        let Some(p) = &self.partition else {
+            return;
+        };
+        let out: Vec<Vec<u8>> = p.sends[class]
+            .iter()
+            .map(|nodes| {
+                let mut buf = Vec::new();
+                columns.iter().for_each(|c| c.pack(nodes, &mut buf));
+                buf
+            })
+            .collect();
+        let got = self.comm.exchange(&p.peers, &out);
+        for (nodes, bytes) in p.receives[class].iter().zip(&got) {
+            let mut at = 0;
+            for c in columns {
+                at += c.unpack(nodes, &bytes[at..]);
+            }
+        }
+    }
+
+    /// Whether this rank counts node `n` in node sums (every node on one rank).
+    #[inline(always)]
+    pub fn owns_node(&self, n: usize) -> bool {
+        self.partition.as_ref().is_none_or(|p| p.owned_nodes[n])
+    }
+
+    /// Adds the other ranks' terms into `sums` (nothing on one rank).
+    pub fn sum(&self, sums: &mut [ExactSum]) {
+        if self.is_split() {
+            self.comm.sum_exact(sums);
+        }
+    }
+}

@@ -1,0 +1,96 @@
+//! A scene split across MPI ranks gives bitwise the outputs of one process (built with the
+//! `mpi` feature; each case starts `mpirun` as a child, since MPI starts once per process).
+//! Without the feature, a launch by mpirun is refused with a clear message.
+
+use std::path::Path;
+use std::process::Command;
+
+/// The environment that lets mpirun run as root, more ranks than cores, on this machine only.
+#[cfg(feature = "mpi")]
+const OMPI_ENV: [(&str, &str); 7] = [
+    ("OMPI_ALLOW_RUN_AS_ROOT", "1"),
+    ("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"),
+    ("OMPI_MCA_rmaps_base_oversubscribe", "1"),
+    ("OMPI_MCA_btl", "self,vader"),
+    ("OMPI_MCA_oob_tcp_if_include", "lo"),
+    ("OMPI_MCA_pml", "ob1"),
+    ("HWLOC_COMPONENTS", "-gl,-opencl"),
+];
+
+/// Runs `scene` with `args`, under `mpirun -np ranks` when `ranks` is given, into `out`.
+#[cfg(feature = "mpi")]
+fn run(scene: &str, ranks: Option<usize>, out: &Path, args: &[&str]) {
+    let bin = env!("CARGO_BIN_EXE_fissure");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join(scene);
+    let mut cmd = match ranks {
+        Some(n) => {
+            let mut c = Command::new("mpirun");
+            c.args(["-np", &n.to_string(), bin]);
+            c
+        }
+        None => Command::new(bin),
+    };
+    cmd.envs(OMPI_ENV)
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(out);
+    let done = cmd.args(args).output().expect("mpirun starts");
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+}
+
+/// energy.csv and probes.csv of `scene` on 2 and 3 ranks equal the serial run's, byte for byte.
+#[cfg(feature = "mpi")]
+fn same_on_ranks(scene: &str, args: &[&str]) {
+    let stem = Path::new(scene).file_stem().unwrap().to_string_lossy();
+    let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_{stem}", std::process::id()));
+    let serial = dir.join("serial");
+    run(scene, None, &serial, args);
+    for n in [2, 3] {
+        let split = dir.join(format!("ranks{n}"));
+        run(
+            scene,
+            Some(n),
+            &split,
+            &[&["--threads", "1"], args].concat(),
+        );
+        for f in ["energy.csv", "probes.csv"] {
+            let a = std::fs::read(serial.join(f)).unwrap();
+            let b = std::fs::read(split.join(f)).unwrap();
+            assert!(a.len() > 100, "{f} has rows");
+            assert!(a == b, "{scene} {f}: {n} ranks differ from one");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[cfg(feature = "mpi")]
+#[test]
+fn colliding_disks_split_across_ranks_match_one_process() {
+    same_on_ranks("scenarios/disks_2d.toml", &[]);
+}
+
+#[cfg(feature = "mpi")]
+#[test]
+fn a_3d_bar_split_across_ranks_matches_one_process() {
+    same_on_ranks("scenarios/bar_wave_3d.toml", &[]);
+}
+
+#[cfg(not(feature = "mpi"))]
+#[test]
+fn a_build_without_mpi_refuses_several_ranks() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bar_wave_2d.toml");
+    let done = Command::new(env!("CARGO_BIN_EXE_fissure"))
+        .env("OMPI_COMM_WORLD_SIZE", "2")
+        .args(["run", scene.to_str().unwrap(), "--out"])
+        .arg(std::env::temp_dir().join("fissure_no_mpi"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&done.stderr);
+    assert!(!done.status.success());
+    assert!(err.contains("--features mpi"), "{err}");
+}
