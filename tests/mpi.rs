@@ -64,8 +64,79 @@ fn same_on_ranks(scene: &str, args: &[&str]) {
             assert!(a.len() > 100, "{f} has rows");
             assert!(a == b, "{scene} {f}: {n} ranks differ from one");
         }
+        same_frames(&serial, &split, n);
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The split run's VTK frames are `.pvtu` files joining one piece per rank, whose point
+/// arrays are the pieces' own and whose pieces hold, together, the serial frame's points.
+#[cfg(feature = "mpi")]
+fn same_frames(serial: &Path, split: &Path, ranks: usize) {
+    let frames = |dir: &Path| -> Vec<String> {
+        let pvd = std::fs::read_to_string(dir.join("particles.pvd")).unwrap();
+        let doc = roxmltree::Document::parse(&pvd).unwrap();
+        (doc.descendants().filter(|e| e.has_tag_name("DataSet")))
+            .map(|e| e.attribute("file").unwrap().to_string())
+            .collect()
+    };
+    let (one, many) = (frames(serial), frames(split));
+    assert_eq!(one.len(), many.len());
+    assert!(many.iter().all(|f| f.ends_with(".pvtu")), "{many:?}");
+    let last = many.last().unwrap();
+    let pvtu = std::fs::read_to_string(split.join(last)).unwrap();
+    let doc = roxmltree::Document::parse(&pvtu).expect("pvtu is well-formed XML");
+    let pieces: Vec<&str> = (doc.descendants().filter(|e| e.has_tag_name("Piece")))
+        .map(|e| e.attribute("Source").unwrap())
+        .collect();
+    assert_eq!(pieces.len(), ranks);
+    let declared: Vec<&str> = (doc.descendants().filter(|e| e.has_tag_name("PDataArray")))
+        .filter_map(|e| e.attribute("Name"))
+        .collect();
+    let mut points = Vec::new();
+    for piece in pieces {
+        let (names, mut p) = points_of(&split.join(piece));
+        assert_eq!(names, declared, "the pvtu declares the piece's arrays");
+        points.append(&mut p);
+    }
+    let (_, mut whole) = points_of(&serial.join(one.last().unwrap()));
+    points.sort_unstable();
+    whole.sort_unstable();
+    assert!(points == whole, "the pieces hold the serial frame's points");
+}
+
+/// A `.vtu` file's array names and its points (as bit patterns).
+#[cfg(feature = "mpi")]
+fn points_of(path: &Path) -> (Vec<String>, Vec<[u64; 3]>) {
+    let bytes = std::fs::read(path).unwrap();
+    let marker = b"<AppendedData encoding=\"raw\">\n_";
+    let at = (bytes.windows(marker.len()))
+        .position(|w| w == marker)
+        .expect("appended data");
+    let header = std::str::from_utf8(&bytes[..at + marker.len() - 1]).unwrap();
+    let xml = format!("{header}</AppendedData>\n</VTKFile>\n");
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let data = &bytes[at + marker.len()..];
+    let arrays: Vec<_> = doc
+        .descendants()
+        .filter(|e| e.has_tag_name("DataArray"))
+        .collect();
+    let names = arrays
+        .iter()
+        .filter_map(|e| e.attribute("Name"))
+        .map(String::from)
+        .collect();
+    let pts = arrays
+        .iter()
+        .find(|e| e.attribute("Name") == Some("Points"))
+        .unwrap();
+    let offset: usize = pts.attribute("offset").unwrap().parse().unwrap();
+    let len = u64::from_le_bytes(data[offset..offset + 8].try_into().unwrap()) as usize;
+    let values: Vec<u64> = (data[offset + 8..offset + 8 + len].chunks_exact(8))
+        .map(|b| u64::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    let points = values.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    (names, points)
 }
 
 #[cfg(feature = "mpi")]

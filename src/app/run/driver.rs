@@ -4,7 +4,7 @@
 
 use super::checkpoint::Checkpointer;
 use super::reports;
-use super::writers::{Contents, Writers};
+use super::writers::{self, Contents, Writers};
 use super::{Outcome, RunOptions, Stop, check_finite, check_snapshot, row_due, step_count};
 use crate::base::error::UsageError;
 use crate::fracture::plan::{FracturePlan, Measured};
@@ -70,22 +70,14 @@ impl<'a, D: DimSystems> Run<'a, D> {
             mut probes,
             expects,
             duration,
-            mut output,
+            output,
             dt_limit,
             checkpoint,
             fracture,
         } = scene;
         distribute::split(&mut world, &mut probes, opts.comm.clone())?;
-        let root = opts.comm.is_root();
-        if opts.comm.is_split() {
-            if root && output.vtk && opts.out.is_some() {
-                eprintln!("note: VTK frames are not yet written on more than one MPI rank");
-            }
-            output.vtk = false;
-            output.plot &= root;
-        }
-        // Only the first rank writes.
-        let out = opts.out.as_ref().filter(|_| root);
+        // Only the first rank writes the files (every rank its piece of a VTK frame).
+        let out = opts.out.as_ref().filter(|_| opts.comm.is_root());
         let schedule = Schedule::for_world(&world, fracture.clone());
         let steps = end_step(&world, opts.until.unwrap_or(duration))?;
         let resumed_from = resumed.as_ref().map(|r| r.1.clone());
@@ -183,7 +175,27 @@ impl<'a, D: DimSystems> Run<'a, D> {
 
     /// Whether VTK frames are written.
     fn vtk(&self) -> bool {
-        self.output.vtk && self.writers.is_some()
+        self.output.vtk && self.opts.out.is_some()
+    }
+
+    /// Writes a VTK frame: split across ranks, every rank its piece and the first the
+    /// `.pvtu` joining them.
+    fn frame(&mut self) -> anyhow::Result<()> {
+        if let Some(dir) = self
+            .opts
+            .out
+            .as_ref()
+            .filter(|_| self.world.domain.is_split())
+        {
+            writers::piece(dir, self.state.frames.len(), &self.world)?;
+        }
+        match &mut self.writers {
+            Some(w) => w.frame(&self.world, &mut self.state),
+            None => {
+                self.state.frames.push(self.world.time);
+                Ok(())
+            }
+        }
     }
 
     /// The state at t = 0: probes, the first history row, J and K, the first frame.
@@ -192,12 +204,11 @@ impl<'a, D: DimSystems> Run<'a, D> {
         let row = *self.state.record(&self.world, self.world.energies());
         let measured = self.schedule.measure_now(&mut self.world)?;
         self.report(measured)?;
-        let vtk = self.vtk();
         if let Some(w) = &mut self.writers {
             w.row(&row, &self.state.history)?;
-            if vtk {
-                w.frame(&self.world, &mut self.state)?;
-            }
+        }
+        if self.vtk() {
+            self.frame()?;
         }
         Ok(())
     }
@@ -253,10 +264,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
         }
         if self.vtk() && (self.world.time >= self.state.next_frame * (1.0 - 1e-9) || last) {
             self.state.next_frame += self.output.interval;
-            if let Some(w) = &mut self.writers {
-                w.frame(&self.world, &mut self.state)
-                    .map_err(Stop::Output)?;
-            }
+            self.frame().map_err(Stop::Output)?;
         }
         let requested =
             self.opts.stop_requested() || self.opts.pause_after == Some(self.world.step);

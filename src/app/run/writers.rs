@@ -355,9 +355,10 @@ impl Writers {
         }
     }
 
-    /// The name of frame `k` of kind `kind` ("particles", "cracks") in the collection file.
-    fn listed(&self, kind: &str, k: usize) -> String {
-        let name = format!("{kind}_{k:05}.vtu");
+    /// The name of frame `k` of kind `kind` ("particles", "cracks") in the collection file,
+    /// of extension `ext` ("vtu", or "pvtu" joining the pieces of a split run).
+    fn listed(&self, kind: &str, k: usize, ext: &str) -> String {
+        let name = format!("{kind}_{k:05}.{ext}");
         match &self.earlier {
             Some((n, dir)) if k < *n => format!("{dir}{name}"),
             _ => name,
@@ -365,14 +366,26 @@ impl Writers {
     }
 
     /// Writes a VTK frame of `world` and the collection file listing every frame so far.
+    /// Split across ranks, the frame is a `.pvtu` joining the ranks' pieces ([`piece`]).
     pub fn frame<D: Dim>(&mut self, world: &World<D>, state: &mut RunState) -> anyhow::Result<()> {
-        let name = frame_name(state.frames.len());
-        whole(&self.dir.join(&name), |p| {
-            vtk::write_particles(p, &world.particles)
-        })?;
+        let k = state.frames.len();
+        let comm = &world.domain.comm;
+        let ext = if comm.is_split() {
+            let pieces: Vec<String> = (0..comm.size()).map(|r| piece_name(k, r)).collect();
+            let plastic = !world.particles.hardened.is_empty();
+            whole(&self.dir.join(format!("particles_{k:05}.pvtu")), |p| {
+                vtk::write_particle_pieces(p, &pieces, plastic)
+            })?;
+            "pvtu"
+        } else {
+            whole(&self.dir.join(frame_name(k)), |p| {
+                vtk::write_particles(p, &world.particles)
+            })?;
+            "vtu"
+        };
         state.frames.push(world.time);
         let list: Vec<(f64, String)> = (state.frames.iter().enumerate())
-            .map(|(k, &t)| (t, self.listed("particles", k)))
+            .map(|(k, &t)| (t, self.listed("particles", k, ext)))
             .collect();
         whole(&self.dir.join("particles.pvd"), |p| {
             vtk::write_collection(p, &list)
@@ -388,7 +401,7 @@ impl Writers {
                 vtk::write_cracks(p, c, &tips)
             })?;
             let list: Vec<(f64, String)> = (state.frames.iter().enumerate())
-                .map(|(k, &t)| (t, self.listed("cracks", k)))
+                .map(|(k, &t)| (t, self.listed("cracks", k, "vtu")))
                 .collect();
             whole(&self.dir.join("cracks.pvd"), |p| {
                 vtk::write_collection(p, &list)
@@ -431,6 +444,20 @@ fn whole(path: &Path, write: impl FnOnce(&Path) -> std::io::Result<()>) -> anyho
 
 fn frame_name(k: usize) -> String {
     format!("particles_{k:05}.vtu")
+}
+
+/// Rank `rank`'s piece of particle frame `k` in a split run.
+fn piece_name(k: usize, rank: usize) -> String {
+    format!("particles_{k:05}_{rank}.vtu")
+}
+
+/// Writes this rank's particles as its piece of frame `k` into `dir` (a split run; every
+/// rank writes one, the first also the `.pvtu` joining them).
+pub fn piece<D: Dim>(dir: &Path, k: usize, world: &World<D>) -> anyhow::Result<()> {
+    let name = piece_name(k, world.domain.comm.rank());
+    whole(&dir.join(name), |p| {
+        vtk::write_particles(p, &world.particles)
+    })
 }
 
 /// The path from folder `from` to folder `to` (both absolute), ending in a separator:

@@ -20,51 +20,55 @@ fn f64s(values: impl Iterator<Item = f64>) -> Vec<u8> {
     values.flat_map(f64::to_le_bytes).collect()
 }
 
+/// The particle arrays' attributes (all but plastic strain), in the order written.
+const PARTICLE_ARRAYS: [&str; 5] = [
+    r#"type="Float64" Name="velocity" NumberOfComponents="3""#,
+    r#"type="Float64" Name="displacement" NumberOfComponents="3""#,
+    r#"type="Float64" Name="stress" NumberOfComponents="6""#,
+    r#"type="Float64" Name="mass" NumberOfComponents="1""#,
+    r#"type="Int32" Name="material" NumberOfComponents="1""#,
+];
+/// The equivalent plastic strain's attributes (plastic scenes only).
+const PLASTIC_ARRAY: &str = r#"type="Float64" Name="plastic_strain" NumberOfComponents="1""#;
+/// The particles' point attributes.
+const POINTS: &str = r#"type="Float64" Name="Points" NumberOfComponents="3""#;
+/// What ParaView shows first.
+const ACTIVE: &str = r#"Vectors="velocity" Tensors="stress""#;
+
 /// Writes the particles as vertex cells to `path` with velocity, displacement, stress
 /// (ParaView's symmetric-tensor order xx, yy, zz, xy, yz, xz), mass and material, and in a
 /// plastic scene the equivalent plastic strain.
 pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result<()> {
     let n = p.len();
     let vec3 = |c: &[D::Vec]| f64s(c.iter().flat_map(|v| D::to_xyz(*v)));
-    let mut point_data = vec![
-        Array {
-            attrs: r#"type="Float64" Name="velocity" NumberOfComponents="3""#.into(),
-            bytes: vec3(&p.v),
-        },
-        Array {
-            attrs: r#"type="Float64" Name="displacement" NumberOfComponents="3""#.into(),
-            bytes: f64s((0..n).flat_map(|i| D::to_xyz(p.displacement(i)))),
-        },
-        Array {
-            attrs: r#"type="Float64" Name="stress" NumberOfComponents="6""#.into(),
-            bytes: f64s(
-                p.stress
-                    .iter()
-                    .map(|s| s.to_sym3())
-                    .flat_map(|s| [s.xx, s.yy, s.zz, s.xy, s.yz, s.xz]),
-            ),
-        },
-        Array {
-            attrs: r#"type="Float64" Name="mass" NumberOfComponents="1""#.into(),
-            bytes: f64s(p.mass.iter().copied()),
-        },
-        Array {
-            attrs: r#"type="Int32" Name="material" NumberOfComponents="1""#.into(),
-            bytes: p
-                .material
+    let bytes = [
+        vec3(&p.v),
+        f64s((0..n).flat_map(|i| D::to_xyz(p.displacement(i)))),
+        f64s(
+            p.stress
                 .iter()
-                .flat_map(|&m| (m as i32).to_le_bytes())
-                .collect(),
-        },
+                .map(|s| s.to_sym3())
+                .flat_map(|s| [s.xx, s.yy, s.zz, s.xy, s.yz, s.xz]),
+        ),
+        f64s(p.mass.iter().copied()),
+        (p.material.iter())
+            .flat_map(|&m| (m as i32).to_le_bytes())
+            .collect(),
     ];
+    let mut point_data: Vec<Array> = (PARTICLE_ARRAYS.iter().zip(bytes))
+        .map(|(a, bytes)| Array {
+            attrs: (*a).into(),
+            bytes,
+        })
+        .collect();
     if !p.hardened.is_empty() {
         point_data.push(Array {
-            attrs: r#"type="Float64" Name="plastic_strain" NumberOfComponents="1""#.into(),
+            attrs: PLASTIC_ARRAY.into(),
             bytes: f64s(p.hardened.iter().map(|h| h.equivalent)),
         });
     }
     let points = Array {
-        attrs: r#"type="Float64" Name="Points" NumberOfComponents="3""#.into(),
+        attrs: POINTS.into(),
         bytes: vec3(&p.x),
     };
     let cells = [
@@ -72,14 +76,7 @@ pub fn write_particles<D: Dim>(path: &Path, p: &Particles<D>) -> std::io::Result
         (1..=n as i64).flat_map(i64::to_le_bytes).collect(),
         vec![1u8; n],
     ];
-    write_unstructured(
-        path,
-        (n, n),
-        r#"Vectors="velocity" Tensors="stress""#,
-        &point_data,
-        points,
-        cells,
-    )
+    write_unstructured(path, (n, n), ACTIVE, &point_data, points, cells)
 }
 
 /// Writes the cracks of `c` as line cells (2D) or triangle cells (3D): the crack-plane
@@ -219,6 +216,31 @@ fn write_unstructured(
     }
     f.write_all(b"\n</AppendedData>\n</VTKFile>\n")?;
     f.flush()
+}
+
+/// Writes a `.pvtu` file joining the particle pieces `pieces` (one `.vtu` per MPI rank, as
+/// [`write_particles`] writes them; `plastic` when they carry the plastic strain).
+pub fn write_particle_pieces(path: &Path, pieces: &[String], plastic: bool) -> std::io::Result<()> {
+    let mut s = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" \
+         byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<PUnstructuredGrid GhostLevel=\"0\">\n",
+    );
+    s.push_str(&format!("<PPointData {ACTIVE}>\n"));
+    let plastic = plastic.then_some(PLASTIC_ARRAY);
+    for a in PARTICLE_ARRAYS.iter().chain(plastic.as_ref()) {
+        s.push_str(&format!("<PDataArray {a}/>\n"));
+    }
+    s.push_str(&format!(
+        "</PPointData>\n<PPoints>\n<PDataArray {POINTS}/>\n</PPoints>\n"
+    ));
+    s.push_str("<PCells>\n<PDataArray type=\"Int64\" Name=\"connectivity\"/>\n");
+    s.push_str("<PDataArray type=\"Int64\" Name=\"offsets\"/>\n");
+    s.push_str("<PDataArray type=\"UInt8\" Name=\"types\"/>\n</PCells>\n");
+    for p in pieces {
+        s.push_str(&format!("<Piece Source=\"{p}\"/>\n"));
+    }
+    s.push_str("</PUnstructuredGrid>\n</VTKFile>\n");
+    std::fs::write(path, s)
 }
 
 /// Writes a `.pvd` collection of `(time, file name)` frames.
