@@ -57,7 +57,8 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
     let (dt, alpha) = (world.settings.dt, world.settings.damping);
     let shape = world.settings.shape;
     let grid = &mut world.grid;
-    grid.momentum.par_iter_mut().for_each(|m| *m = D::zero());
+    let span = world.domain.span(grid.momentum.len());
+    (grid.momentum[span].par_iter_mut()).for_each(|m| *m = D::zero());
     let nodal = (&grid.accel[..], &grid.velocity[..]);
     let tiles = &world.tiles;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);

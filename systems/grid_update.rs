@@ -47,13 +47,17 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     let (damped, weighed) = (alpha != 0.0, D::dot(gravity, gravity) != 0.0);
     // Split across ranks, each node's work is booked by the rank that owns it.
     let owned = world.domain.partition.as_ref().map(|p| &p.owned_nodes);
+    // The entries this rank's particles can reach (all of them on one rank).
+    let span = world.domain.span(velocity.len());
+    let first = span.start;
+    let (velocity, accel) = (&mut velocity[span.clone()], &mut accel[span]);
     let [mut damp, mut grav] = (velocity.par_chunks_mut(CHUNK), accel.par_chunks_mut(CHUNK))
         .into_par_iter()
         .enumerate()
         .map(|(c, (vel, acc))| {
             let [mut damp, mut grav] = [ExactSum::new(), ExactSum::new()];
             for k in 0..vel.len() {
-                let n = c * CHUNK + k;
+                let n = first + c * CHUNK + k;
                 let m = mass[n];
                 if m > tol {
                     let v0 = momentum[n] * (1.0 / m);

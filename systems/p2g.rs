@@ -16,11 +16,13 @@ use rayon::prelude::*;
 /// to a zeroed grid, then adds the external particle loads.
 pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
     let g = &mut world.grid;
-    // One pass zeroes the three scattered columns (they have one entry per grid entry).
+    // One pass zeroes the three scattered columns (they have one entry per grid entry),
+    // where this rank's particles reach.
+    let span = world.domain.span(g.mass.len());
     (
-        g.mass.par_chunks_mut(CHUNK),
-        g.momentum.par_chunks_mut(CHUNK),
-        g.force.par_chunks_mut(CHUNK),
+        g.mass[span.clone()].par_chunks_mut(CHUNK),
+        g.momentum[span.clone()].par_chunks_mut(CHUNK),
+        g.force[span].par_chunks_mut(CHUNK),
     )
         .into_par_iter()
         .for_each(|(m, p, f)| {

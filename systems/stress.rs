@@ -207,12 +207,14 @@ pub(crate) fn node_velocities<D: Dim>(world: &mut World<D>) {
     let tol = world.settings.mass_tol;
     let g = &mut world.grid;
     let (mass, momentum) = (&g.mass, &g.momentum);
-    g.velocity
+    let span = world.domain.span(g.velocity.len());
+    let first = span.start;
+    g.velocity[span]
         .par_chunks_mut(CHUNK)
         .enumerate()
         .for_each(|(c, vel)| {
             for (k, v) in vel.iter_mut().enumerate() {
-                let n = c * CHUNK + k;
+                let n = first + c * CHUNK + k;
                 *v = if mass[n] > tol {
                     momentum[n] * (1.0 / mass[n])
                 } else {

@@ -98,20 +98,26 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
     let geom = &world.grid.geom;
     let p = &world.particles;
     let mut leaving: Vec<Vec<u32>> = vec![Vec::new(); partition.peers.len()];
-    let mut stay = Vec::with_capacity(p.len());
+    // The closing stress update binned the particles where they are now: their tiles are
+    // known (else they are found from the positions).
+    let binned = world.tiles.fresh && world.tiles.tile_of.len() == p.len();
     for i in 0..p.len() {
-        let mut cell = [0usize; 3];
-        for (a, slot) in cell.iter_mut().enumerate().take(D::D) {
-            let c = ((p.x[i][a] - geom.origin[a]) * geom.inv_h[a]).floor();
-            if !(c >= 0.0 && c < geom.cells[a] as f64) {
-                return Err(bin::outside(world, i, world.step, world.time));
+        let t = if binned {
+            world.tiles.tile_of[i]
+        } else {
+            let mut cell = [0usize; 3];
+            for (a, slot) in cell.iter_mut().enumerate().take(D::D) {
+                let c = ((p.x[i][a] - geom.origin[a]) * geom.inv_h[a]).floor();
+                if !(c >= 0.0 && c < geom.cells[a] as f64) {
+                    return Err(bin::outside(world, i, world.step, world.time));
+                }
+                *slot = c as usize;
             }
-            *slot = c as usize;
-        }
-        let t = world.tiles.tile_of_cell(cell);
+            world.tiles.tile_of_cell(cell)
+        };
         let owner = partition.owner[t as usize] as usize;
         if owner == me {
-            stay.push(i as u32);
+            continue;
         } else if let Some(k) = partition.peers.iter().position(|&q| q == owner) {
             leaving[k].push(i as u32);
         } else {
@@ -134,6 +140,12 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
     if !moved {
         return Ok(false);
     }
+    let mut left = bitvec::bitvec![0; world.particles.len()];
+    leaving
+        .iter()
+        .flatten()
+        .for_each(|&i| left.set(i as usize, true));
+    let stay: Vec<u32> = left.iter_zeros().map(|i| i as u32).collect();
     world.particles.permute(&stay);
     for bytes in &got {
         unpack(&mut world.particles, bytes);

@@ -4,8 +4,8 @@
 
 use crate::base::exact_sum::ExactSum;
 use std::fmt;
-#[cfg(feature = "mpi")]
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// This process's place among the run's ranks, and the channel to the others.
 #[derive(Clone, Default)]
@@ -17,6 +17,20 @@ pub struct Comm {
     /// The MPI world when there is more than one rank.
     #[cfg(feature = "mpi")]
     world: Option<Arc<mpi_world::World>>,
+    /// What this rank has sent.
+    traffic: Arc<Traffic>,
+}
+
+/// Messages and bytes this rank has sent to its peers, and collective operations it took
+/// part in.
+#[derive(Debug, Default)]
+pub struct Traffic {
+    /// Point-to-point messages sent (empty ones too).
+    pub messages: AtomicU64,
+    /// Bytes in them.
+    pub bytes: AtomicU64,
+    /// Collective operations (sums, gathers).
+    pub collectives: AtomicU64,
 }
 
 impl fmt::Debug for Comm {
@@ -28,12 +42,13 @@ impl fmt::Debug for Comm {
 impl Comm {
     /// The only rank.
     pub fn single() -> Self {
-        Comm {
-            rank: 0,
-            size: 1,
-            #[cfg(feature = "mpi")]
-            world: None,
-        }
+        Comm::default()
+    }
+
+    /// Messages, bytes and collectives this rank has sent so far.
+    pub fn traffic(&self) -> [u64; 3] {
+        let t = &self.traffic;
+        [&t.messages, &t.bytes, &t.collectives].map(|c| c.load(Ordering::Relaxed))
     }
 
     /// This rank (0-based).
@@ -61,6 +76,7 @@ impl Comm {
     pub fn sum_exact(&self, sums: &mut [ExactSum]) {
         #[cfg(feature = "mpi")]
         if let Some(w) = &self.world {
+            self.traffic.collectives.fetch_add(1, Ordering::Relaxed);
             w.sum_exact(sums);
         }
         let _ = sums;
@@ -71,6 +87,10 @@ impl Comm {
     pub fn exchange(&self, peers: &[usize], out: &[Vec<u8>]) -> Vec<Vec<u8>> {
         #[cfg(feature = "mpi")]
         if let Some(w) = &self.world {
+            let t = &self.traffic;
+            t.messages.fetch_add(out.len() as u64, Ordering::Relaxed);
+            let bytes = out.iter().map(|b| b.len() as u64).sum();
+            t.bytes.fetch_add(bytes, Ordering::Relaxed);
             return w.exchange(peers, out);
         }
         debug_assert!(peers.is_empty(), "one rank has no peers");
@@ -82,6 +102,7 @@ impl Comm {
     pub fn all_gather(&self, mine: Vec<u8>) -> Vec<Vec<u8>> {
         #[cfg(feature = "mpi")]
         if let Some(w) = &self.world {
+            self.traffic.collectives.fetch_add(1, Ordering::Relaxed);
             return w.all_gather(&mine);
         }
         vec![mine]
@@ -173,6 +194,7 @@ mod mpi_world {
             rank,
             size,
             world: (size > 1).then(|| Arc::new(World(world))),
+            traffic: Default::default(),
         };
         let guard = Guard {
             _universe: Some(universe),

@@ -63,6 +63,12 @@ impl Domain {
         }
     }
 
+    /// The grid entries, of `len`, that this rank's particles can reach: all of them on
+    /// one rank (and every crack field's row), the partition's node span when split.
+    pub fn span(&self, len: usize) -> std::ops::Range<usize> {
+        self.partition.as_ref().map_or(0..len, |p| p.span.clone())
+    }
+
     /// Whether this rank counts node `n` in node sums (every node on one rank).
     #[inline(always)]
     pub fn owns_node(&self, n: usize) -> bool {

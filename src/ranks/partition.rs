@@ -78,6 +78,9 @@ pub struct Partition {
     pub sends: Vec<Vec<Vec<u32>>>,
     /// Per colour class, per peer: the shared nodes this rank receives after the class.
     pub receives: Vec<Vec<Vec<u32>>>,
+    /// The nodes from the first to the last this rank's tiles reach (those it scatters to,
+    /// updates and gathers from).
+    pub span: std::ops::Range<usize>,
 }
 
 /// Why tiles cannot be split across the ranks.
@@ -148,7 +151,12 @@ impl Partition {
             }
             owned_nodes.set(n, owner[t] as usize == me);
         }
+        let span = match (reached[me].first_one(), reached[me].last_one()) {
+            (Some(a), Some(b)) => a..b + 1,
+            _ => 0..0,
+        };
         Ok(Partition {
+            span,
             owner,
             owned_nodes,
             peers,

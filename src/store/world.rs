@@ -214,7 +214,11 @@ impl<D: Dim> World<D> {
             .into_par_iter()
             .filter(|&i| (0..D::D).any(|a| cell(p.x[i], a) != cell(p.x0[i], a)))
             .count();
-        Some(moved)
+        // Over every rank (a count is exact as a double).
+        let mut all = [ExactSum::new()];
+        all[0].add(moved as f64);
+        self.domain.sum(&mut all);
+        Some(all[0].value() as usize)
     }
 
     /// Bytes held per particle: the particle columns plus the bins (tile and order, 4 bytes

@@ -395,6 +395,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             energies: world.energies(),
             static_solve: (world.settings.solver == crate::store::world::Solver::Static)
                 .then(|| SolveLog::from_rows(&history.solves)),
+            ranks: reports::ranks(world, steps_run),
             ignored_keys: crate::io::scenario::ignored(self.src),
             probes: reports::probes(&self.probes, history),
             expects: results,

@@ -5,7 +5,7 @@ use crate::base::dim::Dim;
 use crate::fracture::plan::FracturePlan;
 use crate::io::output::summary::{
     ContourReport, GrowthReport, NodeLineReport, ParticlesOnReport, PathReport, ProbeReport,
-    SplitBoundaryReport, TipLinesReport, TubeReport,
+    RanksReport, SplitBoundaryReport, TipLinesReport, TubeReport,
 };
 use crate::physics::growth::Stopped;
 use crate::record::history::{History, last_rows, path_difference, path_tips};
@@ -267,6 +267,33 @@ pub fn tips_on_particle_lines<D: Dim>(world: &World<D>) -> Vec<TipLinesReport> {
             lines,
         })
         .collect()
+}
+
+/// How a split run was divided and what its ranks sent (None on one rank); every rank
+/// calls it.
+pub(super) fn ranks<D: Dim>(world: &World<D>, steps: u64) -> Option<RanksReport> {
+    let comm = &world.domain.comm;
+    if !comm.is_split() {
+        return None;
+    }
+    let [messages, bytes, collectives] = comm.traffic();
+    let mine = [world.particles.len() as u64, messages, bytes, collectives];
+    let all: Vec<[u64; 4]> = (comm.all_gather(bytemuck::cast_slice(&mine).to_vec()).iter())
+        .map(|b| bytemuck::pod_read_unaligned(b))
+        .collect();
+    let per_step = |k: usize| all.iter().map(move |r| r[k] as f64 / steps.max(1) as f64);
+    let mean = |k: usize| per_step(k).sum::<f64>() / all.len() as f64;
+    let most = |k: usize| per_step(k).fold(0.0, f64::max);
+    Some(RanksReport {
+        ranks: all.len(),
+        particles: [
+            all.iter().map(|r| r[0] as usize).min().unwrap_or(0),
+            all.iter().map(|r| r[0] as usize).max().unwrap_or(0),
+        ],
+        messages_per_step: [mean(1), most(1)],
+        bytes_per_step: [mean(2), most(2)],
+        collectives_per_step: mean(3),
+    })
 }
 
 #[cfg(test)]

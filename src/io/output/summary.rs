@@ -39,6 +39,22 @@ impl std::fmt::Display for Status {
     }
 }
 
+/// How a run split across MPI ranks was divided and what the ranks sent each other
+/// (per rank and per step, averaged over the steps run).
+#[derive(Clone, Debug, Serialize)]
+pub struct RanksReport {
+    /// Number of ranks.
+    pub ranks: usize,
+    /// Fewest and most particles a rank held at the end.
+    pub particles: [usize; 2],
+    /// Point-to-point messages a rank sent per step: mean and most over the ranks.
+    pub messages_per_step: [f64; 2],
+    /// Bytes in them (node values at shared nodes, migrating particles): mean and most.
+    pub bytes_per_step: [f64; 2],
+    /// Collective operations (exact sums, gathers) per step.
+    pub collectives_per_step: f64,
+}
+
 /// The run summary written to summary.json at the end of a run.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -98,6 +114,8 @@ pub struct Summary {
     pub energies: Energies,
     /// A static scene's solves (None in an explicit run).
     pub static_solve: Option<SolveLog>,
+    /// A run split across MPI ranks: the split and the ranks' traffic (None on one rank).
+    pub ranks: Option<RanksReport>,
     /// The keys a static scene ignores (explicit runs only: cfl, dt, damping, initial
     /// velocities), as given.
     pub ignored_keys: Vec<String>,
