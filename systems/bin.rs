@@ -104,7 +104,9 @@ pub(crate) fn place<D: Dim>(
         tiles.fresh = false;
         return Err(i);
     }
-    if chunks.iter().any(|c| c.1) || !sorted {
+    // With no particle (a rank whose particles all left) nothing says whether the bins are
+    // stale: they are rebuilt, which is then free.
+    if chunks.iter().any(|c| c.1) || !sorted || x.is_empty() {
         tiles.sort();
     }
     tiles.fresh = true;
@@ -115,6 +117,8 @@ pub(crate) fn place<D: Dim>(
 /// finite), at the positions of `step` and `time`.
 pub(crate) fn outside<D: Dim>(world: &World<D>, i: usize, step: u64, time: f64) -> Unstable {
     let x = D::to_xyz(world.particles.x[i]);
+    // The particle's number in the whole scene (split across ranks, not its place here).
+    let i = world.particles.id.get(i).map_or(i as u64, |&id| id);
     let what = if x.iter().all(|c| c.is_finite()) {
         format!(
             "particle {i} left the grid at ({:.6e}, {:.6e}, {:.6e}) m (its stencil must stay \

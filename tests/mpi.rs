@@ -17,15 +17,28 @@ const OMPI_ENV: [(&str, &str); 7] = [
     ("HWLOC_COMPONENTS", "-gl,-opencl"),
 ];
 
-/// Runs `scene` with `args`, under `mpirun -np ranks` when `ranks` is given, into `out`.
+/// Runs `scene` with `args`, under `mpirun -np ranks` when `ranks` is given, into `out`;
+/// it must succeed.
 #[cfg(feature = "mpi")]
 fn run(scene: &str, ranks: Option<usize>, out: &Path, args: &[&str]) {
+    let done = launch(scene, ranks, out, args);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+}
+
+/// Runs `scene` as [`run`] does and returns how it ended.
+#[cfg(feature = "mpi")]
+fn launch(scene: &str, ranks: Option<usize>, out: &Path, args: &[&str]) -> std::process::Output {
     let bin = env!("CARGO_BIN_EXE_fissure");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join(scene);
     let mut cmd = match ranks {
         Some(n) => {
             let mut c = Command::new("mpirun");
-            c.args(["-np", &n.to_string(), bin]);
+            // A hang (a rank waiting for one that failed) ends the job instead of CI.
+            c.args(["--timeout", "300", "-np", &n.to_string(), bin]);
             c
         }
         None => Command::new(bin),
@@ -35,12 +48,7 @@ fn run(scene: &str, ranks: Option<usize>, out: &Path, args: &[&str]) {
         .arg(&scene)
         .arg("--out")
         .arg(out);
-    let done = cmd.args(args).output().expect("mpirun starts");
-    assert!(
-        done.status.success(),
-        "{}",
-        String::from_utf8_lossy(&done.stderr)
-    );
+    cmd.args(args).output().expect("mpirun starts")
 }
 
 /// energy.csv and probes.csv of `scene` on 2 and 3 ranks equal the serial run's, byte for byte.
@@ -143,6 +151,81 @@ fn points_of(path: &Path) -> (Vec<String>, Vec<[u64; 3]>) {
 #[test]
 fn colliding_disks_split_across_ranks_match_one_process() {
     same_on_ranks("scenarios/disks_2d.toml", &[]);
+}
+
+/// A small plastic disc flying across a large grid: most ranks start with no particle and
+/// take the disc's as it passes; 4 ranks give the serial run's bits.
+#[cfg(feature = "mpi")]
+#[test]
+fn a_disc_crossing_empty_ranks_matches_one_process() {
+    let scene = r#"
+name = "crossing_disc"
+[simulation]
+dimension = 2
+duration = 0.3
+cfl = 0.4
+[grid]
+min = [0.0, 0.0]
+max = [0.2, 0.2]
+cell = [0.0025, 0.0025]
+[[material]]
+name = "soft"
+E = 1000.0
+nu = 0.3
+rho = 1000.0
+model = "j2"
+sigma_y = 50.0
+[[body]]
+material = "soft"
+disc = { center = [0.03, 0.04], radius = 0.012 }
+velocity = [0.5, 0.4]
+[[probe]]
+name = "vx"
+region = { min = [0.018, 0.028], max = [0.042, 0.052] }
+quantity = "velocity"
+component = "x"
+[output]
+interval = 0.05
+"#;
+    let (dir, file) = disc_scene(scene, "disc");
+    let serial = dir.join("serial");
+    run(file.to_str().unwrap(), None, &serial, &[]);
+    let split = dir.join("ranks4");
+    run(file.to_str().unwrap(), Some(4), &split, &["--threads", "1"]);
+    for f in ["energy.csv", "probes.csv"] {
+        let a = std::fs::read(serial.join(f)).unwrap();
+        assert!(a == std::fs::read(split.join(f)).unwrap(), "{f} differs");
+    }
+    let summary = std::fs::read_to_string(split.join("summary.json")).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    let held = &json["ranks"]["particles"];
+    assert_eq!(held[0], 0, "some rank ends with no particle: {held}");
+
+    // Flown on, the disc leaves the grid: the rank holding the particle that left stops
+    // every rank with its message, and the rows written so far are the serial run's.
+    let (dir, file) = disc_scene(
+        &scene.replace("duration = 0.3", "duration = 0.6"),
+        "leaving",
+    );
+    let (serial, split) = (dir.join("serial"), dir.join("ranks3"));
+    let one = launch(file.to_str().unwrap(), None, &serial, &[]);
+    let many = launch(file.to_str().unwrap(), Some(3), &split, &["--threads", "1"]);
+    assert!(!one.status.success() && !many.status.success());
+    let said = String::from_utf8_lossy(&many.stderr);
+    assert!(said.contains("left the grid"), "{said}");
+    let a = std::fs::read(serial.join("energy.csv")).unwrap();
+    assert!(a == std::fs::read(split.join("energy.csv")).unwrap());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Writes `scene` into a fresh folder named after `name`; returns the folder and the file.
+#[cfg(feature = "mpi")]
+fn disc_scene(scene: &str, name: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+    let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("crossing_disc.toml");
+    std::fs::write(&file, scene).unwrap();
+    (dir, file)
 }
 
 #[cfg(feature = "mpi")]

@@ -101,6 +101,7 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
     // The closing stress update binned the particles where they are now: their tiles are
     // known (else they are found from the positions).
     let binned = world.tiles.fresh && world.tiles.tile_of.len() == p.len();
+    let (mut lost, mut far) = (None, None);
     for i in 0..p.len() {
         let t = if binned {
             world.tiles.tile_of[i]
@@ -109,9 +110,9 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
             for (a, slot) in cell.iter_mut().enumerate().take(D::D) {
                 let c = ((p.x[i][a] - geom.origin[a]) * geom.inv_h[a]).floor();
                 if !(c >= 0.0 && c < geom.cells[a] as f64) {
-                    return Err(bin::outside(world, i, world.step, world.time));
+                    lost.get_or_insert(i);
                 }
-                *slot = c as usize;
+                *slot = (c.max(0.0) as usize).min(geom.cells[a] - 1);
             }
             world.tiles.tile_of_cell(cell)
         };
@@ -121,21 +122,28 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
         } else if let Some(k) = partition.peers.iter().position(|&q| q == owner) {
             leaving[k].push(i as u32);
         } else {
-            return Err(Unstable {
-                step: world.step,
-                time: world.time,
-                what: format!(
-                    "particle {} crossed more than a tile in one step (to rank {owner})",
-                    p.id[i]
-                ),
-            });
+            far.get_or_insert((i, owner));
         }
     }
+    // Every rank takes part in the exchange, then all stop if one found a particle lost.
+    let found = match (lost, far) {
+        (Some(i), _) => Err(bin::outside(world, i, world.step, world.time)),
+        (None, Some((i, owner))) => Err(Unstable {
+            step: world.step,
+            time: world.time,
+            what: format!(
+                "particle {} crossed more than a tile in one step (to rank {owner})",
+                p.id[i]
+            ),
+        }),
+        (None, None) => Ok(()),
+    };
     let out: Vec<Vec<u8>> = leaving
         .iter()
         .map(|rows| pack(&mut world.particles, rows))
         .collect();
     let got = world.domain.comm.exchange(&partition.peers, &out);
+    world.domain.agree(found)?;
     let moved = leaving.iter().any(|l| !l.is_empty()) || got.iter().any(|g| !g.is_empty());
     if !moved {
         return Ok(false);
@@ -159,37 +167,54 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
     Ok(true)
 }
 
-/// The rows `rows` of every allocated column, column after column.
+/// The rows `rows` of every allocated column, column after column, after the row count and
+/// a mask of the allocated columns (a rank that holds no particles has no column
+/// allocated, and takes the sender's).
 fn pack<D: Dim>(p: &mut Particles<D>, rows: &[u32]) -> Vec<u8> {
-    struct Pack<'a>(&'a [u32], Vec<u8>);
+    struct Pack<'a> {
+        rows: &'a [u32],
+        out: Vec<u8>,
+        mask: u32,
+        k: u32,
+    }
     impl ColumnOp for Pack<'_> {
         fn column<T: Columnar>(&mut self, col: &mut Vec<T>) {
             if !col.is_empty() {
-                for &i in self.0 {
-                    self.1
-                        .extend_from_slice(bytemuck::bytes_of(&col[i as usize]));
+                self.mask |= 1 << self.k;
+                for &i in self.rows {
+                    (self.out).extend_from_slice(bytemuck::bytes_of(&col[i as usize]));
                 }
             }
+            self.k += 1;
         }
     }
     if rows.is_empty() {
         return Vec::new();
     }
-    let mut op = Pack(rows, Vec::new());
+    let mut op = Pack {
+        rows,
+        out: vec![0; 8],
+        mask: 0,
+        k: 0,
+    };
     p.for_each_column(&mut op);
-    op.1
+    op.out[..4].copy_from_slice(&(rows.len() as u32).to_le_bytes());
+    op.out[4..8].copy_from_slice(&op.mask.to_le_bytes());
+    op.out
 }
 
-/// Appends the rows `pack` wrote (the same columns are allocated on every rank).
+/// Appends the rows [`pack`] wrote.
 fn unpack<D: Dim>(p: &mut Particles<D>, bytes: &[u8]) {
     struct Unpack<'a> {
         bytes: &'a [u8],
         at: usize,
         rows: usize,
+        mask: u32,
+        k: u32,
     }
     impl ColumnOp for Unpack<'_> {
         fn column<T: Columnar>(&mut self, col: &mut Vec<T>) {
-            if !col.is_empty() {
+            if self.mask & (1 << self.k) != 0 {
                 let size = std::mem::size_of::<T>();
                 for _ in 0..self.rows {
                     let b = &self.bytes[self.at..self.at + size];
@@ -197,31 +222,19 @@ fn unpack<D: Dim>(p: &mut Particles<D>, bytes: &[u8]) {
                     self.at += size;
                 }
             }
+            self.k += 1;
         }
     }
     if bytes.is_empty() {
         return;
     }
-    let row = row_bytes(p);
+    let word = |k: usize| u32::from_le_bytes(bytes[k..k + 4].try_into().expect("4 bytes"));
     let mut op = Unpack {
         bytes,
-        at: 0,
-        rows: bytes.len() / row,
+        at: 8,
+        rows: word(0) as usize,
+        mask: word(4),
+        k: 0,
     };
     p.for_each_column(&mut op);
-}
-
-/// Bytes per particle over the allocated columns.
-fn row_bytes<D: Dim>(p: &mut Particles<D>) -> usize {
-    struct Size(usize);
-    impl ColumnOp for Size {
-        fn column<T: Columnar>(&mut self, col: &mut Vec<T>) {
-            if !col.is_empty() {
-                self.0 += std::mem::size_of::<T>();
-            }
-        }
-    }
-    let mut op = Size(0);
-    p.for_each_column(&mut op);
-    op.0
 }

@@ -303,7 +303,10 @@ impl Schedule {
         for k in 0..self.systems.len() {
             let t0 = Instant::now();
             match self.systems[k] {
-                System::Bin => bin::run(world)?,
+                System::Bin => {
+                    let binned = bin::run(world);
+                    world.domain.agree(binned)?;
+                }
                 System::Classify => classify::run(world)?,
                 System::CrackAdvect => crack_advect::run(world),
                 System::Contact { update } => contact::run(world, update),
@@ -311,7 +314,10 @@ impl Schedule {
                 System::MomentumBc { end } => grid_update::momentum_bc(world, end),
                 System::StressForce { fraction } => stress_force::run(world, fraction),
                 System::StressBin { fraction } if keep_stencils => stress::run(world, fraction),
-                System::StressBin { fraction } => stress_bin::run(world, fraction)?,
+                System::StressBin { fraction } => {
+                    let binned = stress_bin::run(world, fraction);
+                    world.domain.agree(binned)?;
+                }
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),

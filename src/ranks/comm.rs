@@ -190,6 +190,17 @@ mod mpi_world {
             .ok_or_else(|| anyhow::anyhow!("MPI was already initialised"))?;
         let world = universe.world();
         let (rank, size) = (world.rank() as usize, world.size() as usize);
+        if size > 1 {
+            // A panic on one rank would leave the others waiting for it: abort them all.
+            let report = std::panic::take_hook();
+            std::panic::set_hook(Box::new(move |info| {
+                report(info);
+                eprintln!("rank {rank} panicked: stopping every rank");
+                // SAFETY: MPI is initialised (the universe outlives the run); MPI_Abort
+                // does not return.
+                unsafe { mpi::ffi::MPI_Abort(mpi::ffi::RSMPI_COMM_WORLD, 101) };
+            }));
+        }
         let comm = Comm {
             rank,
             size,

@@ -8,6 +8,7 @@
 //! too, which take the value as theirs. Before each class every rank holding a shared node
 //! therefore holds the one-rank running sum, and after the last class the full sum.
 
+use crate::base::error::Unstable;
 use crate::base::exact_sum::ExactSum;
 use crate::ranks::comm::Comm;
 use crate::ranks::partition::Partition;
@@ -73,6 +74,32 @@ impl Domain {
     #[inline(always)]
     pub fn owns_node(&self, n: usize) -> bool {
         self.partition.as_ref().is_none_or(|p| p.owned_nodes[n])
+    }
+
+    /// Whether every rank's `stepped` is Ok: split, every rank calls it at the same point
+    /// and all get the lowest failing rank's error (its own if it failed), so that none
+    /// goes on to wait for one that stopped.
+    pub fn agree(&self, stepped: Result<(), Unstable>) -> Result<(), Unstable> {
+        if !self.is_split() {
+            return stepped;
+        }
+        // The step, the time's bits and what happened, space-separated.
+        let mine =
+            (stepped.as_ref().err()).map(|u| format!("{} {} {}", u.step, u.time.to_bits(), u.what));
+        match self.comm.first_error(mine) {
+            None => Ok(()),
+            Some(_) if stepped.is_err() => stepped,
+            Some((rank, text)) => {
+                let mut parts = text.splitn(3, ' ');
+                let mut next = || parts.next().unwrap_or_default();
+                let (step, time) = (next().parse().unwrap_or(0), next().parse().unwrap_or(0));
+                Err(Unstable {
+                    step,
+                    time: f64::from_bits(time),
+                    what: format!("on rank {rank}: {}", next()),
+                })
+            }
+        }
     }
 
     /// Adds the other ranks' terms into `sums` (nothing on one rank).

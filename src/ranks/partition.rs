@@ -87,7 +87,7 @@ pub struct Partition {
 #[derive(Debug, thiserror::Error)]
 #[error(
     "{ranks} MPI ranks but the grid has {tiles} tiles: every rank needs one (use fewer ranks, \
-     or a finer grid)"
+     smaller tiles: `simulation.tile`, or a finer grid)"
 )]
 pub struct TooManyRanks {
     /// Ranks asked.
