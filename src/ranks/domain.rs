@@ -47,16 +47,22 @@ impl Domain {
         let Some(p) = &self.partition else {
             return;
         };
-        let out: Vec<Vec<u8>> = p.sends[class]
-            .iter()
-            .map(|nodes| {
+        // A peer with nothing to send or take in this class is left out on both sides
+        // (the lists are each other's mirror).
+        let talks: Vec<usize> = (0..p.peers.len())
+            .filter(|&k| !(p.sends[class][k].is_empty() && p.receives[class][k].is_empty()))
+            .collect();
+        let peers: Vec<usize> = talks.iter().map(|&k| p.peers[k]).collect();
+        let out: Vec<Vec<u8>> = (talks.iter())
+            .map(|&k| {
                 let mut buf = Vec::new();
-                columns.iter().for_each(|c| c.pack(nodes, &mut buf));
+                columns.iter().for_each(|c| c.pack(&p.sends[class][k], &mut buf));
                 buf
             })
             .collect();
-        let got = self.comm.exchange(&p.peers, &out);
-        for (nodes, bytes) in p.receives[class].iter().zip(&got) {
+        let got = self.comm.exchange(&peers, &out);
+        for (&k, bytes) in talks.iter().zip(&got) {
+            let nodes = &p.receives[class][k];
             let mut at = 0;
             for c in columns {
                 at += c.unpack(nodes, &bytes[at..]);
