@@ -109,6 +109,20 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(name) = one_process(&cli.command) {
+        // Started by mpirun on several ranks, every rank would do the whole job.
+        match start() {
+            Ok((c, _)) if c.is_split() && !c.is_root() => return ExitCode::FAILURE,
+            Ok((c, _)) if c.is_split() => {
+                return report(anyhow::anyhow!(
+                    "`fissure {name}` runs on one process: start it without mpirun (only \
+                     `run` divides a scene among MPI ranks)"
+                ));
+            }
+            Ok(_) => {}
+            Err(e) => return report(e),
+        }
+    }
     match cli.command {
         Command::Run {
             scenario,
@@ -141,6 +155,18 @@ fn main() -> ExitCode {
             out,
             yes,
         } => cmd_sweep(&scenario, &vary, threads, out, yes),
+    }
+}
+
+/// The name of a command that runs on one process only (all but `run`), None for `run`.
+fn one_process(command: &Command) -> Option<&'static str> {
+    match command {
+        Command::Run { .. } => None,
+        Command::Resume { .. } => Some("resume"),
+        Command::Inspect { .. } => Some("inspect"),
+        Command::Check { .. } => Some("check"),
+        Command::Validate { .. } => Some("validate"),
+        Command::Sweep { .. } => Some("sweep"),
     }
 }
 
@@ -432,15 +458,6 @@ fn cmd_resume(path: &Path, out: Option<PathBuf>, threads: usize, until: Option<f
             Err(e) => return report(e),
         },
     };
-    match start() {
-        Ok((c, _)) if c.is_split() => {
-            return report(anyhow::anyhow!(
-                "resuming on more than one MPI rank is not yet supported: resume without mpirun"
-            ));
-        }
-        Ok(_) => {}
-        Err(e) => return report(e),
-    }
     let opts = RunOptions {
         out: Some(out.clone()),
         threads,

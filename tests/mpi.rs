@@ -248,3 +248,38 @@ fn a_build_without_mpi_refuses_several_ranks() {
     assert!(!done.status.success());
     assert!(err.contains("--features mpi"), "{err}");
 }
+
+/// What a split run cannot do yet is refused by name, once (by the first rank): a scene
+/// with cracks, and the commands that run on one process.
+#[cfg(feature = "mpi")]
+#[test]
+fn split_runs_refuse_what_they_cannot_do_yet() {
+    let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_refuse", std::process::id()));
+    let done = launch("scenarios/dcb_2d.toml", Some(2), &dir, &[]);
+    let said = String::from_utf8_lossy(&done.stderr);
+    assert!(!done.status.success());
+    assert!(said.contains("a scene with cracks cannot yet run on more than one MPI rank"));
+    assert_eq!(said.matches("error:").count(), 1, "{said}");
+
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/dcb_2d.toml");
+    let done = Command::new("mpirun")
+        .args([
+            "--timeout",
+            "300",
+            "-np",
+            "2",
+            env!("CARGO_BIN_EXE_fissure"),
+            "check",
+        ])
+        .arg(scene)
+        .envs(OMPI_ENV)
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&done.stderr);
+    assert!(!done.status.success());
+    assert!(
+        said.contains("`fissure check` runs on one process"),
+        "{said}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

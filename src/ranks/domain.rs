@@ -56,7 +56,9 @@ impl Domain {
         let out: Vec<Vec<u8>> = (talks.iter())
             .map(|&k| {
                 let mut buf = Vec::new();
-                columns.iter().for_each(|c| c.pack(&p.sends[class][k], &mut buf));
+                columns
+                    .iter()
+                    .for_each(|c| c.pack(&p.sends[class][k], &mut buf));
                 buf
             })
             .collect();
