@@ -184,6 +184,15 @@ name = "vx"
 region = { min = [0.018, 0.028], max = [0.042, 0.052] }
 quantity = "velocity"
 component = "x"
+[[probe]]
+name = "gap"
+region = { min = [0.018, 0.028], max = [0.042, 0.052] }
+quantity = "opening"
+component = "x"
+[[probe]]
+name = "yielded"
+region = { center = [0.03, 0.04], radius = 0.012 }
+quantity = "plastic_radius"
 [output]
 interval = 0.05
 "#;

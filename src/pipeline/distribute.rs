@@ -8,7 +8,7 @@ use crate::ranks::ABSENT;
 use crate::ranks::comm::Comm;
 use crate::ranks::domain::Domain;
 use crate::ranks::partition::{Partition, TileGrid};
-use crate::record::probe::{Probe, ProbeQty};
+use crate::record::probe::Probe;
 use crate::store::particles::{ColumnOp, Particles};
 use crate::store::world::{Solver, World};
 use crate::systems::bin;
@@ -24,7 +24,7 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
         };
         return Ok(());
     }
-    refuse_unsupported(world, probes)?;
+    refuse_unsupported(world)?;
     bin::run(world).map_err(|u| anyhow::anyhow!("{u}"))?;
     let tiles = &world.tiles;
     let counts: Vec<u32> = tiles.start.windows(2).map(|w| w[1] - w[0]).collect();
@@ -58,19 +58,13 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
 }
 
 /// What a split run cannot do yet, refused by name.
-fn refuse_unsupported<D: Dim>(world: &World<D>, probes: &[Probe]) -> anyhow::Result<()> {
+fn refuse_unsupported<D: Dim>(world: &World<D>) -> anyhow::Result<()> {
     let no = |what: &str| anyhow::anyhow!("{what} cannot yet run on more than one MPI rank");
     if world.cracks.is_some() {
         return Err(no("a scene with cracks"));
     }
     if world.settings.solver == Solver::Static {
         return Err(no("a static scene"));
-    }
-    if let Some(p) = probes
-        .iter()
-        .find(|p| matches!(p.qty, ProbeQty::Opening | ProbeQty::PlasticRadius))
-    {
-        return Err(no(&format!("probe '{}' ({:?})", p.name, p.qty)));
     }
     Ok(())
 }

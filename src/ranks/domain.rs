@@ -110,6 +110,16 @@ impl Domain {
         }
     }
 
+    /// The largest of every rank's `x`.
+    pub fn max(&self, x: f64) -> f64 {
+        if !self.is_split() {
+            return x;
+        }
+        (self.comm.all_gather(x.to_le_bytes().to_vec()).iter())
+            .map(|b| f64::from_le_bytes(b[..].try_into().expect("8 bytes per rank")))
+            .fold(x, f64::max)
+    }
+
     /// Adds the other ranks' terms into `sums` (nothing on one rank).
     pub fn sum(&self, sums: &mut [ExactSum]) {
         if self.is_split() {

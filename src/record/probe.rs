@@ -4,6 +4,7 @@ use crate::base::dim::Dim;
 use crate::base::exact_sum::ExactSum;
 use crate::base::sym::SymTensor;
 use crate::ranks::ABSENT;
+use crate::ranks::domain::Domain;
 use crate::store::particles::Particles;
 use crate::store::world::World;
 use serde::Serialize;
@@ -62,8 +63,8 @@ impl Probe {
     pub fn sample<D: Dim>(&self, world: &World<D>) -> f64 {
         let (p, materials) = (&world.particles, &world.materials);
         match self.qty {
-            ProbeQty::Opening => return self.opening(p),
-            ProbeQty::PlasticRadius => return self.plastic_radius(p),
+            ProbeQty::Opening => return self.opening(p, &world.domain),
+            ProbeQty::PlasticRadius => return self.plastic_radius(p, &world.domain),
             ProbeQty::Reaction => {
                 let bcs = &world.bcs;
                 let force = |&(b, k): &(u32, u32)| bcs[b as usize].reaction[k as usize];
@@ -109,23 +110,25 @@ impl Probe {
     }
 
     /// The [`ProbeQty::Opening`] sample.
-    fn opening<D: Dim>(&self, p: &Particles<D>) -> f64 {
+    fn opening<D: Dim>(&self, p: &Particles<D>, domain: &Domain) -> f64 {
         let c = self.comp;
-        let mut sides = [(0.0, 0usize); 2];
-        for &i in &self.particles {
+        // Per side: the displacements' sum and the count (exact, over every rank).
+        let mut sides: [ExactSum; 4] = Default::default();
+        for &i in self.particles.iter().filter(|&&i| i != ABSENT) {
             let i = i as usize;
-            let side = &mut sides[usize::from(p.x0[i][c] > self.centre[c])];
-            side.0 += p.displacement(i)[c];
-            side.1 += 1;
+            let side = 2 * usize::from(p.x0[i][c] > self.centre[c]);
+            sides[side].add(p.displacement(i)[c]);
+            sides[side + 1].add(1.0);
         }
-        let mean = |(sum, n): (f64, usize)| sum / n as f64;
-        mean(sides[1]) - mean(sides[0])
+        domain.sum(&mut sides);
+        let [s0, n0, s1, n1] = sides.map(|s| s.value());
+        s1 / n1 - s0 / n0
     }
 
     /// The [`ProbeQty::PlasticRadius`] sample; 0 in a scene without plastic columns.
-    fn plastic_radius<D: Dim>(&self, p: &Particles<D>) -> f64 {
+    fn plastic_radius<D: Dim>(&self, p: &Particles<D>, domain: &Domain) -> f64 {
         let mut radius = 0.0f64;
-        for &i in &self.particles {
+        for &i in self.particles.iter().filter(|&&i| i != ABSENT) {
             let i = i as usize;
             if p.hardened.get(i).is_some_and(|h| h.equivalent > 0.0) {
                 let x = D::to_xyz(p.x0[i]);
@@ -133,6 +136,6 @@ impl Probe {
                 radius = radius.max((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt());
             }
         }
-        radius
+        domain.max(radius)
     }
 }
