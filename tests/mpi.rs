@@ -207,8 +207,9 @@ interval = 0.05
     }
     let summary = std::fs::read_to_string(split.join("summary.json")).unwrap();
     let json: serde_json::Value = serde_json::from_str(&summary).unwrap();
-    let held = &json["ranks"]["particles"];
-    assert_eq!(held[0], 0, "some rank ends with no particle: {held}");
+    // The disc started in the first rank's tiles: the tiles were divided anew as it moved.
+    let rebalances = json["ranks"]["rebalances"].as_u64().unwrap();
+    assert!(rebalances >= 1, "{}", json["ranks"]);
 
     // Flown on, the disc leaves the grid: the rank holding the particle that left stops
     // every rank with its message, and the rows written so far are the serial run's.

@@ -12,6 +12,7 @@ use crate::record::probe::Probe;
 use crate::store::particles::{ColumnOp, Particles};
 use crate::store::world::{Solver, World};
 use crate::systems::bin;
+use std::borrow::Cow;
 
 /// Keeps this rank's particles of a scene every rank built whole: those in the tiles the
 /// partition gives it, numbered by their index in the whole scene. Loads and probes keep
@@ -20,7 +21,7 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
     if !comm.is_split() {
         world.domain = Domain {
             comm,
-            partition: None,
+            ..Domain::default()
         };
         return Ok(());
     }
@@ -52,6 +53,7 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
     world.domain = Domain {
         comm,
         partition: Some(partition),
+        rebalances: 0,
     };
     localize(world, probes);
     Ok(())
@@ -89,27 +91,11 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
         return Ok(false);
     };
     let me = world.domain.comm.rank();
-    let geom = &world.grid.geom;
     let p = &world.particles;
     let mut leaving: Vec<Vec<u32>> = vec![Vec::new(); partition.peers.len()];
-    // The closing stress update binned the particles where they are now: their tiles are
-    // known (else they are found from the positions).
-    let binned = world.tiles.fresh && world.tiles.tile_of.len() == p.len();
-    let (mut lost, mut far) = (None, None);
-    for i in 0..p.len() {
-        let t = if binned {
-            world.tiles.tile_of[i]
-        } else {
-            let mut cell = [0usize; 3];
-            for (a, slot) in cell.iter_mut().enumerate().take(D::D) {
-                let c = ((p.x[i][a] - geom.origin[a]) * geom.inv_h[a]).floor();
-                if !(c >= 0.0 && c < geom.cells[a] as f64) {
-                    lost.get_or_insert(i);
-                }
-                *slot = (c.max(0.0) as usize).min(geom.cells[a] - 1);
-            }
-            world.tiles.tile_of_cell(cell)
-        };
+    let (tile_of, lost) = tiles_now(world);
+    let mut far = None;
+    for (i, &t) in tile_of.iter().enumerate() {
         let owner = partition.owner[t as usize] as usize;
         if owner == me {
             continue;
@@ -132,24 +118,66 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
         }),
         (None, None) => Ok(()),
     };
-    let out: Vec<Vec<u8>> = leaving
-        .iter()
+    let peers = partition.peers.clone();
+    let got = exchange_rows(world, &peers, &leaving);
+    world.domain.agree(found)?;
+    Ok(settle_rows(world, probes, &leaving, &got))
+}
+
+/// Each particle's tile from its position (the closing stress update's bins when they are
+/// fresh), and the first particle outside the grid, if any.
+fn tiles_now<D: Dim>(world: &World<D>) -> (Cow<'_, [u32]>, Option<usize>) {
+    let p = &world.particles;
+    if world.tiles.fresh && world.tiles.tile_of.len() == p.len() {
+        return (Cow::Borrowed(&world.tiles.tile_of), None);
+    }
+    let geom = &world.grid.geom;
+    let mut lost = None;
+    let tiles = (0..p.len())
+        .map(|i| {
+            let mut cell = [0usize; 3];
+            for (a, slot) in cell.iter_mut().enumerate().take(D::D) {
+                let c = ((p.x[i][a] - geom.origin[a]) * geom.inv_h[a]).floor();
+                if !(c >= 0.0 && c < geom.cells[a] as f64) {
+                    lost.get_or_insert(i);
+                }
+                *slot = (c.max(0.0) as usize).min(geom.cells[a] - 1);
+            }
+            world.tiles.tile_of_cell(cell)
+        })
+        .collect();
+    (Cow::Owned(tiles), lost)
+}
+
+/// Sends the rows `leaving[k]` to `peers[k]` and returns what each sent here.
+fn exchange_rows<D: Dim>(
+    world: &mut World<D>,
+    peers: &[usize],
+    leaving: &[Vec<u32>],
+) -> Vec<Vec<u8>> {
+    let out: Vec<Vec<u8>> = (leaving.iter())
         .map(|rows| pack(&mut world.particles, rows))
         .collect();
-    let got = world.domain.comm.exchange(&partition.peers, &out);
-    world.domain.agree(found)?;
+    world.domain.comm.exchange(peers, &out)
+}
+
+/// Drops the rows that left, appends those that arrived, restores the ascending ids and
+/// points loads and probes at the new places; returns whether anything moved.
+fn settle_rows<D: Dim>(
+    world: &mut World<D>,
+    probes: &mut [Probe],
+    leaving: &[Vec<u32>],
+    got: &[Vec<u8>],
+) -> bool {
     let moved = leaving.iter().any(|l| !l.is_empty()) || got.iter().any(|g| !g.is_empty());
     if !moved {
-        return Ok(false);
+        return false;
     }
     let mut left = bitvec::bitvec![0; world.particles.len()];
-    leaving
-        .iter()
-        .flatten()
-        .for_each(|&i| left.set(i as usize, true));
+    (leaving.iter().flatten()).for_each(|&i| left.set(i as usize, true));
     let stay: Vec<u32> = left.iter_zeros().map(|i| i as u32).collect();
     world.particles.permute(&stay);
-    for bytes in &got {
+    for bytes in got {
         unpack(&mut world.particles, bytes);
     }
     let mut order: Vec<u32> = (0..world.particles.len() as u32).collect();
@@ -158,6 +186,80 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
     world.tiles.tile_of.clear();
     world.tiles.fresh = false;
     localize(world, probes);
+    true
+}
+
+/// Steps between looks at the ranks' balance.
+const BALANCE_EVERY: u64 = 64;
+/// The most particles on a rank over the mean past which the tiles are divided anew.
+const IMBALANCE: f64 = 1.25;
+
+/// Every [`BALANCE_EVERY`] steps, when a rank holds more than [`IMBALANCE`] times the mean
+/// particle count, divides the tiles anew by where the particles are now and moves each to
+/// its tile's new owner. The results do not change (node sums and reductions do not depend
+/// on the split). Every rank of a split run calls it at the same point of each step.
+pub fn rebalance<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<bool, Unstable> {
+    if !world.domain.is_split() || !world.step.is_multiple_of(BALANCE_EVERY) {
+        return Ok(false);
+    }
+    let comm = world.domain.comm.clone();
+    let held: Vec<u64> = (comm
+        .all_gather((world.particles.len() as u64).to_le_bytes().to_vec())
+        .iter())
+    .map(|b| u64::from_le_bytes(b[..].try_into().expect("8 bytes per rank")))
+    .collect();
+    let mean = held.iter().sum::<u64>() as f64 / held.len() as f64;
+    if (*held.iter().max().unwrap_or(&0) as f64) <= IMBALANCE * mean {
+        return Ok(false);
+    }
+    let (tile_of, lost) = tiles_now(world);
+    world.domain.agree(match lost {
+        Some(i) => Err(bin::outside(world, i, world.step, world.time)),
+        None => Ok(()),
+    })?;
+    let mut counts = vec![0u32; world.tiles.len()];
+    tile_of.iter().for_each(|&t| counts[t as usize] += 1);
+    let mut total = vec![0u32; counts.len()];
+    for b in comm.all_gather(bytemuck::cast_slice(&counts).to_vec()) {
+        let theirs: Vec<u32> = bytemuck::pod_collect_to_vec(&b);
+        total.iter_mut().zip(theirs).for_each(|(t, c)| *t += c);
+    }
+    let tiles = &world.tiles;
+    let grid = TileGrid {
+        counts: tiles.counts,
+        size: tiles.size,
+        cells: world.grid.geom.cells,
+        dims: D::D,
+    };
+    let (me, ranks) = (comm.rank(), comm.size());
+    let partition = Partition::new(grid, &total, ranks, me).map_err(|e| Unstable {
+        step: world.step,
+        time: world.time,
+        what: e.to_string(),
+    })?;
+    // Whole tiles may not divide better than now: then nothing moves.
+    let mut shares = vec![0u64; ranks];
+    (total.iter().zip(&partition.owner)).for_each(|(&c, &r)| shares[r as usize] += c as u64);
+    if shares.iter().max() >= held.iter().max() {
+        return Ok(false);
+    }
+    // Particles may go to any rank: every other rank is a peer of this exchange.
+    let others: Vec<usize> = (0..ranks).filter(|&r| r != me).collect();
+    let mut leaving: Vec<Vec<u32>> = vec![Vec::new(); others.len()];
+    for (i, &t) in tile_of.iter().enumerate() {
+        let owner = partition.owner[t as usize] as usize;
+        if owner != me {
+            let k = others
+                .iter()
+                .position(|&r| r == owner)
+                .expect("another rank");
+            leaving[k].push(i as u32);
+        }
+    }
+    let got = exchange_rows(world, &others, &leaving);
+    world.domain.partition = Some(partition);
+    world.domain.rebalances += 1;
+    settle_rows(world, probes, &leaving, &got);
     Ok(true)
 }
 

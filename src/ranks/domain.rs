@@ -20,6 +20,8 @@ pub struct Domain {
     pub comm: Comm,
     /// This rank's tiles and shared nodes (None on one rank).
     pub partition: Option<Partition>,
+    /// How many times the tiles were divided anew as the particles moved.
+    pub rebalances: u32,
 }
 
 /// A grid column a colour class's exchange carries.

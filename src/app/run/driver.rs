@@ -236,6 +236,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
             next == self.steps,
         );
         distribute::migrate(&mut self.world, &mut self.probes).map_err(Stop::Unstable)?;
+        distribute::rebalance(&mut self.world, &mut self.probes).map_err(Stop::Unstable)?;
         let measured = (self.schedule)
             .step_measuring(&mut self.world, ends_at_row)
             .map_err(Stop::Unstable)?;

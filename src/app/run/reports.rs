@@ -293,6 +293,7 @@ pub(super) fn ranks<D: Dim>(world: &World<D>, steps: u64) -> Option<RanksReport>
         messages_per_step: [mean(1), most(1)],
         bytes_per_step: [mean(2), most(2)],
         collectives_per_step: mean(3),
+        rebalances: world.domain.rebalances,
     })
 }
 

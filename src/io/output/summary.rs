@@ -53,6 +53,8 @@ pub struct RanksReport {
     pub bytes_per_step: [f64; 2],
     /// Collective operations (exact sums, gathers) per step.
     pub collectives_per_step: f64,
+    /// Times the tiles were divided anew as the particles moved.
+    pub rebalances: u32,
 }
 
 /// The run summary written to summary.json at the end of a run.
