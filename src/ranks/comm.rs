@@ -8,7 +8,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// This process's place among the run's ranks, and the channel to the others.
-#[derive(Clone, Default)]
+#[derive(Clone)]
 pub struct Comm {
     /// This rank (0-based).
     rank: usize,
@@ -19,6 +19,13 @@ pub struct Comm {
     world: Option<Arc<mpi_world::World>>,
     /// What this rank has sent.
     traffic: Arc<Traffic>,
+}
+
+impl Default for Comm {
+    /// The only rank.
+    fn default() -> Self {
+        Comm::single()
+    }
 }
 
 /// Messages and bytes this rank has sent to its peers, and collective operations it took
@@ -35,14 +42,20 @@ pub struct Traffic {
 
 impl fmt::Debug for Comm {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "rank {} of {}", self.rank, self.size.max(1))
+        write!(f, "rank {} of {}", self.rank, self.size)
     }
 }
 
 impl Comm {
     /// The only rank.
     pub fn single() -> Self {
-        Comm::default()
+        Comm {
+            rank: 0,
+            size: 1,
+            #[cfg(feature = "mpi")]
+            world: None,
+            traffic: Default::default(),
+        }
     }
 
     /// Messages, bytes and collectives this rank has sent so far.
@@ -58,7 +71,7 @@ impl Comm {
 
     /// Number of ranks.
     pub fn size(&self) -> usize {
-        self.size.max(1)
+        self.size
     }
 
     /// Whether this is the rank that writes the run's outputs.
