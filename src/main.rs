@@ -9,6 +9,7 @@ use fissure::base::dim::{D2, D3};
 use fissure::base::error::{ScenarioError, UsageError};
 use fissure::io::output::summary::{Status, Summary};
 use fissure::io::scenario::{Source, build, folder_name_problem};
+use fissure::io::snapshot::pieces::verify as verify_pieces;
 use fissure::io::snapshot::{Reader, SnapshotError};
 use fissure::pipeline::schedule::Schedule;
 use fissure::ranks::comm::start;
@@ -158,14 +159,15 @@ fn main() -> ExitCode {
     }
 }
 
-/// The name of a command that runs on one process only (all but `run`), None for `run`.
+/// The name of a command that runs on one process only, None for those that divide their
+/// scenes among MPI ranks (`run`, `resume`, `validate`).
 fn one_process(command: &Command) -> Option<&'static str> {
     match command {
         Command::Run { .. } => None,
-        Command::Resume { .. } => Some("resume"),
+        Command::Resume { .. } => None,
         Command::Inspect { .. } => Some("inspect"),
         Command::Check { .. } => Some("check"),
-        Command::Validate { .. } => Some("validate"),
+        Command::Validate { .. } => None,
         Command::Sweep { .. } => Some("sweep"),
     }
 }
@@ -422,17 +424,18 @@ fn cmd_run(
     until: Option<f64>,
     overrides: &[String],
 ) -> ExitCode {
-    let src = match Source::load(path, overrides) {
-        Ok(s) => s,
-        Err(e) => return bad_input(&e),
-    };
-    let out = out.unwrap_or_else(|| PathBuf::from("out").join(src.name()));
     // Under mpirun: one process per rank, the first one writing and reporting.
     let (comm, _mpi) = match start() {
         Ok(c) => c,
         Err(e) => return report(e),
     };
     let root = comm.is_root();
+    let src = match Source::load(path, overrides) {
+        Ok(s) => s,
+        Err(e) if root => return bad_input(&e),
+        Err(_) => return ExitCode::from(BAD_INPUT),
+    };
+    let out = out.unwrap_or_else(|| PathBuf::from("out").join(src.name()));
     let opts = RunOptions {
         out: Some(out.clone()),
         threads,
@@ -442,34 +445,41 @@ fn cmd_run(
         stop: Some(stop_flag(StopRequests::new(&out), AFTER_THIS_STEP)),
         comm,
     };
-    match run(&src, &opts) {
-        Ok(o) if root => finish(&o, &out),
-        Err(e) if root => report(e),
-        Ok(_) => ExitCode::SUCCESS,
-        Err(_) => ExitCode::FAILURE,
-    }
+    on_root(root, run(&src, &opts), &out)
 }
 
 fn cmd_resume(path: &Path, out: Option<PathBuf>, threads: usize, until: Option<f64>) -> ExitCode {
-    let out = match out {
-        Some(o) => o,
-        None => match default_out(path) {
-            Ok(o) => o,
-            Err(e) => return report(e),
-        },
+    // Under mpirun: one process per rank, as many as wanted, the first one reporting.
+    let (comm, _mpi) = match start() {
+        Ok(c) => c,
+        Err(e) => return report(e),
+    };
+    let root = comm.is_root();
+    let out = match out.map_or_else(|| default_out(path), Ok) {
+        Ok(o) => o,
+        Err(e) => return on_root(root, Err(e), Path::new("")),
     };
     let opts = RunOptions {
         out: Some(out.clone()),
         threads,
-        progress: true,
+        progress: root,
         until,
         pause_after: None,
         stop: Some(stop_flag(StopRequests::new(&out), AFTER_THIS_STEP)),
-        comm: Default::default(),
+        comm,
     };
-    match resume(path, &opts) {
-        Ok(o) => finish(&o, &out),
-        Err(e) => report(e),
+    on_root(root, resume(path, &opts), &out)
+}
+
+/// How a run ends for the process: the first rank reports it (every rank reaches the same
+/// end), the others only exit with success or failure.
+fn on_root(root: bool, done: anyhow::Result<Outcome>, out: &Path) -> ExitCode {
+    match done {
+        Ok(o) if root => finish(&o, out),
+        Err(e) if root => report(e),
+        Ok(_) => ExitCode::SUCCESS,
+        Err(e) if is_bad_input(&e) => ExitCode::from(BAD_INPUT),
+        Err(_) => ExitCode::FAILURE,
     }
 }
 
@@ -549,7 +559,21 @@ fn cmd_inspect(path: &Path) -> ExitCode {
         } else {
             println!("{bad} column(s) fail their checksum");
         }
-        Ok(bad == 0)
+        // A split run's manifest: its particles are in one piece per rank.
+        let pieces = verify_pieces(&mut r)?;
+        for (k, (p, problem)) in pieces.iter().enumerate() {
+            println!(
+                "piece {k:<5} {} {:>12} particles  {}",
+                p.name,
+                p.particles,
+                problem.as_deref().unwrap_or("ok")
+            );
+        }
+        let broken = pieces.iter().filter(|p| p.1.is_some()).count();
+        if !pieces.is_empty() {
+            println!("{} of {} pieces ok", pieces.len() - broken, pieces.len());
+        }
+        Ok(bad == 0 && broken == 0)
     };
     match inspect() {
         Ok(true) => ExitCode::SUCCESS,
@@ -631,23 +655,36 @@ fn cmd_validate(
     out: Option<PathBuf>,
     overrides: &[String],
 ) -> ExitCode {
+    // Under mpirun: every scenario runs on all the ranks, the first one reporting.
+    let (comm, _mpi) = match start() {
+        Ok(c) => c,
+        Err(e) => return report(e),
+    };
+    let root = comm.is_root();
+    let say = |line: String| {
+        if root {
+            println!("{line}");
+        }
+    };
     let files = collect(paths);
     if files.is_empty() {
         let list: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-        eprintln!("error: no scenario (*.toml) in {}", list.join(", "));
+        if root {
+            eprintln!("error: no scenario (*.toml) in {}", list.join(", "));
+        }
         return ExitCode::from(BAD_INPUT);
     }
     let (mut failed, mut passed, mut refused) = (0usize, 0usize, 0usize);
-    println!(
+    say(format!(
         "{:<28} {:<24} {:>13} {:>13} {:>10} {:>9} {:<5} {:>9}",
         "scenario", "quantity", "reference", "obtained", "error", "tolerance", "pass", "wall (s)"
-    );
+    ));
     for file in &files {
         let t0 = Instant::now();
         let src = match Source::load(file, overrides) {
             Ok(s) => s,
             Err(e) => {
-                println!("{:<28} error: {e}", file.display());
+                say(format!("{:<28} error: {e}", file.display()));
                 refused += 1;
                 continue;
             }
@@ -655,6 +692,7 @@ fn cmd_validate(
         let opts = RunOptions {
             out: out.as_ref().map(|o| o.join(src.name())),
             threads,
+            comm: comm.clone(),
             ..RunOptions::default()
         };
         match run(&src, &opts) {
@@ -666,7 +704,7 @@ fn cmd_validate(
                     } else {
                         failed += 1;
                     }
-                    println!(
+                    say(format!(
                         "{:<28} {:<24} {:>13.5e} {:>13} {:>10} {:>9.2e} {:<5} {:>9.2}",
                         o.summary.scenario,
                         format!("{} {}", e.quantity, e.probes.join(",")),
@@ -676,20 +714,20 @@ fn cmd_validate(
                         e.tolerance,
                         if e.pass { "yes" } else { "NO" },
                         wall
-                    );
+                    ));
                 }
                 if o.summary.expects.is_empty() {
-                    println!(
+                    say(format!(
                         "{:<28} ran ({}) in {wall:.2} s; it has no [[expect]] to check",
                         o.summary.scenario, o.summary.status
-                    );
+                    ));
                 }
                 if let Some(note) = k_withheld_note(&o.summary) {
-                    println!("{:<28} note: {note}", o.summary.scenario);
+                    say(format!("{:<28} note: {note}", o.summary.scenario));
                 }
             }
             Err(e) => {
-                println!("{:<28} error: {e:#}", src.name());
+                say(format!("{:<28} error: {e:#}", src.name()));
                 if is_bad_input(&e) {
                     refused += 1;
                 } else {
@@ -699,10 +737,12 @@ fn cmd_validate(
         }
     }
     if refused > 0 {
-        println!("{passed} passed, {failed} failed, {refused} refused as bad input");
+        say(format!(
+            "{passed} passed, {failed} failed, {refused} refused as bad input"
+        ));
         return ExitCode::from(BAD_INPUT);
     }
-    println!("{passed} passed, {failed} failed");
+    say(format!("{passed} passed, {failed} failed"));
     if failed == 0 {
         ExitCode::SUCCESS
     } else {

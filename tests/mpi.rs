@@ -32,8 +32,16 @@ fn run(scene: &str, ranks: Option<usize>, out: &Path, args: &[&str]) {
 /// Runs `scene` as [`run`] does and returns how it ended.
 #[cfg(feature = "mpi")]
 fn launch(scene: &str, ranks: Option<usize>, out: &Path, args: &[&str]) -> std::process::Output {
-    let bin = env!("CARGO_BIN_EXE_fissure");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join(scene);
+    let mut cmd = fissure(ranks);
+    cmd.arg("run").arg(&scene).arg("--out").arg(out);
+    cmd.args(args).output().expect("mpirun starts")
+}
+
+/// The launcher, under `mpirun -np ranks` when `ranks` is given.
+#[cfg(feature = "mpi")]
+fn fissure(ranks: Option<usize>) -> Command {
+    let bin = env!("CARGO_BIN_EXE_fissure");
     let mut cmd = match ranks {
         Some(n) => {
             let mut c = Command::new("mpirun");
@@ -43,12 +51,18 @@ fn launch(scene: &str, ranks: Option<usize>, out: &Path, args: &[&str]) -> std::
         }
         None => Command::new(bin),
     };
-    cmd.envs(OMPI_ENV)
-        .arg("run")
-        .arg(&scene)
-        .arg("--out")
-        .arg(out);
-    cmd.args(args).output().expect("mpirun starts")
+    cmd.envs(OMPI_ENV);
+    cmd
+}
+
+/// Resumes `snapshot` into `out`, under `mpirun -np ranks` when `ranks` is given.
+#[cfg(feature = "mpi")]
+fn resume(snapshot: &Path, ranks: Option<usize>, out: &Path) -> std::process::Output {
+    let mut cmd = fissure(ranks);
+    cmd.arg("resume").arg(snapshot).arg("--out").arg(out);
+    cmd.args(["--threads", "1"])
+        .output()
+        .expect("mpirun starts")
 }
 
 /// energy.csv and probes.csv of `scene` on 2 and 3 ranks equal the serial run's, byte for byte.
@@ -197,6 +211,7 @@ quantity = "plastic_radius"
 interval = 0.05
 "#;
     let (dir, file) = disc_scene(scene, "disc");
+    snapshots_resume_on_any_rank_count(&dir, &file);
     let serial = dir.join("serial");
     run(file.to_str().unwrap(), None, &serial, &[]);
     let split = dir.join("ranks4");
@@ -228,6 +243,64 @@ interval = 0.05
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The disc's run on 4 ranks (some of them empty) writes snapshot sets of a manifest and 4
+/// pieces, keeping the newest 2; a set resumed on 3 ranks and on one process ends as the
+/// uninterrupted serial run, bit for bit; a set with a piece missing is refused, once.
+#[cfg(feature = "mpi")]
+fn snapshots_resume_on_any_rank_count(dir: &Path, file: &Path) {
+    let every = [
+        "--set",
+        "checkpoint.every_steps=50",
+        "--set",
+        "checkpoint.keep=2",
+    ];
+    let serial = dir.join("serial_snapshots");
+    run(file.to_str().unwrap(), None, &serial, &every);
+    let split = dir.join("ranks4_snapshots");
+    let args = [&["--threads", "1"], &every[..]].concat();
+    run(file.to_str().unwrap(), Some(4), &split, &args);
+    let snaps = split.join("snapshots");
+    let mut names: Vec<String> = (std::fs::read_dir(&snaps).unwrap())
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let manifests: Vec<&String> = names.iter().filter(|n| n.ends_with(".fsnap")).collect();
+    assert_eq!(manifests.len(), 2, "{names:?}");
+    assert_eq!(
+        names.len(),
+        2 * 5,
+        "a manifest and 4 pieces per set: {names:?}"
+    );
+    let older = snaps.join(manifests[0]);
+    for (ranks, name) in [(Some(3), "resumed3"), (None, "resumed1")] {
+        let out = dir.join(name);
+        let done = resume(&older, ranks, &out);
+        assert!(
+            done.status.success(),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
+        for f in ["energy.csv", "probes.csv"] {
+            let a = std::fs::read(serial.join(f)).unwrap();
+            let b = std::fs::read(out.join(f)).unwrap();
+            assert!(
+                a == b,
+                "{f}: resumed from the 4-rank set on {ranks:?} ranks differs"
+            );
+        }
+    }
+    let piece = names.iter().find(|n| n.ends_with(".fpiece")).unwrap();
+    std::fs::remove_file(snaps.join(piece)).unwrap();
+    let done = resume(&older, Some(2), &dir.join("incomplete"));
+    let said = String::from_utf8_lossy(&done.stderr);
+    assert!(!done.status.success());
+    assert!(
+        said.contains("is missing: the snapshot set is incomplete"),
+        "{said}"
+    );
+    assert_eq!(said.matches("error:").count(), 1, "{said}");
+}
+
 /// Writes `scene` into a fresh folder named after `name`; returns the folder and the file.
 #[cfg(feature = "mpi")]
 fn disc_scene(scene: &str, name: &str) -> (std::path::PathBuf, std::path::PathBuf) {
@@ -242,6 +315,50 @@ fn disc_scene(scene: &str, name: &str) -> (std::path::PathBuf, std::path::PathBu
 #[test]
 fn a_3d_bar_split_across_ranks_matches_one_process() {
     same_on_ranks("scenarios/bar_wave_3d.toml", &[]);
+}
+
+/// `validate` on 3 ranks prints, once, the table one process prints (the wall times
+/// aside): the colliding disks' momentum drift (relative to the momentum scale summed
+/// over the ranks) and angular momentum drift (about the centre of mass of all ranks) too.
+#[cfg(feature = "mpi")]
+#[test]
+fn validate_on_ranks_reports_what_one_process_does() {
+    let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_validate", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let disks = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/disks_2d.toml");
+    // A spinning lower disc gives the pair angular momentum to compare.
+    let text = std::fs::read_to_string(disks).unwrap().replacen(
+        "velocity = [0.1, 0.1]",
+        "velocity = [0.1, 0.1]\nangular_velocity = [0.05]",
+        1,
+    ) + "\n[[expect]]\nquantity = \"angular_momentum_drift\"\nreference = 0.0\n\
+           source = \"no torque on the pair\"\ntolerance = 0.05\n";
+    let file = dir.join("disks.toml");
+    std::fs::write(&file, text).unwrap();
+    let table = |ranks: Option<usize>| -> Vec<String> {
+        let done = fissure(ranks)
+            .arg("validate")
+            .arg(&file)
+            .args(["--threads", "1"])
+            .output()
+            .unwrap();
+        assert!(
+            done.status.success(),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
+        // Each row without its last field, the wall time.
+        (String::from_utf8_lossy(&done.stdout).lines())
+            .map(|l| l.rsplit_once(' ').map_or(l, |(row, _)| row).to_string())
+            .collect()
+    };
+    let (one, three) = (table(None), table(Some(3)));
+    assert!(
+        one.iter().any(|l| l.contains("angular_momentum_drift")),
+        "{one:?}"
+    );
+    assert_eq!(one, three);
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[cfg(not(feature = "mpi"))]

@@ -122,6 +122,11 @@ impl Domain {
             .fold(x, f64::max)
     }
 
+    /// Whether `yes` holds on any rank.
+    pub fn any(&self, yes: bool) -> bool {
+        self.max(f64::from(u8::from(yes))) > 0.0
+    }
+
     /// Adds the other ranks' terms into `sums` (nothing on one rank).
     pub fn sum(&self, sums: &mut [ExactSum]) {
         if self.is_split() {

@@ -2,6 +2,7 @@
 //! output and checkpoint cadences. Snapshots store it so a resumed run continues exactly.
 
 use crate::base::dim::Dim;
+use crate::base::exact_sum::ExactSum;
 use crate::record::history::{History, Row};
 use crate::record::probe::Probe;
 use crate::store::world::{Energies, World};
@@ -33,12 +34,7 @@ impl RunState {
         frame_interval: f64,
         checkpoint_interval: Option<f64>,
     ) -> Self {
-        let p = &world.particles;
-        let total: f64 = p.mass.iter().sum();
-        let mut centre = D::zero();
-        for i in 0..p.len() {
-            centre += p.x[i] * (p.mass[i] / total);
-        }
+        let centre = centre_of_mass(world);
         RunState {
             history: History {
                 probes: vec![Vec::with_capacity((steps as usize + 1).min(1 << 20)); probes],
@@ -63,9 +59,10 @@ impl RunState {
     /// Appends a history row with energies `e`.
     pub fn record<D: Dim>(&mut self, world: &World<D>, e: Energies) -> &Row {
         let p = &world.particles;
-        let scale = (0..p.len())
-            .map(|i| p.mass[i] * D::dot(p.v[i], p.v[i]).sqrt())
-            .sum();
+        let mut scale = [ExactSum::new()];
+        (0..p.len()).for_each(|i| scale[0].add(p.mass[i] * D::dot(p.v[i], p.v[i]).sqrt()));
+        world.domain.sum(&mut scale);
+        let scale = scale[0].value();
         let centre = D::from_slice(&self.centre[..D::D]);
         self.history.rows.push(Row {
             step: world.step,
@@ -77,4 +74,23 @@ impl RunState {
         });
         self.history.rows.last().expect("just pushed")
     }
+}
+
+/// The centre of mass over every rank, summed exactly (so the same for any split).
+fn centre_of_mass<D: Dim>(world: &World<D>) -> D::Vec {
+    let p = &world.particles;
+    let mut sums: [ExactSum; 4] = Default::default();
+    for i in 0..p.len() {
+        sums[0].add(p.mass[i]);
+        for a in 0..D::D {
+            sums[1 + a].add(p.x[i][a] * p.mass[i]);
+        }
+    }
+    world.domain.sum(&mut sums);
+    let total = sums[0].value();
+    let mut centre = D::zero();
+    for a in 0..D::D {
+        centre[a] = sums[1 + a].value() / total;
+    }
+    centre
 }

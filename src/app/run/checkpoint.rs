@@ -1,12 +1,17 @@
-//! When to write snapshots during a run, where, and how many to keep.
+//! When to write snapshots during a run, where, and how many to keep. Split across ranks,
+//! every rank writes its piece and the first rank the manifest, and alone removes files.
 
 use crate::base::dim::Dim;
 use crate::base::error::UsageError;
 use crate::io::scenario::{CheckpointPlan, Source};
-use crate::io::snapshot::state::write;
+use crate::io::snapshot::Reader;
+use crate::io::snapshot::pieces::{self, Piece};
+use crate::io::snapshot::state::{write, write_manifest};
+use crate::ranks::comm::Comm;
 use crate::record::state::RunState;
 use crate::store::world::World;
 use anyhow::Context;
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -14,6 +19,8 @@ use std::time::Instant;
 pub struct Checkpointer {
     dir: PathBuf,
     plan: CheckpointPlan,
+    /// Whether this process tidies the folder (the first rank of a split run).
+    tidies: bool,
     last_wall: Instant,
     /// The newest snapshot written or resumed from, with its step.
     pub last: Option<(PathBuf, u64)>,
@@ -39,21 +46,28 @@ fn step_of(name: &str) -> Option<u64> {
 impl Checkpointer {
     /// Snapshots for a run writing to `out` (the folder `out/snapshots` is made on the first
     /// write). A fresh run removes the snapshots a previous run left there; a resumed run
-    /// keeps them (and counts `resumed` as its newest).
+    /// keeps them (and counts `resumed` as its newest). Split across ranks, only the first
+    /// rank removes files, here before the run's first collective call, so before any rank
+    /// can write a piece.
     pub fn new(
         out: &Path,
         plan: CheckpointPlan,
         resumed: Option<(PathBuf, u64)>,
+        comm: &Comm,
     ) -> anyhow::Result<Self> {
         let dir = out.join("snapshots");
         let c = Checkpointer {
             dir,
             plan,
+            tidies: comm.is_root(),
             last_wall: Instant::now(),
             last: resumed,
             seconds: 0.0,
             bytes: 0,
         };
+        if !c.tidies {
+            return Ok(c);
+        }
         if c.last.is_none() {
             for (_, path) in c.existing()? {
                 std::fs::remove_file(&path)
@@ -61,26 +75,64 @@ impl Checkpointer {
             }
         }
         c.remove_partial()?;
+        c.remove_unlisted_pieces()?;
         Ok(c)
     }
 
-    /// Removes `*.fsnap.tmp` files: snapshot writes cut short by a kill (a write renames
-    /// its temporary file only once it is complete, so none of them is a snapshot).
+    /// Removes `*.fsnap.tmp` and `*.fpiece.tmp` files: snapshot writes cut short by a kill
+    /// (a write renames its temporary file only once it is complete, so none of them is a
+    /// snapshot).
     fn remove_partial(&self) -> anyhow::Result<()> {
-        if !self.dir.exists() {
-            return Ok(());
-        }
-        let entries = std::fs::read_dir(&self.dir)
-            .with_context(|| format!("cannot list {}", self.dir.display()))?;
-        for e in entries.filter_map(Result::ok) {
-            if e.file_name().to_string_lossy().ends_with(".fsnap.tmp") {
-                let path = e.path();
+        for (name, path) in self.files()? {
+            if name
+                .strip_suffix(".tmp")
+                .is_some_and(|n| n.ends_with(".fsnap") || pieces::is_piece(n))
+            {
                 std::fs::remove_file(&path).with_context(|| {
                     format!("cannot remove a partial snapshot {}", path.display())
                 })?;
             }
         }
         Ok(())
+    }
+
+    /// Removes the pieces no snapshot in the folder names: those of sets pruned or cut
+    /// short before their manifest was written.
+    fn remove_unlisted_pieces(&self) -> anyhow::Result<()> {
+        let files = self.files()?;
+        if !files.iter().any(|(name, _)| pieces::is_piece(name)) {
+            return Ok(());
+        }
+        let mut listed = HashSet::new();
+        for (_, manifest) in self.existing()? {
+            // A snapshot that cannot be read names nothing; resuming it says why.
+            if let Ok(mut r) = Reader::open(&manifest)
+                && let Ok(list) = pieces::listing(&mut r)
+            {
+                listed.extend(list.into_iter().map(|p| p.name));
+            }
+        }
+        for (name, path) in files {
+            if pieces::is_piece(&name) && !listed.contains(&name) {
+                std::fs::remove_file(&path).with_context(|| {
+                    format!("cannot remove an unused snapshot piece {}", path.display())
+                })?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Every file in the folder, by name (none while the folder does not exist).
+    fn files(&self) -> anyhow::Result<Vec<(String, PathBuf)>> {
+        if !self.dir.exists() {
+            return Ok(Vec::new());
+        }
+        let entries = std::fs::read_dir(&self.dir)
+            .with_context(|| format!("cannot list {}", self.dir.display()))?;
+        Ok(entries
+            .filter_map(Result::ok)
+            .map(|e| (e.file_name().to_string_lossy().into_owned(), e.path()))
+            .collect())
     }
 
     /// Snapshot files in the folder, by step (none while the folder does not exist).
@@ -127,7 +179,8 @@ impl Checkpointer {
 
     /// Writes a snapshot of the current state and prunes all but the newest `keep` at or
     /// before this step (later ones, from a run that went further before it stopped, are
-    /// the same states this deterministic run will reach, and are left alone).
+    /// the same states this deterministic run will reach, and are left alone). Split
+    /// across ranks, every rank calls it at the same point of the step.
     pub fn write<D: Dim>(
         &mut self,
         src: &Source,
@@ -138,22 +191,71 @@ impl Checkpointer {
         std::fs::create_dir_all(&self.dir)
             .with_context(|| format!("cannot create {}", self.dir.display()))?;
         let path = self.dir.join(file_name(world.step));
-        self.bytes += write(&path, src, world, state)
-            .with_context(|| format!("cannot write snapshot {}", path.display()))?;
+        self.bytes += if world.domain.is_split() {
+            self.write_set(&path, src, world, state)?
+        } else {
+            write(&path, src, world, state)
+                .with_context(|| format!("cannot write snapshot {}", path.display()))?
+        };
         self.seconds += t0.elapsed().as_secs_f64();
         self.last_wall = Instant::now();
         self.last = Some((path.clone(), world.step));
+        if self.tidies {
+            self.prune(world.step)?;
+        }
+        Ok(path)
+    }
+
+    /// A split run's snapshot: every rank's piece, then, once all are written, the
+    /// manifest naming them. Returns the bytes of the whole set.
+    fn write_set<D: Dim>(
+        &self,
+        path: &Path,
+        src: &Source,
+        world: &World<D>,
+        state: &RunState,
+    ) -> anyhow::Result<u64> {
+        let comm = &world.domain.comm;
+        let stem = file_name(world.step);
+        let stem = stem.trim_end_matches(".fsnap");
+        let mine = pieces::write(&self.dir, stem, comm.rank(), src, world);
+        if let Some((rank, why)) = comm.first_error(mine.as_ref().err().map(|e| e.to_string())) {
+            anyhow::bail!(
+                "rank {rank} cannot write its piece of snapshot {}: {why}",
+                path.display()
+            );
+        }
+        let mine = postcard::to_stdvec(&mine?).context("cannot encode a snapshot piece")?;
+        let all: Vec<Piece> = (comm.all_gather(mine).iter())
+            .map(|b| postcard::from_bytes(b).expect("a piece from every rank"))
+            .collect();
+        let manifest = if comm.is_root() {
+            write_manifest(path, src, world, state, &all)
+                .map_err(|e| format!("cannot write snapshot {}: {e}", path.display()))
+        } else {
+            Ok(0)
+        };
+        if let Some((_, why)) = comm.first_error(manifest.as_ref().err().cloned()) {
+            anyhow::bail!("{why}");
+        }
+        Ok(all.iter().map(|p| p.bytes).sum::<u64>() + manifest.unwrap_or(0))
+    }
+
+    /// Removes all but the newest `keep` snapshots at or before `step`, then the pieces
+    /// that no snapshot left names. The other ranks cannot write the next set before this
+    /// rank has joined the next step's collective calls, so no new piece is removed.
+    fn prune(&self, step: u64) -> anyhow::Result<()> {
         let older: Vec<PathBuf> = self
             .existing()?
             .into_iter()
-            .filter(|(s, _)| *s <= world.step)
+            .filter(|(s, _)| *s <= step)
             .map(|(_, p)| p)
             .collect();
         for p in older.iter().rev().skip(self.plan.keep) {
             std::fs::remove_file(p)
                 .with_context(|| format!("cannot remove old snapshot {}", p.display()))?;
         }
-        Ok(path)
+        self.remove_unlisted_pieces()
     }
 }
 

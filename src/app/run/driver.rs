@@ -128,11 +128,13 @@ impl<'a, D: DimSystems> Run<'a, D> {
         {
             w.frames_in(run_dir, state.frames.len());
         }
-        let checkpoints = match out.filter(|_| !opts.comm.is_split()) {
+        // Split across ranks, every rank writes its piece of each snapshot.
+        let checkpoints = match &opts.out {
             Some(dir) => Some(Checkpointer::new(
                 dir,
                 checkpoint,
                 resumed_from.clone().map(|p| (p, world.step)),
+                &opts.comm,
             )?),
             None => None,
         };
@@ -269,12 +271,16 @@ impl<'a, D: DimSystems> Run<'a, D> {
         }
         let requested =
             self.opts.stop_requested() || self.opts.pause_after == Some(self.world.step);
+        // The wall clock and signals differ between ranks: one rank's wish writes on all.
         if let Some(c) = &mut self.checkpoints
-            && (c.due(self.world.step, self.world.time, &mut self.state)
-                || requested
-                || (last && c.periodic()))
+            && (self.world.domain).any(
+                c.due(self.world.step, self.world.time, &mut self.state)
+                    || requested
+                    || (last && c.periodic()),
+            )
         {
-            check_snapshot(&mut self.world).map_err(Stop::Unstable)?;
+            let checked = check_snapshot(&mut self.world);
+            self.world.domain.agree(checked).map_err(Stop::Unstable)?;
             if let Some(w) = &mut self.writers {
                 w.flush().map_err(Stop::Output)?;
             }

@@ -106,17 +106,18 @@ pub fn run(src: &Source, opts: &RunOptions) -> anyhow::Result<Outcome> {
 }
 
 /// Continues the run stored in the snapshot at `path` (a file, or a run folder whose
-/// newest snapshot is taken).
+/// newest snapshot is taken), on as many ranks as `opts.comm` has, whatever the number
+/// that wrote it.
 pub fn resume(path: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
     opts.writing(false);
-    let file = checkpoint::resolve(path)?;
-    let mut reader = Reader::open(&file)?;
+    let opened = checkpoint::resolve(path).and_then(|f| Ok((Reader::open(&f)?, f)));
+    let (mut reader, file) = agreed(&opts.comm, opened)?;
     fn go<D: DimSystems>(
         r: &mut Reader,
         file: &Path,
         opts: &RunOptions,
     ) -> anyhow::Result<Outcome> {
-        let restored = restore::<D>(r)?;
+        let restored = agreed(&opts.comm, restore::<D>(r))?;
         let resumed = (restored.state, file.to_path_buf());
         drive::<D>(&restored.source, restored.scene, Some(resumed), opts)
     }
@@ -127,6 +128,15 @@ pub fn resume(path: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
             .invalid(format!("dimension {d} in the header (corrupt)"))
             .into()),
     })
+}
+
+/// `done` as every rank sees it: split across ranks, a failure on one (a file it cannot
+/// read) fails all, with the lowest failing rank's message.
+fn agreed<T>(comm: &Comm, done: anyhow::Result<T>) -> anyhow::Result<T> {
+    match comm.first_error(done.as_ref().err().map(|e| format!("{e:#}"))) {
+        Some((rank, why)) if done.is_ok() => Err(anyhow::anyhow!("rank {rank}: {why}")),
+        _ => done,
+    }
 }
 
 /// Steps of `dt` that reach `end`: the fewest whose end is not short of it by more than

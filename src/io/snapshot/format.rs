@@ -133,10 +133,9 @@ impl<'a> ColumnSet<'a> {
         self.len
     }
 
-    /// Writes the snapshot to `path` atomically: into a temporary file in the same folder,
-    /// flushed and synced, then renamed over `path` (and the folder synced), so a crash at
-    /// any moment leaves the old file or the new one, never a torn one.
-    pub fn write(self, path: &Path, mut header: Header) -> std::io::Result<()> {
+    /// Fixes the header (column table, data length) and its checksum, which identifies
+    /// the whole file since the table holds every column's checksum.
+    pub fn seal(self, mut header: Header) -> std::io::Result<Sealed<'a>> {
         header.data_len = self.len;
         header.columns = self.table;
         let head = postcard::to_stdvec(&header).map_err(std::io::Error::other)?;
@@ -145,23 +144,54 @@ impl<'a> ColumnSet<'a> {
         pre.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
         pre.extend_from_slice(&(head.len() as u64).to_le_bytes());
         pre.extend_from_slice(&head);
-        let checksum = xxh3_64(&pre);
-        let pad = |n: u64| vec![0u8; (align8(n) - n) as usize];
+        Ok(Sealed {
+            checksum: xxh3_64(&pre),
+            pre,
+            header,
+            blobs: self.blobs,
+        })
+    }
 
+    /// Writes the snapshot to `path` atomically (see [`Sealed::write`]).
+    pub fn write(self, path: &Path, header: Header) -> std::io::Result<()> {
+        self.seal(header)?.write(path)
+    }
+}
+
+/// A snapshot ready to write: its header fixed and checksummed.
+pub struct Sealed<'a> {
+    /// The header checksum (the file's last 8 bytes).
+    pub checksum: u64,
+    pre: Vec<u8>,
+    header: Header,
+    blobs: Vec<&'a [u8]>,
+}
+
+impl Sealed<'_> {
+    /// Bytes of the column section (the bulk of the file).
+    pub fn bytes(&self) -> u64 {
+        self.header.data_len
+    }
+
+    /// Writes the snapshot to `path` atomically: into a temporary file in the same folder,
+    /// flushed and synced, then renamed over `path` (and the folder synced), so a crash at
+    /// any moment leaves the old file or the new one, never a torn one.
+    pub fn write(self, path: &Path) -> std::io::Result<()> {
+        let pad = |n: u64| vec![0u8; (align8(n) - n) as usize];
         let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
         let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
         tmp_name.push(".tmp");
         let tmp = path.with_file_name(tmp_name);
         let written = (|| {
             let mut f = std::io::BufWriter::with_capacity(1 << 20, File::create(&tmp)?);
-            f.write_all(&pre)?;
-            f.write_all(&pad(pre.len() as u64))?;
-            for (col, blob) in header.columns.iter().zip(&self.blobs) {
+            f.write_all(&self.pre)?;
+            f.write_all(&pad(self.pre.len() as u64))?;
+            for (col, blob) in self.header.columns.iter().zip(&self.blobs) {
                 debug_assert_eq!(col.len * col.elem.size(), blob.len() as u64);
                 f.write_all(blob)?;
                 f.write_all(&pad(blob.len() as u64))?;
             }
-            f.write_all(&checksum.to_le_bytes())?;
+            f.write_all(&self.checksum.to_le_bytes())?;
             let f = f.into_inner().map_err(|e| e.into_error())?;
             f.sync_all()?;
             drop(f);
@@ -189,6 +219,8 @@ pub struct Reader {
     file: File,
     /// The verified header.
     pub header: Header,
+    /// The header checksum, which identifies the file (see [`ColumnSet::seal`]).
+    pub checksum: u64,
     data_start: u64,
 }
 
@@ -252,7 +284,8 @@ impl Reader {
         h.update(&head);
         let decoded: Option<Header> = postcard::from_bytes(&head).ok();
         let data_start = align8(PREAMBLE + head_len);
-        if h.digest() != u64::from_le_bytes(trailer) {
+        let checksum = u64::from_le_bytes(trailer);
+        if h.digest() != checksum {
             let expected = decoded
                 .as_ref()
                 .and_then(|d| data_start.checked_add(d.data_len)?.checked_add(TRAILER));
@@ -293,8 +326,14 @@ impl Reader {
             path: path.to_path_buf(),
             file,
             header,
+            checksum,
             data_start,
         })
+    }
+
+    /// The file read.
+    pub fn path(&self) -> &Path {
+        &self.path
     }
 
     /// An error about this snapshot.

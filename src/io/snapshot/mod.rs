@@ -1,7 +1,9 @@
 //! Snapshots for checkpoint and restart: a versioned, checksummed container of named
-//! columns (`format`) and the mapping of a run's state onto it (`state`).
+//! columns (`format`), the mapping of a run's state onto it (`state`), and a split run's
+//! pieces and manifest (`pieces`).
 
 pub mod format;
+pub mod pieces;
 pub mod state;
 mod topology;
 

@@ -5,7 +5,9 @@
 //! rebuilt by the first step.
 
 use super::format::{ColumnSet, Header, Reader, SnapshotError};
+use super::pieces::{self, Piece, Table};
 use super::topology::{self, Encoded};
+use crate::base::columnar::Columnar;
 use crate::base::dim::Dim;
 use crate::fracture::plan::{PathResult, TipResult};
 use crate::io::scenario::{Scene, Source, build};
@@ -87,7 +89,32 @@ pub fn write<D: Dim>(
     world: &World<D>,
     state: &RunState,
 ) -> std::io::Result<u64> {
+    write_with(path, src, world, state, None)
+}
+
+/// Writes the manifest of a split run's snapshot: everything but the particles, which are
+/// in `pieces`; returns the bytes.
+pub fn write_manifest<D: Dim>(
+    path: &Path,
+    src: &Source,
+    world: &World<D>,
+    state: &RunState,
+    pieces: &[Piece],
+) -> std::io::Result<u64> {
+    write_with(path, src, world, state, Some(pieces))
+}
+
+/// Writes the snapshot; with `pieces`, the manifest of a split run, whose particles are in
+/// the pieces it names.
+fn write_with<D: Dim>(
+    path: &Path,
+    src: &Source,
+    world: &World<D>,
+    state: &RunState,
+    pieces: Option<&[Piece]>,
+) -> std::io::Result<u64> {
     let p = &world.particles;
+    let table = pieces.map(Table::new);
     let m = &world.materials;
     let youngs: Vec<f64> = m.iter().map(|m| m.youngs).collect();
     let poisson: Vec<f64> = m.iter().map(|m| m.poisson).collect();
@@ -124,18 +151,10 @@ pub fn write<D: Dim>(
     let mut c = ColumnSet::default();
     c.add("scenario.toml", src.text.as_bytes());
     c.add("scenario.file", src.file.as_bytes());
-    c.add("particles.x", &p.x);
-    c.add("particles.v", &p.v);
-    c.add("particles.x0", &p.x0);
-    c.add("particles.mass", &p.mass);
-    c.add("particles.volume", &p.volume);
-    c.add("particles.stress", &p.stress);
-    c.add("particles.grad_v", &p.grad_v);
-    c.add("particles.material", &p.material);
-    c.add("particles.half", &p.half);
-    c.add("particles.grad_u", &p.grad_u);
-    c.add("particles.plastic_strain", &p.plastic_strain);
-    c.add("particles.hardened", &p.hardened);
+    match &table {
+        Some(t) => t.add(&mut c),
+        None => add_particles(&mut c, p),
+    }
     c.add("materials.youngs", &youngs);
     c.add("materials.poisson", &poisson);
     c.add("materials.density", &density);
@@ -172,9 +191,33 @@ pub fn write<D: Dim>(
     c.add("history.rows.plastic", &rows_plastic);
     c.add("history.rows.friction", &rows_friction);
     c.add("run.friction", &friction);
-    let header = Header {
+    let particles = table.as_ref().map_or(p.len() as u64, Table::particles);
+    let bytes = c.bytes();
+    c.write(path, header(src, world, particles))?;
+    Ok(bytes)
+}
+
+/// The particle columns (ids aside).
+pub(super) fn add_particles<'a, D: Dim>(c: &mut ColumnSet<'a>, p: &'a Particles<D>) {
+    c.add("particles.x", &p.x);
+    c.add("particles.v", &p.v);
+    c.add("particles.x0", &p.x0);
+    c.add("particles.mass", &p.mass);
+    c.add("particles.volume", &p.volume);
+    c.add("particles.stress", &p.stress);
+    c.add("particles.grad_v", &p.grad_v);
+    c.add("particles.material", &p.material);
+    c.add("particles.half", &p.half);
+    c.add("particles.grad_u", &p.grad_u);
+    c.add("particles.plastic_strain", &p.plastic_strain);
+    c.add("particles.hardened", &p.hardened);
+}
+
+/// The header of a snapshot of `world` holding `particles` particles.
+pub(super) fn header<D: Dim>(src: &Source, world: &World<D>, particles: u64) -> Header {
+    Header {
         dimension: D::D as u8,
-        particles: p.len() as u64,
+        particles,
         nodes: world.grid.geom.node_count() as u64,
         step: world.step,
         time: world.time,
@@ -184,10 +227,7 @@ pub fn write<D: Dim>(
         build: env!("CARGO_PKG_VERSION").to_string(),
         data_len: 0,
         columns: Vec::new(),
-    };
-    let bytes = c.bytes();
-    c.write(path, header)?;
-    Ok(bytes)
+    }
 }
 
 /// A run put back together from a snapshot.
@@ -206,7 +246,11 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
     let h = r.header.clone();
     let (source, mut scene) = stored_scene::<D>(r, &h)?;
     let w = &mut scene.world;
-    read_particles(r, &mut w.particles)?;
+    if pieces::listed(r) {
+        pieces::read(r, &mut w.particles)?;
+    } else {
+        read_particles(r, &mut w.particles, None)?;
+    }
     read_materials(r, &mut w.materials)?;
     read_work(r, &mut w.work)?;
     if let Some(cr) = &mut w.cracks {
@@ -279,24 +323,51 @@ fn stored_scene<D: Dim>(r: &mut Reader, h: &Header) -> anyhow::Result<(Source, S
 }
 
 /// The particle columns; the optional ones (uGIMP size, gradients, plastic state) where
-/// the rebuilt scene keeps them.
-fn read_particles<D: Dim>(r: &mut Reader, p: &mut Particles<D>) -> Result<(), SnapshotError> {
-    let n = p.len();
-    p.x = r.column("particles.x", n)?;
-    p.v = r.column("particles.v", n)?;
-    p.x0 = r.column("particles.x0", n)?;
-    p.mass = r.column("particles.mass", n)?;
-    p.volume = r.column("particles.volume", n)?;
-    p.stress = r.column("particles.stress", n)?;
-    p.material = r.column("particles.material", n)?;
-    p.half = r.column("particles.half", if p.half.is_empty() { 0 } else { n })?;
+/// the rebuilt scene keeps them. `at`: the rows of `p` the file's rows go to (a piece of a
+/// split run), else all of them in order.
+pub(super) fn read_particles<D: Dim>(
+    r: &mut Reader,
+    p: &mut Particles<D>,
+    at: Option<&[u64]>,
+) -> Result<(), SnapshotError> {
+    put(r, "particles.x", &mut p.x, at)?;
+    put(r, "particles.v", &mut p.v, at)?;
+    put(r, "particles.x0", &mut p.x0, at)?;
+    put(r, "particles.mass", &mut p.mass, at)?;
+    put(r, "particles.volume", &mut p.volume, at)?;
+    put(r, "particles.stress", &mut p.stress, at)?;
+    put(r, "particles.material", &mut p.material, at)?;
+    put(r, "particles.half", &mut p.half, at)?;
     if !p.grad_u.is_empty() {
-        p.grad_u = r.column("particles.grad_u", n)?;
-        p.grad_v = r.column("particles.grad_v", n)?;
+        put(r, "particles.grad_u", &mut p.grad_u, at)?;
+        put(r, "particles.grad_v", &mut p.grad_v, at)?;
     }
     if !p.hardened.is_empty() {
-        p.plastic_strain = r.column("particles.plastic_strain", n)?;
-        p.hardened = r.column("particles.hardened", n)?;
+        put(r, "particles.plastic_strain", &mut p.plastic_strain, at)?;
+        put(r, "particles.hardened", &mut p.hardened, at)?;
+    }
+    Ok(())
+}
+
+/// Reads column `name` into `col`: whole, or row k into `col[at[k]]`. A column the scene
+/// does not keep (empty) must be empty in the file too.
+fn put<T: Columnar>(
+    r: &mut Reader,
+    name: &str,
+    col: &mut [T],
+    at: Option<&[u64]>,
+) -> Result<(), SnapshotError> {
+    match at {
+        _ if col.is_empty() => {
+            r.column::<T>(name, 0)?;
+        }
+        None => col.copy_from_slice(&r.column::<T>(name, col.len())?),
+        Some(rows) => {
+            let values: Vec<T> = r.column(name, rows.len())?;
+            for (&i, v) in rows.iter().zip(values) {
+                col[i as usize] = v;
+            }
+        }
     }
     Ok(())
 }

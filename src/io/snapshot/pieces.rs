@@ -1,0 +1,192 @@
+//! A split run's snapshot: every rank writes its particles, with their whole-scene ids,
+//! into a piece file, then the first rank writes the manifest (`step_N.fsnap`: everything
+//! else, and the table of pieces with their checksums). The manifest is renamed into place
+//! last, so a set is whole once its manifest exists; a piece's name carries its checksum,
+//! so a new set never overwrites a piece an older manifest names.
+
+use super::format::{ColumnSet, Reader, SnapshotError};
+use super::state;
+use crate::base::dim::Dim;
+use crate::io::scenario::Source;
+use crate::store::particles::Particles;
+use crate::store::world::World;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// File extension of a piece.
+pub const EXTENSION: &str = "fpiece";
+/// Manifest column: per piece, its particle count and its header checksum.
+const TABLE: &str = "ranks.pieces";
+/// Manifest column: the pieces' file names, one per line, in rank order.
+const NAMES: &str = "ranks.piece_names";
+
+/// One rank's piece of a snapshot, as the manifest lists it.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Piece {
+    /// File name, in the manifest's folder.
+    pub name: String,
+    /// Particles in the piece.
+    pub particles: u64,
+    /// The piece's header checksum (which covers every column's checksum).
+    pub checksum: u64,
+    /// Bytes of its columns.
+    pub bytes: u64,
+}
+
+/// Writes this rank's piece of the snapshot `stem` (`step_000000000100`) into `dir`.
+pub fn write<D: Dim>(
+    dir: &Path,
+    stem: &str,
+    rank: usize,
+    src: &Source,
+    world: &World<D>,
+) -> std::io::Result<Piece> {
+    let p = &world.particles;
+    let mut c = ColumnSet::default();
+    state::add_particles(&mut c, p);
+    c.add("particles.id", &p.id);
+    let sealed = c.seal(state::header(src, world, p.len() as u64))?;
+    let piece = Piece {
+        name: format!("{stem}.r{rank:05}.{:016x}.{EXTENSION}", sealed.checksum),
+        particles: p.len() as u64,
+        checksum: sealed.checksum,
+        bytes: sealed.bytes(),
+    };
+    sealed.write(&dir.join(&piece.name))?;
+    Ok(piece)
+}
+
+/// Whether `name` is a piece's file name.
+pub fn is_piece(name: &str) -> bool {
+    name.strip_suffix(EXTENSION)
+        .is_some_and(|s| s.ends_with('.'))
+}
+
+/// The manifest's table of pieces, as columns.
+pub(super) struct Table {
+    names: String,
+    data: Vec<u64>,
+}
+
+impl Table {
+    pub(super) fn new(pieces: &[Piece]) -> Self {
+        let names: Vec<&str> = pieces.iter().map(|p| p.name.as_str()).collect();
+        Table {
+            names: names.join("\n"),
+            data: pieces
+                .iter()
+                .flat_map(|p| [p.particles, p.checksum])
+                .collect(),
+        }
+    }
+
+    /// Particles over all pieces.
+    pub(super) fn particles(&self) -> u64 {
+        self.data.iter().step_by(2).sum()
+    }
+
+    pub(super) fn add<'a>(&'a self, c: &mut ColumnSet<'a>) {
+        c.add(NAMES, self.names.as_bytes());
+        c.add(TABLE, &self.data);
+    }
+}
+
+/// Whether the snapshot `r` is a split run's manifest.
+pub(super) fn listed(r: &Reader) -> bool {
+    r.offset_of(TABLE).is_some()
+}
+
+/// The pieces a manifest names, with their particle counts and checksums (none for a
+/// whole snapshot). A name that is not a plain piece file name is refused, so a damaged
+/// manifest cannot lead the reader out of its folder.
+pub fn listing(r: &mut Reader) -> Result<Vec<Piece>, SnapshotError> {
+    if !listed(r) {
+        return Ok(Vec::new());
+    }
+    let bytes: Vec<u8> = r.column_any(NAMES)?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| r.invalid(format!("column `{NAMES}` is not UTF-8 text")))?;
+    let names: Vec<&str> = text.split('\n').collect();
+    let data: Vec<u64> = r.column(TABLE, names.len() * 2)?;
+    let mut pieces = Vec::with_capacity(names.len());
+    for (name, d) in names.iter().zip(data.chunks_exact(2)) {
+        let plain = Path::new(name).file_name() == Some(name.as_ref());
+        if !(plain && is_piece(name)) {
+            return Err(r.invalid(format!(
+                "`{}` in the table of pieces is not a piece's file name (corrupt)",
+                name.escape_debug()
+            )));
+        }
+        pieces.push(Piece {
+            name: name.to_string(),
+            particles: d[0],
+            checksum: d[1],
+            bytes: 0,
+        });
+    }
+    Ok(pieces)
+}
+
+/// Puts the particles of the pieces the manifest `r` names back into `p` (the whole
+/// scene's store), each at its id; every particle must come from exactly one piece.
+pub(super) fn read<D: Dim>(r: &mut Reader, p: &mut Particles<D>) -> Result<(), SnapshotError> {
+    let pieces = listing(r)?;
+    let dir = r.path().parent().unwrap_or(Path::new(".")).to_path_buf();
+    let n = p.len();
+    let mut seen = bitvec::bitvec![0; n];
+    for (rank, piece) in pieces.iter().enumerate() {
+        let path = dir.join(&piece.name);
+        if !path.exists() {
+            return Err(r.invalid(format!(
+                "piece {} (rank {rank}) is missing: the snapshot set is incomplete",
+                piece.name
+            )));
+        }
+        let mut f = Reader::open(&path)?;
+        if f.checksum != piece.checksum || f.header.particles != piece.particles {
+            return Err(f.invalid(format!(
+                "not the piece the manifest {} names (checksum {:016x}, expected {:016x}): \
+                 from another run or damaged",
+                r.path().display(),
+                f.checksum,
+                piece.checksum
+            )));
+        }
+        let ids: Vec<u64> = f.column("particles.id", piece.particles as usize)?;
+        for &id in &ids {
+            if id as usize >= n || seen.replace(id as usize, true) {
+                return Err(f.invalid(format!(
+                    "particle id {id} is outside the scene's {n} particles or in two pieces"
+                )));
+            }
+        }
+        state::read_particles(&mut f, p, Some(&ids))?;
+    }
+    if let Some(missing) = seen.first_zero() {
+        return Err(r.invalid(format!(
+            "no piece holds particle {missing}: the snapshot set is incomplete"
+        )));
+    }
+    Ok(())
+}
+
+/// Checks every piece the manifest `r` names: present, the one named (checksum, count),
+/// every column intact. Per piece, None when sound, else what is wrong.
+pub fn verify(r: &mut Reader) -> Result<Vec<(Piece, Option<String>)>, SnapshotError> {
+    let dir = r.path().parent().unwrap_or(Path::new(".")).to_path_buf();
+    let mut out = Vec::new();
+    for piece in listing(r)? {
+        let problem = match Reader::open(&dir.join(&piece.name)) {
+            Err(e) => Some(e.to_string()),
+            Ok(f) if f.checksum != piece.checksum || f.header.particles != piece.particles => {
+                Some("not the piece the manifest names (from another run or damaged)".into())
+            }
+            Ok(mut f) => {
+                let bad = f.verify()?.iter().filter(|(_, ok)| !ok).count();
+                (bad > 0).then(|| format!("{bad} column(s) fail their checksum"))
+            }
+        };
+        out.push((piece, problem));
+    }
+    Ok(out)
+}
