@@ -300,6 +300,25 @@ fn stop_flag(requests: StopRequests, first: &'static str) -> StopFlag {
     flag
 }
 
+/// The stop flag of a run writing to `out`; split across ranks (mpirun passes a signal to
+/// every rank), only the first says it stops and leaves an abort's summary.
+fn rank_stop_flag(root: bool, out: &Path) -> StopFlag {
+    if root {
+        return stop_flag(StopRequests::new(out), AFTER_THIS_STEP);
+    }
+    let requests = StopRequests::without_summary();
+    let flag = requests.flag();
+    let installed = ctrlc::set_handler(move || {
+        if requests.request() != Request::Stop {
+            std::process::exit(i32::from(INTERRUPTED));
+        }
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: no clean stop on Ctrl-C: {e}");
+    }
+    flag
+}
+
 /// Prints a finished run's line and its expects; the exit code says how it ended.
 fn finish(o: &Outcome, out: &Path) -> ExitCode {
     let s = &o.summary;
@@ -442,7 +461,7 @@ fn cmd_run(
         progress: root,
         until,
         pause_after: None,
-        stop: Some(stop_flag(StopRequests::new(&out), AFTER_THIS_STEP)),
+        stop: Some(rank_stop_flag(root, &out)),
         comm,
     };
     on_root(root, run(&src, &opts), &out)
@@ -465,7 +484,7 @@ fn cmd_resume(path: &Path, out: Option<PathBuf>, threads: usize, until: Option<f
         progress: root,
         until,
         pause_after: None,
-        stop: Some(stop_flag(StopRequests::new(&out), AFTER_THIS_STEP)),
+        stop: Some(rank_stop_flag(root, &out)),
         comm,
     };
     on_root(root, resume(path, &opts), &out)

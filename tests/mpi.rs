@@ -361,6 +361,62 @@ fn validate_on_ranks_reports_what_one_process_does() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Ctrl-C (SIGINT to mpirun, which passes it to every rank) stops a split run on all its
+/// ranks after one step, with a snapshot set; resumed on 3 ranks in the same folder, the
+/// run ends with the files of the uninterrupted one-process run.
+#[cfg(feature = "mpi")]
+#[test]
+fn a_split_run_stopped_by_a_signal_resumes_bit_for_bit() {
+    let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_signal", std::process::id()));
+    let args = ["--set", "simulation.duration=4e-4"];
+    let serial = dir.join("serial");
+    run("scenarios/bar_mode_2d.toml", None, &serial, &args);
+    let split = dir.join("ranks2");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/bar_mode_2d.toml");
+    let child = fissure(Some(2))
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&split)
+        .args(["--threads", "1"])
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Signalled once it writes (a signal during set-up ends it at once, writing nothing).
+    let t0 = std::time::Instant::now();
+    while !split.join("energy.csv").exists() && t0.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let signalled = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(signalled.success());
+    let said = child.wait_with_output().unwrap();
+    let summary = std::fs::read_to_string(split.join("summary.json")).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert_eq!(
+        json["status"],
+        "interrupted",
+        "{}",
+        String::from_utf8_lossy(&said.stderr)
+    );
+    let done = resume(&split, Some(3), &split);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    for f in ["energy.csv", "probes.csv"] {
+        let a = std::fs::read(serial.join(f)).unwrap();
+        assert!(a == std::fs::read(split.join(f)).unwrap(), "{f} differs");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[cfg(not(feature = "mpi"))]
 #[test]
 fn a_build_without_mpi_refuses_several_ranks() {
