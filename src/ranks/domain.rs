@@ -49,11 +49,7 @@ impl Domain {
         let Some(p) = &self.partition else {
             return;
         };
-        // A peer with nothing to send or take in this class is left out on both sides
-        // (the lists are each other's mirror).
-        let talks: Vec<usize> = (0..p.peers.len())
-            .filter(|&k| !(p.sends[class][k].is_empty() && p.receives[class][k].is_empty()))
-            .collect();
+        let talks = &p.talks[class];
         let peers: Vec<usize> = talks.iter().map(|&k| p.peers[k]).collect();
         let out: Vec<Vec<u8>> = (talks.iter())
             .map(|&k| {

@@ -78,6 +78,10 @@ pub struct Partition {
     pub sends: Vec<Vec<Vec<u32>>>,
     /// Per colour class, per peer: the shared nodes this rank receives after the class.
     pub receives: Vec<Vec<Vec<u32>>>,
+    /// Per colour class: the peers (their indices in `peers`) this rank sends to or
+    /// receives from after the class; the others are left out on both sides, since the
+    /// lists are each other's mirror.
+    pub talks: Vec<Vec<usize>>,
     /// The nodes from the first to the last this rank's tiles reach (those it scatters to,
     /// updates and gathers from).
     pub span: std::ops::Range<usize>,
@@ -132,11 +136,18 @@ impl Partition {
             }
             list
         };
-        let sends = (0..classes)
+        let sends: Vec<Vec<Vec<u32>>> = (0..classes)
             .map(|c| peers.iter().map(|&q| shared(me, q, c)).collect())
             .collect();
-        let receives = (0..classes)
+        let receives: Vec<Vec<Vec<u32>>> = (0..classes)
             .map(|c| peers.iter().map(|&q| shared(q, me, c)).collect())
+            .collect();
+        let talks = (0..classes)
+            .map(|c| {
+                (0..peers.len())
+                    .filter(|&k| !(sends[c][k].is_empty() && receives[c][k].is_empty()))
+                    .collect()
+            })
             .collect();
         let mut owned_nodes = bitvec![0; total];
         let [nx, ny, _] = nodes;
@@ -162,6 +173,7 @@ impl Partition {
             peers,
             sends,
             receives,
+            talks,
         })
     }
 
