@@ -2,6 +2,7 @@
 //! columns (`format`), the mapping of a run's state onto it (`state`), and a split run's
 //! pieces and manifest (`pieces`).
 
+mod columns;
 pub mod format;
 pub mod pieces;
 pub mod state;

@@ -4,8 +4,8 @@
 //! last, so a set is whole once its manifest exists; a piece's name carries its checksum,
 //! so a new set never overwrites a piece an older manifest names.
 
+use super::columns;
 use super::format::{ColumnSet, Reader, SnapshotError};
-use super::state;
 use crate::base::dim::Dim;
 use crate::io::scenario::Source;
 use crate::store::particles::Particles;
@@ -43,9 +43,9 @@ pub fn write<D: Dim>(
 ) -> std::io::Result<Piece> {
     let p = &world.particles;
     let mut c = ColumnSet::default();
-    state::add_particles(&mut c, p);
+    columns::add_particles(&mut c, p);
     c.add("particles.id", &p.id);
-    let sealed = c.seal(state::header(src, world, p.len() as u64))?;
+    let sealed = c.seal(columns::header(src, world, p.len() as u64))?;
     let piece = Piece {
         name: format!("{stem}.r{rank:05}.{:016x}.{EXTENSION}", sealed.checksum),
         particles: p.len() as u64,
@@ -160,7 +160,7 @@ pub(super) fn read<D: Dim>(r: &mut Reader, p: &mut Particles<D>) -> Result<(), S
                 )));
             }
         }
-        state::read_particles(&mut f, p, Some(&ids))?;
+        columns::read_particles(&mut f, p, Some(&ids))?;
     }
     if let Some(missing) = seen.first_zero() {
         return Err(r.invalid(format!(

@@ -4,10 +4,10 @@
 //! surfaces, work, history); grid scratch, particle bins and crack velocity fields are
 //! rebuilt by the first step.
 
+use super::columns::{add_particles, header, read_particles};
 use super::format::{ColumnSet, Header, Reader, SnapshotError};
 use super::pieces::{self, Piece, Table};
 use super::topology::{self, Encoded};
-use crate::base::columnar::Columnar;
 use crate::base::dim::Dim;
 use crate::fracture::plan::{PathResult, TipResult};
 use crate::io::scenario::{Scene, Source, build};
@@ -17,7 +17,6 @@ use crate::record::history::{History, Row};
 use crate::record::solve_log::SolveRow;
 use crate::record::state::RunState;
 use crate::store::crack::Cracks;
-use crate::store::particles::Particles;
 use crate::store::world::{Energies, Work, World};
 use std::path::Path;
 use xxhash_rust::xxh3::xxh3_64;
@@ -197,39 +196,6 @@ fn write_with<D: Dim>(
     Ok(bytes)
 }
 
-/// The particle columns (ids aside).
-pub(super) fn add_particles<'a, D: Dim>(c: &mut ColumnSet<'a>, p: &'a Particles<D>) {
-    c.add("particles.x", &p.x);
-    c.add("particles.v", &p.v);
-    c.add("particles.x0", &p.x0);
-    c.add("particles.mass", &p.mass);
-    c.add("particles.volume", &p.volume);
-    c.add("particles.stress", &p.stress);
-    c.add("particles.grad_v", &p.grad_v);
-    c.add("particles.material", &p.material);
-    c.add("particles.half", &p.half);
-    c.add("particles.grad_u", &p.grad_u);
-    c.add("particles.plastic_strain", &p.plastic_strain);
-    c.add("particles.hardened", &p.hardened);
-}
-
-/// The header of a snapshot of `world` holding `particles` particles.
-pub(super) fn header<D: Dim>(src: &Source, world: &World<D>, particles: u64) -> Header {
-    Header {
-        dimension: D::D as u8,
-        particles,
-        nodes: world.grid.geom.node_count() as u64,
-        step: world.step,
-        time: world.time,
-        dt: world.settings.dt,
-        scenario: src.name(),
-        scenario_hash: xxh3_64(src.text.as_bytes()),
-        build: env!("CARGO_PKG_VERSION").to_string(),
-        data_len: 0,
-        columns: Vec::new(),
-    }
-}
-
 /// A run put back together from a snapshot.
 pub struct Restored<D: Dim> {
     /// The stored scenario.
@@ -320,56 +286,6 @@ fn stored_scene<D: Dim>(r: &mut Reader, h: &Header) -> anyhow::Result<(Source, S
             .into());
     }
     Ok((source, scene))
-}
-
-/// The particle columns; the optional ones (uGIMP size, gradients, plastic state) where
-/// the rebuilt scene keeps them. `at`: the rows of `p` the file's rows go to (a piece of a
-/// split run), else all of them in order.
-pub(super) fn read_particles<D: Dim>(
-    r: &mut Reader,
-    p: &mut Particles<D>,
-    at: Option<&[u64]>,
-) -> Result<(), SnapshotError> {
-    put(r, "particles.x", &mut p.x, at)?;
-    put(r, "particles.v", &mut p.v, at)?;
-    put(r, "particles.x0", &mut p.x0, at)?;
-    put(r, "particles.mass", &mut p.mass, at)?;
-    put(r, "particles.volume", &mut p.volume, at)?;
-    put(r, "particles.stress", &mut p.stress, at)?;
-    put(r, "particles.material", &mut p.material, at)?;
-    put(r, "particles.half", &mut p.half, at)?;
-    if !p.grad_u.is_empty() {
-        put(r, "particles.grad_u", &mut p.grad_u, at)?;
-        put(r, "particles.grad_v", &mut p.grad_v, at)?;
-    }
-    if !p.hardened.is_empty() {
-        put(r, "particles.plastic_strain", &mut p.plastic_strain, at)?;
-        put(r, "particles.hardened", &mut p.hardened, at)?;
-    }
-    Ok(())
-}
-
-/// Reads column `name` into `col`: whole, or row k into `col[at[k]]`. A column the scene
-/// does not keep (empty) must be empty in the file too.
-fn put<T: Columnar>(
-    r: &mut Reader,
-    name: &str,
-    col: &mut [T],
-    at: Option<&[u64]>,
-) -> Result<(), SnapshotError> {
-    match at {
-        _ if col.is_empty() => {
-            r.column::<T>(name, 0)?;
-        }
-        None => col.copy_from_slice(&r.column::<T>(name, col.len())?),
-        Some(rows) => {
-            let values: Vec<T> = r.column(name, rows.len())?;
-            for (&i, v) in rows.iter().zip(values) {
-                col[i as usize] = v;
-            }
-        }
-    }
-    Ok(())
 }
 
 /// The elastic constants of every material.
