@@ -21,12 +21,30 @@ const OMPI_ENV: [(&str, &str); 7] = [
 /// it must succeed.
 #[cfg(feature = "mpi")]
 fn run(scene: &str, ranks: Option<usize>, out: &Path, args: &[&str]) {
-    let done = launch(scene, ranks, out, args);
+    succeeded(&launch(scene, ranks, out, args));
+}
+
+/// Asserts that a launch succeeded, showing its errors if not.
+#[cfg(feature = "mpi")]
+fn succeeded(done: &std::process::Output) {
     assert!(
         done.status.success(),
         "{}",
         String::from_utf8_lossy(&done.stderr)
     );
+}
+
+/// Asserts that `other` holds `serial`'s energy.csv and probes.csv byte for byte.
+#[cfg(feature = "mpi")]
+fn same_outputs(serial: &Path, other: &Path, what: &str) {
+    for f in ["energy.csv", "probes.csv"] {
+        let a = std::fs::read(serial.join(f)).unwrap();
+        assert!(a.len() > 100, "{f} has rows");
+        assert!(
+            a == std::fs::read(other.join(f)).unwrap(),
+            "{what}: {f} differs"
+        );
+    }
 }
 
 /// Runs `scene` as [`run`] does and returns how it ended.
@@ -80,12 +98,7 @@ fn same_on_ranks(scene: &str, args: &[&str]) {
             &split,
             &[&["--threads", "1"], args].concat(),
         );
-        for f in ["energy.csv", "probes.csv"] {
-            let a = std::fs::read(serial.join(f)).unwrap();
-            let b = std::fs::read(split.join(f)).unwrap();
-            assert!(a.len() > 100, "{f} has rows");
-            assert!(a == b, "{scene} {f}: {n} ranks differ from one");
-        }
+        same_outputs(&serial, &split, &format!("{scene} on {n} ranks"));
         same_frames(&serial, &split, n);
     }
     std::fs::remove_dir_all(&dir).ok();
@@ -216,10 +229,7 @@ interval = 0.05
     run(file.to_str().unwrap(), None, &serial, &[]);
     let split = dir.join("ranks4");
     run(file.to_str().unwrap(), Some(4), &split, &["--threads", "1"]);
-    for f in ["energy.csv", "probes.csv"] {
-        let a = std::fs::read(serial.join(f)).unwrap();
-        assert!(a == std::fs::read(split.join(f)).unwrap(), "{f} differs");
-    }
+    same_outputs(&serial, &split, "the disc on 4 ranks");
     let summary = std::fs::read_to_string(split.join("summary.json")).unwrap();
     let json: serde_json::Value = serde_json::from_str(&summary).unwrap();
     // The disc started in the first rank's tiles: the tiles were divided anew as it moved.
@@ -274,20 +284,12 @@ fn snapshots_resume_on_any_rank_count(dir: &Path, file: &Path) {
     let older = snaps.join(manifests[0]);
     for (ranks, name) in [(Some(3), "resumed3"), (None, "resumed1")] {
         let out = dir.join(name);
-        let done = resume(&older, ranks, &out);
-        assert!(
-            done.status.success(),
-            "{}",
-            String::from_utf8_lossy(&done.stderr)
+        succeeded(&resume(&older, ranks, &out));
+        same_outputs(
+            &serial,
+            &out,
+            &format!("the 4-rank set resumed on {ranks:?}"),
         );
-        for f in ["energy.csv", "probes.csv"] {
-            let a = std::fs::read(serial.join(f)).unwrap();
-            let b = std::fs::read(out.join(f)).unwrap();
-            assert!(
-                a == b,
-                "{f}: resumed from the 4-rank set on {ranks:?} ranks differs"
-            );
-        }
     }
     let piece = names.iter().find(|n| n.ends_with(".fpiece")).unwrap();
     std::fs::remove_file(snaps.join(piece)).unwrap();
@@ -404,16 +406,8 @@ fn a_split_run_stopped_by_a_signal_resumes_bit_for_bit() {
         "{}",
         String::from_utf8_lossy(&said.stderr)
     );
-    let done = resume(&split, Some(3), &split);
-    assert!(
-        done.status.success(),
-        "{}",
-        String::from_utf8_lossy(&done.stderr)
-    );
-    for f in ["energy.csv", "probes.csv"] {
-        let a = std::fs::read(serial.join(f)).unwrap();
-        assert!(a == std::fs::read(split.join(f)).unwrap(), "{f} differs");
-    }
+    succeeded(&resume(&split, Some(3), &split));
+    same_outputs(&serial, &split, "the stopped run resumed on 3 ranks");
     std::fs::remove_dir_all(&dir).ok();
 }
 
