@@ -137,15 +137,8 @@ impl Checkpointer {
 
     /// Snapshot files in the folder, by step (none while the folder does not exist).
     fn existing(&self) -> anyhow::Result<Vec<(u64, PathBuf)>> {
-        if !self.dir.exists() {
-            return Ok(Vec::new());
-        }
-        let mut found: Vec<(u64, PathBuf)> = std::fs::read_dir(&self.dir)
-            .with_context(|| format!("cannot list {}", self.dir.display()))?
-            .filter_map(|e| {
-                let e = e.ok()?;
-                Some((step_of(e.file_name().to_str()?)?, e.path()))
-            })
+        let mut found: Vec<(u64, PathBuf)> = (self.files()?.into_iter())
+            .filter_map(|(name, path)| Some((step_of(&name)?, path)))
             .collect();
         found.sort();
         Ok(found)
