@@ -13,6 +13,7 @@ use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::base::geometry::{Aabb, Element};
 use crate::physics::shape::{ShapeKind, Stencil, StencilCache};
+use crate::ranks::domain::Domain;
 use crate::store::crack::{self, Classified, Cracks, Fields, side_bit};
 use crate::store::grid::GridGeom;
 use crate::store::tiles::Tiles;
@@ -437,7 +438,13 @@ impl<D: Dim> Pass<'_, D> {
     /// The grid entries of the particles whose lines cross a crack, with this step's
     /// weights (a node of zero weight keeps its own field), and the extra field rows;
     /// returns how many rows.
-    fn fields(&self, rec: &Classified<D>, particles: usize, f: &mut Fields) -> usize {
+    fn fields(
+        &self,
+        rec: &Classified<D>,
+        particles: usize,
+        domain: &Domain,
+        f: &mut Fields,
+    ) -> usize {
         let per = self.per();
         let geom = self.geom;
         f.per = per;
@@ -495,21 +502,27 @@ impl<D: Dim> Pass<'_, D> {
                 r
             })
             .collect();
-        let mut order: Vec<u32> = (0..rows.len() as u32).collect();
-        order.sort_unstable_by_key(|&r| rows[r as usize]);
+        // Split across ranks, the rows are those of every rank's particles, so that an
+        // entry means one field on every rank.
+        let mut mine: Vec<[u64; 2]> = (rows.iter()).map(|&(n, m)| [u64::from(n), m]).collect();
+        mine.sort_unstable();
+        let all = domain.union(mine);
         let mut entry = vec![0u32; rows.len()];
-        for (k, &r) in order.iter().enumerate() {
-            entry[r as usize] = (f.nodes + k) as u32;
-            f.head[rows[r as usize].0 as usize] = u32::MAX;
+        for (r, &(n, m)) in rows.iter().enumerate() {
+            let k = all
+                .binary_search(&[u64::from(n), m])
+                .expect("a row of the union");
+            entry[r] = (f.nodes + k) as u32;
+            f.head[n as usize] = u32::MAX;
         }
         f.targets.clear();
         f.targets
             .extend((pairs.iter().zip(&row_of)).map(|(&(n, _), &r)| {
                 if r == u32::MAX { n } else { entry[r as usize] }
             }));
-        f.node = order.iter().map(|&r| rows[r as usize].0).collect();
-        f.mask = order.iter().map(|&r| rows[r as usize].1).collect();
-        rows.len()
+        f.node = all.iter().map(|r| r[0] as u32).collect();
+        f.mask = all.iter().map(|r| r[1]).collect();
+        all.len()
     }
 }
 
@@ -598,7 +611,7 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
     } else {
         pass.refresh(&world.particles.x, moved, rec);
     }
-    let extra = pass.fields(rec, world.particles.len(), fields);
+    let extra = pass.fields(rec, world.particles.len(), &world.domain, fields);
     world.grid.set_extra_fields(extra);
     Ok(())
 }

@@ -35,8 +35,27 @@ pub(crate) fn nearest<D: Dim>(
     Some((elem_crack[e] as usize, elems[e].normal(verts)))
 }
 
+/// One particle's term m u S on one crack field's entry, and where one rank adds it: the
+/// particle's tile, then the particle's index in the whole scene.
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+struct Term<D: Dim> {
+    tile: u64,
+    id: u64,
+    entry: u64,
+    mu: D::Vec,
+}
+
+// SAFETY: three u64 and a vector of f64 (2 or 3): no padding, and every bit pattern is
+// valid.
+unsafe impl<D: Dim> bytemuck::Zeroable for Term<D> {}
+// SAFETY: as above; `D::Vec` is Pod (a DVec2 or DVec3).
+unsafe impl<D: Dim> bytemuck::Pod for Term<D> {}
+
 /// Mass-weighted displacement sums m u at every entry of the nodes with crack fields, from
-/// the particles of the tiles around them (Eq. 68), in a fixed order.
+/// the particles of the tiles around them (Eq. 68), tile by tile in index order and in
+/// particle order within a tile. Split across ranks, each rank adds its own terms and its
+/// peers' on the nodes it shares with them, in that order.
 fn nodal_displacements<D: Dim>(world: &mut World<D>) {
     let Some(cracks) = world.cracks.as_mut() else {
         return;
@@ -65,6 +84,9 @@ fn nodal_displacements<D: Dim>(world: &mut World<D>) {
         t_hi[a] = ((hi[a] + 2) / tiles.size).min(tiles.counts[a] - 1);
     }
     let shape = world.settings.shape;
+    // One rank adds each term as it comes; split, the terms are merged first.
+    let split = world.domain.is_split();
+    let mut mine = Vec::new();
     for tk in t_lo[2]..=t_hi[2] {
         for tj in t_lo[1]..=t_hi[1] {
             for ti in t_lo[0]..=t_hi[0] {
@@ -72,8 +94,19 @@ fn nodal_displacements<D: Dim>(world: &mut World<D>) {
                 for &i in tiles.particles(t as u32) {
                     let i = i as usize;
                     let mu = p.displacement(i) * p.mass[i];
+                    let id = p.id.get(i).copied().unwrap_or(i as u64);
                     let mut add = |entry: usize, w: f64| {
-                        if let Some(s) = disp.entry(entry) {
+                        let Some(s) = disp.entry(entry) else {
+                            return;
+                        };
+                        if split {
+                            mine.push(Term::<D> {
+                                tile: t as u64,
+                                id,
+                                entry: entry as u64,
+                                mu: mu * w,
+                            });
+                        } else {
                             disp.sums[s] += mu * w;
                         }
                     };
@@ -86,6 +119,12 @@ fn nodal_displacements<D: Dim>(world: &mut World<D>) {
                     });
                 }
             }
+        }
+    }
+    let node = |t: &Term<D>| f.node_of(t.entry as usize);
+    for term in (world.domain).with_shared(mine, node, |t| (t.tile, t.id)) {
+        if let Some(s) = disp.entry(term.entry as usize) {
+            disp.sums[s] += term.mu;
         }
     }
 }
@@ -130,6 +169,10 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
     for (c, crack) in cracks.topology.cracks().iter().enumerate() {
         acts[cracks.scratch.color(c) as usize] |= crack.contact.law != Law::None;
     }
+    // Whether friction can work (every rank has the same cracks).
+    let coulomb =
+        (cracks.topology.cracks().iter()).any(|c| matches!(c.contact.law, Law::Coulomb(_)));
+    let domain = &world.domain;
     let h = D::to_xyz(g.geom.h);
     let cell = std::array::from_fn(|k| if k < D::D { h[k] } else { 1.0 });
     let mut friction = ExactSum::new();
@@ -179,7 +222,10 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
             continue;
         }
         let dp = contact.law.momentum_change::<D>(ma, va, mb, vb, nrm);
-        if let Law::Coulomb(_) = contact.law {
+        // Split across ranks, the node's owner books the work.
+        if let Law::Coulomb(_) = contact.law
+            && domain.owns_node(n)
+        {
             friction.add(friction_work::<D>(
                 dp,
                 va + dp * (1.0 / ma) - (vb - dp * (1.0 / mb)),
@@ -201,6 +247,9 @@ pub fn run<D: Dim>(world: &mut World<D>, update: bool) {
     cracks.scratch.contact_normals = normals;
     if !update {
         cracks.scratch.contact_dp = changes;
+    }
+    if coulomb {
+        domain.sum(std::slice::from_mut(&mut friction));
     }
     world.work.friction += friction.value();
 }

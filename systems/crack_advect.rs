@@ -4,8 +4,10 @@
 
 use crate::base::dim::Dim;
 use crate::physics::shape::{ShapeKind, Stencil};
+use crate::ranks::domain::Domain;
 use crate::store::crack::{Cracks, Fields, Positions};
 use crate::store::grid::Grid;
+use crate::store::tiles::Tiles;
 use crate::store::world::{Update, World};
 
 /// Momentum and mass at node `n`, all fields together (Eq. 23's centre of mass), and of its
@@ -59,13 +61,13 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             g.velocity[e] * g.mass[e]
         }
     };
-    advect(
-        world.cracks.as_mut(),
-        g,
-        world.settings.sliver_mass,
-        momentum,
-        dt,
-    );
+    let mover = Mover {
+        grid: g,
+        tiles: &world.tiles,
+        domain: &world.domain,
+        sliver: world.settings.sliver_mass,
+    };
+    mover.advect(world.cracks.as_mut(), momentum, dt);
 }
 
 /// Moves every crack vertex and both surfaces by a static load step's displacement:
@@ -73,74 +75,119 @@ pub fn run<D: Dim>(world: &mut World<D>) {
 /// over the step (a momentum with dt = 1).
 pub fn displace<D: Dim>(world: &mut World<D>, moved: &[D::Vec]) {
     let g = &world.grid;
-    advect(
-        world.cracks.as_mut(),
-        g,
-        world.settings.sliver_mass,
-        |e| moved[e],
-        1.0,
-    );
+    let mover = Mover {
+        grid: g,
+        tiles: &world.tiles,
+        domain: &world.domain,
+        sliver: world.settings.sliver_mass,
+    };
+    mover.advect(world.cracks.as_mut(), |e| moved[e], 1.0);
 }
 
-/// Moves the cracks by `dt` times the mass-weighted velocity (`momentum` per entry over the
-/// grid's masses) at each vertex.
-fn advect<D: Dim>(
-    cracks: Option<&mut Cracks<D>>,
-    g: &Grid<D>,
+/// A crack vertex's new place and its surfaces' (the vertex's index first).
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
+struct Moved<D: Dim> {
+    k: u64,
+    x: D::Vec,
+    top: D::Vec,
+    bottom: D::Vec,
+}
+
+// SAFETY: a u64 and three vectors of f64 (2 or 3 each): no padding, and every bit pattern
+// is valid.
+unsafe impl<D: Dim> bytemuck::Zeroable for Moved<D> {}
+// SAFETY: as above; `D::Vec` is Pod (a DVec2 or DVec3).
+unsafe impl<D: Dim> bytemuck::Pod for Moved<D> {}
+
+/// What moving the cracks reads: the grid, and who moves which vertex.
+struct Mover<'a, D: Dim> {
+    grid: &'a Grid<D>,
+    tiles: &'a Tiles,
+    /// Split across ranks, the rank owning a vertex's tile moves it (its nodes hold the
+    /// sums one rank would) and every rank takes the new places.
+    domain: &'a Domain,
+    /// Fields this light or lighter are left out (kg).
     sliver: f64,
-    momentum: impl Fn(usize) -> D::Vec,
-    dt: f64,
-) {
-    let Some(Cracks {
-        topology,
-        geometry: Positions { x: xs, top, bottom },
-        scratch,
-        ..
-    }) = cracks
-    else {
-        return;
-    };
-    let geom = &g.geom;
-    let fields = &scratch.fields;
-    for (c, crack) in topology.cracks().iter().enumerate() {
-        let color = scratch.color(c);
-        for k in crack.vertices.iter().map(|&k| k as usize) {
-            let x = xs[k];
-            if !geom.fits(ShapeKind::Linear, x, D::zero()) {
-                continue;
-            }
-            let mut st = Stencil::<2> {
-                first: 0,
-                w: [[1.0, 0.0, 0.0]; 3],
-                dw: [[0.0; 3]; 3],
-            };
-            for a in 0..D::D {
-                let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
-                let (b, w, dw) = ShapeKind::Linear.axis(xi, 0.0, geom.inv_h[a]);
-                st.first += b * geom.stride[a];
-                st.w[a] = w;
-                st.dw[a] = dw;
-            }
-            let mut sums = [(D::zero(), 0.0); 3];
-            st.for_each::<D>(&geom.stride, |n, w, _| {
-                let f = node_fields::<D>(n, color, &g.mass, &momentum, fields, sliver);
-                for (s, (p, m)) in sums.iter_mut().zip(f) {
-                    s.0 += p * w;
-                    s.1 += m * w;
+}
+
+impl<D: Dim> Mover<'_, D> {
+    /// Moves the cracks by `dt` times the mass-weighted velocity (`momentum` per entry over
+    /// the grid's masses) at each vertex.
+    fn advect(&self, cracks: Option<&mut Cracks<D>>, momentum: impl Fn(usize) -> D::Vec, dt: f64) {
+        let Some(Cracks {
+            topology,
+            geometry: Positions { x: xs, top, bottom },
+            scratch,
+            ..
+        }) = cracks
+        else {
+            return;
+        };
+        let (g, sliver) = (self.grid, self.sliver);
+        let geom = &g.geom;
+        let fields = &scratch.fields;
+        // One rank moves each vertex as it comes; split, every rank takes the moves.
+        let split = self.domain.is_split();
+        let mut mine = Vec::new();
+        for (c, crack) in topology.cracks().iter().enumerate() {
+            let color = scratch.color(c);
+            for k in crack.vertices.iter().map(|&k| k as usize) {
+                let x = xs[k];
+                if !geom.fits(ShapeKind::Linear, x, D::zero()) {
+                    continue;
                 }
-            });
-            // Mass-weighted velocities (momentum over mass), where Eqs. 22-23 weight the
-            // nodes' velocities by the shape functions alone: a node holding a sliver of mass
-            // has a meaningless velocity, and with plain weights it threw crack vertices and
-            // surfaces off (a crack end outside the body ran at tens of m/s). The crack moves
-            // with the centre of mass; each surface with its side's fields, or with the crack
-            // where its side has no mass.
-            let velocity = |(p, m): (D::Vec, f64)| if m > 0.0 { p * (1.0 / m) } else { D::zero() };
-            let cm = velocity(sums[0]);
-            let surface = |s: (D::Vec, f64)| if s.1 > 0.0 { velocity(s) } else { cm };
-            xs[k] += cm * dt;
-            top[k] += surface(sums[1]) * dt;
-            bottom[k] += surface(sums[2]) * dt;
+                let mut st = Stencil::<2> {
+                    first: 0,
+                    w: [[1.0, 0.0, 0.0]; 3],
+                    dw: [[0.0; 3]; 3],
+                };
+                let mut cell = [0; 3];
+                for a in 0..D::D {
+                    let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
+                    let (b, w, dw) = ShapeKind::Linear.axis(xi, 0.0, geom.inv_h[a]);
+                    st.first += b * geom.stride[a];
+                    st.w[a] = w;
+                    st.dw[a] = dw;
+                    cell[a] = b.min(geom.cells[a] - 1);
+                }
+                if split && !self.domain.owns_tile(self.tiles.tile_of_cell(cell)) {
+                    continue;
+                }
+                let mut sums = [(D::zero(), 0.0); 3];
+                st.for_each::<D>(&geom.stride, |n, w, _| {
+                    let f = node_fields::<D>(n, color, &g.mass, &momentum, fields, sliver);
+                    for (s, (p, m)) in sums.iter_mut().zip(f) {
+                        s.0 += p * w;
+                        s.1 += m * w;
+                    }
+                });
+                // Mass-weighted velocities (momentum over mass), where Eqs. 22-23 weight the
+                // nodes' velocities by the shape functions alone: a node holding a sliver of
+                // mass has a meaningless velocity, and with plain weights it threw crack
+                // vertices and surfaces off (a crack end outside the body ran at tens of
+                // m/s). The crack moves with the centre of mass; each surface with its side's
+                // fields, or with the crack where its side has no mass.
+                let velocity =
+                    |(p, m): (D::Vec, f64)| if m > 0.0 { p * (1.0 / m) } else { D::zero() };
+                let cm = velocity(sums[0]);
+                let surface = |s: (D::Vec, f64)| if s.1 > 0.0 { velocity(s) } else { cm };
+                let moved = Moved::<D> {
+                    k: k as u64,
+                    x: x + cm * dt,
+                    top: top[k] + surface(sums[1]) * dt,
+                    bottom: bottom[k] + surface(sums[2]) * dt,
+                };
+                if split {
+                    mine.push(moved);
+                } else {
+                    (xs[k], top[k], bottom[k]) = (moved.x, moved.top, moved.bottom);
+                }
+            }
+        }
+        for m in self.domain.in_order(mine, |m| m.k) {
+            let k = m.k as usize;
+            (xs[k], top[k], bottom[k]) = (m.x, m.top, m.bottom);
         }
     }
 }

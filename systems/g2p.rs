@@ -8,7 +8,7 @@ use crate::ranks::ABSENT;
 use crate::store::disjoint::Disjoint;
 use crate::store::particles::Particles;
 use crate::store::world::{CHUNK, World};
-use crate::systems::p2g::scatter_coded;
+use crate::systems::scatter_coded;
 use crate::with_shape;
 use rayon::prelude::*;
 
@@ -57,8 +57,9 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
     let (dt, alpha) = (world.settings.dt, world.settings.damping);
     let shape = world.settings.shape;
     let grid = &mut world.grid;
-    let span = world.domain.span(grid.momentum.len());
-    (grid.momentum[span].par_iter_mut()).for_each(|m| *m = D::zero());
+    for span in (world.domain).spans(grid.momentum.len(), grid.geom.node_count()) {
+        (grid.momentum[span].par_iter_mut()).for_each(|m| *m = D::zero());
+    }
     let nodal = (&grid.accel[..], &grid.velocity[..]);
     let tiles = &world.tiles;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
@@ -99,11 +100,12 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
     let fastest = fastest.max(move_coded(world));
     if let Some(c) = world.cracks.as_ref() {
         let p = &world.particles;
-        scatter_coded::<D, false, true, false>(
+        scatter_coded::run::<D, false, true, false>(
             &c.scratch.fields,
             p,
             shape,
             &world.tiles.stencils,
+            &world.domain,
             &mut world.grid,
         );
     }

@@ -3,6 +3,7 @@
 
 use crate::base::dim::Dim;
 use crate::base::exact_sum::ExactSum;
+use crate::ranks::domain::Domain;
 use crate::store::crack::Fields;
 use crate::store::grid::Grid;
 use crate::store::world::{CHUNK, World};
@@ -41,60 +42,63 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         force,
         velocity,
         accel,
-        ..
+        geom,
     } = &mut world.grid;
     let (mass, momentum, force) = (&*mass, &*momentum, &*force);
     let (damped, weighed) = (alpha != 0.0, D::dot(gravity, gravity) != 0.0);
-    // Split across ranks, each node's work is booked by the rank that owns it.
-    let owned = world.domain.partition.as_ref().map(|p| &p.owned_nodes);
-    // The entries this rank's particles can reach (all of them on one rank).
-    let span = world.domain.span(velocity.len());
-    let first = span.start;
-    let (velocity, accel) = (&mut velocity[span.clone()], &mut accel[span]);
-    let [mut damp, mut grav] = (velocity.par_chunks_mut(CHUNK), accel.par_chunks_mut(CHUNK))
-        .into_par_iter()
-        .enumerate()
-        .map(|(c, (vel, acc))| {
-            let [mut damp, mut grav] = [ExactSum::new(), ExactSum::new()];
-            for k in 0..vel.len() {
-                let n = first + c * CHUNK + k;
-                let m = mass[n];
-                if m > tol {
-                    let v0 = momentum[n] * (1.0 / m);
-                    let f = force[n] - momentum[n] * alpha + gravity * m;
-                    let a = f * (1.0 / m);
-                    let v1 = v0 + a * dt;
-                    let vmid = (v0 + v1) * 0.5;
-                    // Zero terms are skipped: an undamped, weightless scene pays nothing.
-                    let books = owned.is_none_or(|o| o[n]);
-                    if damped && books {
-                        damp.add(alpha * D::dot(momentum[n], vmid) * dt);
-                    }
-                    if weighed && books {
-                        grav.add(m * D::dot(gravity, vmid) * dt);
-                    }
-                    vel[k] = v1;
-                    acc[k] = a;
-                } else {
-                    vel[k] = D::zero();
-                    acc[k] = D::zero();
-                }
-            }
-            [damp, grav]
-        })
-        .reduce(Default::default, |[mut d, mut g], [d2, g2]| {
-            d.merge(&d2);
-            g.merge(&g2);
-            [d, g]
-        });
-    if let Some(c) = world.cracks.as_ref() {
-        let work = [&mut damp, &mut grav];
-        merge_slivers(&mut world.grid, work, &c.scratch.fields, &world.settings);
-    }
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
+    // Split across ranks, each entry's work is booked by the rank that owns its node.
     let domain = &world.domain;
+    let books = |n: usize| domain.owns_node(fields.map_or(n, |f| f.node_of(n)));
+    let mut work = [ExactSum::new(), ExactSum::new()];
+    for span in domain.spans(velocity.len(), geom.node_count()) {
+        let first = span.start;
+        let (velocity, accel) = (&mut velocity[span.clone()], &mut accel[span]);
+        let [damp, grav] = (velocity.par_chunks_mut(CHUNK), accel.par_chunks_mut(CHUNK))
+            .into_par_iter()
+            .enumerate()
+            .map(|(c, (vel, acc))| {
+                let [mut damp, mut grav] = [ExactSum::new(), ExactSum::new()];
+                for k in 0..vel.len() {
+                    let n = first + c * CHUNK + k;
+                    let m = mass[n];
+                    if m > tol {
+                        let v0 = momentum[n] * (1.0 / m);
+                        let f = force[n] - momentum[n] * alpha + gravity * m;
+                        let a = f * (1.0 / m);
+                        let v1 = v0 + a * dt;
+                        let vmid = (v0 + v1) * 0.5;
+                        // Zero terms are skipped: an undamped, weightless scene pays nothing.
+                        if damped && books(n) {
+                            damp.add(alpha * D::dot(momentum[n], vmid) * dt);
+                        }
+                        if weighed && books(n) {
+                            grav.add(m * D::dot(gravity, vmid) * dt);
+                        }
+                        vel[k] = v1;
+                        acc[k] = a;
+                    } else {
+                        vel[k] = D::zero();
+                        acc[k] = D::zero();
+                    }
+                }
+                [damp, grav]
+            })
+            .reduce(Default::default, |[mut d, mut g], [d2, g2]| {
+                d.merge(&d2);
+                g.merge(&g2);
+                [d, g]
+            });
+        work[0].merge(&damp);
+        work[1].merge(&grav);
+    }
+    let [mut damp, mut grav] = work;
+    if let Some(f) = fields {
+        let work = [&mut damp, &mut grav];
+        merge_slivers(&mut world.grid, work, f, &world.settings, domain);
+    }
     let t1 = world.time + dt;
     let g = &mut world.grid;
-    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     for bc in &mut world.bcs {
         for k in 0..bc.nodes.len() {
             let (node, mut reaction) = (bc.nodes[k], D::zero());
@@ -144,6 +148,7 @@ fn merge_slivers<D: Dim>(
     [damping, external]: [&mut ExactSum; 2],
     fields: &Fields,
     settings: &crate::store::world::Settings<D>,
+    domain: &Domain,
 ) {
     let (dt, alpha, gravity, tol) = (
         settings.dt,
@@ -158,6 +163,8 @@ fn merge_slivers<D: Dim>(
         if !group().any(light) {
             continue;
         }
+        // Split across ranks, the node's owner books the work.
+        let books = domain.owns_node(node as usize);
         let heavy = group()
             .max_by(|&a, &b| grid.mass[a].total_cmp(&grid.mass[b]))
             .expect("a node's own entry");
@@ -166,8 +173,10 @@ fn merge_slivers<D: Dim>(
             // Take back the damping and gravity work booked for the entry alone.
             let (m0, p0) = (grid.mass[n], grid.momentum[n]);
             let vmid = p0 * (1.0 / m0) + grid.accel[n] * (0.5 * dt);
-            damping.add(-alpha * D::dot(p0, vmid) * dt);
-            external.add(-m0 * D::dot(gravity, vmid) * dt);
+            if books {
+                damping.add(-alpha * D::dot(p0, vmid) * dt);
+                external.add(-m0 * D::dot(gravity, vmid) * dt);
+            }
             m += m0;
             p += p0;
             f += grid.force[n];
@@ -175,8 +184,10 @@ fn merge_slivers<D: Dim>(
         let a = (f - p * alpha + gravity * m) * (1.0 / m);
         let v1 = p * (1.0 / m) + a * dt;
         let vmid = p * (1.0 / m) + a * (0.5 * dt);
-        damping.add(alpha * D::dot(p, vmid) * dt);
-        external.add(m * D::dot(gravity, vmid) * dt);
+        if books {
+            damping.add(alpha * D::dot(p, vmid) * dt);
+            external.add(m * D::dot(gravity, vmid) * dt);
+        }
         for n in group().filter(|&n| n == heavy || light(n)) {
             grid.velocity[n] = v1;
             grid.accel[n] = a;

@@ -30,6 +30,7 @@ pub mod grid_update;
 pub mod grow;
 pub mod grow_front;
 pub mod p2g;
+pub mod scatter_coded;
 pub mod static_solve;
 pub mod stress;
 pub mod stress_bin;

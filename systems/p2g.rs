@@ -2,13 +2,11 @@
 //! Eqs. 3-6, single velocity field), tile by tile in colour classes.
 
 use crate::base::dim::Dim;
-use crate::physics::shape::{Rows, ShapeKind, Stencil, StencilCache};
+use crate::physics::shape::{Rows, Stencil};
 use crate::ranks::ABSENT;
-use crate::store::crack::Fields;
 use crate::store::disjoint::Disjoint;
-use crate::store::grid::Grid;
-use crate::store::particles::Particles;
 use crate::store::world::{CHUNK, World};
+use crate::systems::scatter_coded;
 use crate::with_shape;
 use rayon::prelude::*;
 
@@ -18,18 +16,19 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
     let g = &mut world.grid;
     // One pass zeroes the three scattered columns (they have one entry per grid entry),
     // where this rank's particles reach.
-    let span = world.domain.span(g.mass.len());
-    (
-        g.mass[span.clone()].par_chunks_mut(CHUNK),
-        g.momentum[span.clone()].par_chunks_mut(CHUNK),
-        g.force[span].par_chunks_mut(CHUNK),
-    )
-        .into_par_iter()
-        .for_each(|(m, p, f)| {
-            m.fill(0.0);
-            p.fill(D::zero());
-            f.fill(D::zero());
-        });
+    for span in world.domain.spans(g.mass.len(), g.geom.node_count()) {
+        (
+            g.mass[span.clone()].par_chunks_mut(CHUNK),
+            g.momentum[span.clone()].par_chunks_mut(CHUNK),
+            g.force[span].par_chunks_mut(CHUNK),
+        )
+            .into_par_iter()
+            .for_each(|(m, p, f)| {
+                m.fill(0.0);
+                p.fill(D::zero());
+                f.fill(D::zero());
+            });
+    }
     if internal {
         scatter::<D, true>(world);
     } else {
@@ -83,7 +82,7 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
         },
     );
     if let Some(f) = fields {
-        scatter_coded::<D, true, true, FORCE>(f, p, shape, &world.tiles.stencils, grid);
+        scatter_coded::run::<D, true, true, FORCE>(f, p, shape, &tiles.stencils, domain, grid);
     }
 }
 
@@ -110,43 +109,6 @@ pub(crate) unsafe fn add_internal_force<D: Dim, const N: usize>(
             std::array::from_fn::<_, N, _>(|a| sxq * st.dw[0][a] + syz * st.w[0][a])
         })
     };
-}
-
-/// The scatter of the particles near a crack, each pair into its field's grid entry
-/// (Guo & Nairn 2D (2004) Eqs. 3 and 6), sequentially in particle order.
-pub(crate) fn scatter_coded<D: Dim, const MASS: bool, const MOMENTUM: bool, const FORCE: bool>(
-    fields: &Fields,
-    p: &Particles<D>,
-    shape: ShapeKind,
-    stencils: &StencilCache,
-    grid: &mut Grid<D>,
-) {
-    let Grid {
-        geom,
-        mass,
-        momentum,
-        force,
-        ..
-    } = grid;
-    for &i in &fields.coded {
-        let i = i as usize;
-        let targets = fields.targets_of(i).expect("coded particle");
-        let (m, mv, s, vol) = (p.mass[i], p.v[i] * p.mass[i], p.stress[i], p.volume[i]);
-        with_shape!(shape, S, N => {
-            let st = Stencil::<N>::cached::<D>(S, stencils, i);
-            st.for_each_target::<D>(&geom.stride, targets, |n, w, g| {
-                if MASS {
-                    mass[n] += m * w;
-                }
-                if MOMENTUM {
-                    momentum[n] += mv * w;
-                }
-                if FORCE {
-                    force[n] -= D::stress_dot(&s, g) * vol;
-                }
-            });
-        });
-    }
 }
 
 /// Adds external particle forces to the grid (sequential, in load order); `g2p` books

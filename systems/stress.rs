@@ -207,19 +207,20 @@ pub(crate) fn node_velocities<D: Dim>(world: &mut World<D>) {
     let tol = world.settings.mass_tol;
     let g = &mut world.grid;
     let (mass, momentum) = (&g.mass, &g.momentum);
-    let span = world.domain.span(g.velocity.len());
-    let first = span.start;
-    g.velocity[span]
-        .par_chunks_mut(CHUNK)
-        .enumerate()
-        .for_each(|(c, vel)| {
-            for (k, v) in vel.iter_mut().enumerate() {
-                let n = first + c * CHUNK + k;
-                *v = if mass[n] > tol {
-                    momentum[n] * (1.0 / mass[n])
-                } else {
-                    D::zero()
-                };
-            }
-        });
+    for span in world.domain.spans(g.velocity.len(), g.geom.node_count()) {
+        let first = span.start;
+        g.velocity[span]
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, vel)| {
+                for (k, v) in vel.iter_mut().enumerate() {
+                    let n = first + c * CHUNK + k;
+                    *v = if mass[n] > tol {
+                        momentum[n] * (1.0 / mass[n])
+                    } else {
+                        D::zero()
+                    };
+                }
+            });
+    }
 }

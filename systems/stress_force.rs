@@ -7,7 +7,8 @@ use crate::store::disjoint::Disjoint;
 use crate::store::grid::Grid;
 use crate::store::particles::Particles;
 use crate::store::world::World;
-use crate::systems::p2g::{add_internal_force, scatter_coded};
+use crate::systems::p2g::add_internal_force;
+use crate::systems::scatter_coded;
 use crate::systems::stress::{StressColumns, node_velocities, update_coded, velocity_gradient};
 
 /// Updates every particle's stress over `fraction` of the step from grad v gathered off
@@ -61,11 +62,12 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
         update_coded(world, dt);
         let f = &world.cracks.as_ref().expect("cracks").scratch.fields;
         let stencils = &world.tiles.stencils;
-        scatter_coded::<D, false, false, true>(
+        scatter_coded::run::<D, false, false, true>(
             f,
             &world.particles,
             shape,
             stencils,
+            &world.domain,
             &mut world.grid,
         );
     }

@@ -223,7 +223,7 @@ quantity = "plastic_radius"
 [output]
 interval = 0.05
 "#;
-    let (dir, file) = disc_scene(scene, "disc");
+    let (dir, file) = scene_file(scene, "disc");
     snapshots_resume_on_any_rank_count(&dir, &file);
     let serial = dir.join("serial");
     run(file.to_str().unwrap(), None, &serial, &[]);
@@ -238,7 +238,7 @@ interval = 0.05
 
     // Flown on, the disc leaves the grid: the rank holding the particle that left stops
     // every rank with its message, and the rows written so far are the serial run's.
-    let (dir, file) = disc_scene(
+    let (dir, file) = scene_file(
         &scene.replace("duration = 0.3", "duration = 0.6"),
         "leaving",
     );
@@ -305,12 +305,141 @@ fn snapshots_resume_on_any_rank_count(dir: &Path, file: &Path) {
 
 /// Writes `scene` into a fresh folder named after `name`; returns the folder and the file.
 #[cfg(feature = "mpi")]
-fn disc_scene(scene: &str, name: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+fn scene_file(scene: &str, name: &str) -> (std::path::PathBuf, std::path::PathBuf) {
     let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("crossing_disc.toml");
+    let file = dir.join(format!("{name}.toml"));
     std::fs::write(&file, scene).unwrap();
     (dir, file)
+}
+
+/// An edge crack with Coulomb faces to the middle of a square plate whose edge below the
+/// crack is driven into it (Lee & Freund's problem, coarse): the lower face bulges into the
+/// upper one and they slide. The plate fills 8 x 8 tiles, so the Morton curve divides them
+/// between 2 ranks half a cell below the crack and between 4 ranks at the tip too: the
+/// crack's fields lie on nodes the ranks share.
+#[cfg(feature = "mpi")]
+const SLIDING_CRACK_2D: &str = r#"
+name = "sliding_crack_2d"
+[simulation]
+dimension = 2
+plane = "strain"
+shape = "ugimp"
+update = "usavg"
+duration = 7.0e-6
+cfl = 0.5
+[grid]
+min = [-0.032, -0.032]
+max = [0.032, 0.032]
+cell = [0.001, 0.001]
+anchor = { point = [0.0, 0.0], offset = [0.0, 0.5] }
+[[material]]
+name = "steel"
+E = 211.0e9
+nu = 0.25
+rho = 7800.0
+[[body]]
+material = "steel"
+box = { min = [-0.03, -0.03], max = [0.03, 0.03] }
+[[crack]]
+name = "crack"
+line = { start = [-0.0305, 0.0], end = [0.004, 0.0], spacing = 2.5e-4 }
+contact = { law = "friction", friction = 0.3 }
+[[boundary]]
+region = { min = [-0.0321, -0.0301], max = [-0.03, -0.0005] }
+fix = ["x"]
+velocity = [16.5, 0.0]
+[[probe]]
+name = "mouth"
+region = { min = [-0.03, -0.002], max = [-0.028, 0.002] }
+quantity = "opening"
+component = "y"
+[output]
+interval = 1.0e-6
+history_interval = 1.0e-7
+"#;
+
+/// A penny crack with Coulomb faces in a block squeezed and sheared from its top face.
+#[cfg(feature = "mpi")]
+const SQUEEZED_PENNY_3D: &str = r#"
+name = "squeezed_penny_3d"
+[simulation]
+dimension = 3
+duration = 2.0e-6
+cfl = 0.5
+[grid]
+min = [-0.002, -0.002, -0.002]
+max = [0.014, 0.014, 0.014]
+cell = [0.001, 0.001, 0.001]
+[[material]]
+name = "steel"
+E = 200.0e9
+nu = 0.3
+rho = 7800.0
+[[body]]
+material = "steel"
+box = { min = [0.0, 0.0, 0.0], max = [0.012, 0.012, 0.012] }
+[[crack]]
+name = "penny"
+penny = { center = [0.006, 0.0065, 0.006], normal = [0.0, 1.0, 0.0], radius = 0.004 }
+contact = { law = "friction", friction = 0.3 }
+[[boundary]]
+region = { min = [-0.002, 0.0115, -0.002], max = [0.014, 0.014, 0.014] }
+fix = ["x", "y"]
+velocity = [3.0, -10.0, 0.0]
+[[boundary]]
+region = { min = [-0.002, -0.002, -0.002], max = [0.014, 0.0005, 0.014] }
+fix = ["x", "y", "z"]
+[[probe]]
+name = "centre"
+region = { min = [0.005, 0.0055, 0.005], max = [0.007, 0.0075, 0.007] }
+quantity = "opening"
+component = "y"
+[output]
+interval = 1.0e-6
+history_interval = 1.0e-7
+"#;
+
+/// `scene` (a crack with Coulomb faces) on 2, 3 and 4 ranks as on one process: energy.csv
+/// (friction's work among it, which must be positive) and probes.csv byte for byte, the
+/// frames' particles, and the cracks' last frame (the advected vertices and surfaces).
+#[cfg(feature = "mpi")]
+fn cracks_slide_alike_on_ranks(scene: &str, name: &str) {
+    let (dir, file) = scene_file(scene, name);
+    let file = file.to_str().unwrap();
+    let serial = dir.join("serial");
+    run(file, None, &serial, &[]);
+    let energy = std::fs::read_to_string(serial.join("energy.csv")).unwrap();
+    let last = energy.lines().last().unwrap();
+    let friction: f64 = last.rsplit(',').next().unwrap().parse().unwrap();
+    assert!(friction > 0.0, "the faces slid under friction: {last}");
+    let frames = std::fs::read_to_string(serial.join("cracks.pvd")).unwrap();
+    let last = frames.lines().filter(|l| l.contains("file=")).count() - 1;
+    let crack = format!("cracks_{last:05}.vtu");
+    for n in [2, 3, 4] {
+        let split = dir.join(format!("ranks{n}"));
+        run(file, Some(n), &split, &["--threads", "1"]);
+        same_outputs(&serial, &split, &format!("{name} on {n} ranks"));
+        same_frames(&serial, &split, n);
+        assert!(
+            std::fs::read(serial.join(&crack)).unwrap()
+                == std::fs::read(split.join(&crack)).unwrap(),
+            "{name}: {crack} differs on {n} ranks"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[cfg(feature = "mpi")]
+#[test]
+fn a_sliding_crack_split_across_ranks_matches_one_process() {
+    cracks_slide_alike_on_ranks(SLIDING_CRACK_2D, "sliding_crack_2d");
+}
+
+#[cfg(feature = "mpi")]
+#[test]
+fn a_squeezed_penny_split_across_ranks_matches_one_process() {
+    cracks_slide_alike_on_ranks(SQUEEZED_PENNY_3D, "squeezed_penny_3d");
 }
 
 #[cfg(feature = "mpi")]
@@ -426,17 +555,28 @@ fn a_build_without_mpi_refuses_several_ranks() {
     assert!(err.contains("--features mpi"), "{err}");
 }
 
-/// What a split run cannot do yet is refused by name, once (by the first rank): a scene
-/// with cracks, and the commands that run on one process.
+/// What a split run cannot do yet is refused by name, once (by the first rank): J and K
+/// at crack tips, a growing crack, and the commands that run on one process.
 #[cfg(feature = "mpi")]
 #[test]
 fn split_runs_refuse_what_they_cannot_do_yet() {
     let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_refuse", std::process::id()));
-    let done = launch("scenarios/dcb_2d.toml", Some(2), &dir, &[]);
-    let said = String::from_utf8_lossy(&done.stderr);
-    assert!(!done.status.success());
-    assert!(said.contains("a scene with cracks cannot yet run on more than one MPI rank"));
-    assert_eq!(said.matches("error:").count(), 1, "{said}");
+    for (scene, what) in [
+        (
+            "scenarios/dcb_2d.toml",
+            "measuring J and K at crack tips (the [fracture] section)",
+        ),
+        ("scenarios/freund_running_2d.toml", "a growing crack"),
+    ] {
+        let done = launch(scene, Some(2), &dir, &[]);
+        let said = String::from_utf8_lossy(&done.stderr);
+        assert!(!done.status.success());
+        assert!(
+            said.contains(what) && said.contains("cannot yet run on more than one MPI rank"),
+            "{said}"
+        );
+        assert_eq!(said.matches("error:").count(), 1, "{said}");
+    }
 
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/dcb_2d.toml");
     let done = Command::new("mpirun")

@@ -17,7 +17,13 @@ use std::borrow::Cow;
 /// Keeps this rank's particles of a scene every rank built whole: those in the tiles the
 /// partition gives it, numbered by their index in the whole scene. Loads and probes keep
 /// their whole lists, with the entries of other ranks' particles marked [`ABSENT`].
-pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> anyhow::Result<()> {
+/// `measures`: whether the scene measures J and K at its crack tips.
+pub fn split<D: Dim>(
+    world: &mut World<D>,
+    probes: &mut [Probe],
+    measures: bool,
+    comm: Comm,
+) -> anyhow::Result<()> {
     if !comm.is_split() {
         world.domain = Domain {
             comm,
@@ -25,7 +31,7 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
         };
         return Ok(());
     }
-    refuse_unsupported(world)?;
+    refuse_unsupported(world, measures)?;
     bin::run(world).map_err(|u| anyhow::anyhow!("{u}"))?;
     let tiles = &world.tiles;
     let counts: Vec<u32> = tiles.start.windows(2).map(|w| w[1] - w[0]).collect();
@@ -42,6 +48,9 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
         .collect();
     world.particles.id = (0..world.particles.len() as u64).collect();
     world.particles.permute(&keep);
+    if let Some(c) = world.cracks.as_mut() {
+        c.scratch.forget_particles();
+    }
     for load in &mut world.loads {
         load.ids = load.particles.clone();
     }
@@ -60,10 +69,17 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
 }
 
 /// What a split run cannot do yet, refused by name.
-fn refuse_unsupported<D: Dim>(world: &World<D>) -> anyhow::Result<()> {
+fn refuse_unsupported<D: Dim>(world: &World<D>, measures: bool) -> anyhow::Result<()> {
     let no = |what: &str| anyhow::anyhow!("{what} cannot yet run on more than one MPI rank");
-    if world.cracks.is_some() {
-        return Err(no("a scene with cracks"));
+    if let Some(c) = &world.cracks {
+        if let Some(g) = c.topology.cracks().iter().find(|c| c.growth.is_some()) {
+            return Err(no(&format!("a growing crack (`{}`)", g.name)));
+        }
+        if measures {
+            return Err(no(
+                "measuring J and K at crack tips (the [fracture] section)",
+            ));
+        }
     }
     if world.settings.solver == Solver::Static {
         return Err(no("a static scene"));
@@ -185,6 +201,9 @@ fn settle_rows<D: Dim>(
     world.particles.permute(&order);
     world.tiles.tile_of.clear();
     world.tiles.fresh = false;
+    if let Some(c) = world.cracks.as_mut() {
+        c.scratch.forget_particles();
+    }
     localize(world, probes);
     true
 }

@@ -12,6 +12,8 @@ use crate::base::error::Unstable;
 use crate::base::exact_sum::ExactSum;
 use crate::ranks::comm::Comm;
 use crate::ranks::partition::Partition;
+use bytemuck::Pod;
+use std::ops::Range;
 
 /// The ranks and, when there is more than one, this rank's partition.
 #[derive(Clone, Debug, Default)]
@@ -70,10 +72,19 @@ impl Domain {
         }
     }
 
-    /// The grid entries, of `len`, that this rank's particles can reach: all of them on
-    /// one rank (and every crack field's row), the partition's node span when split.
-    pub fn span(&self, len: usize) -> std::ops::Range<usize> {
-        self.partition.as_ref().map_or(0..len, |p| p.span.clone())
+    /// The grid entries, of `len` with the crack fields' extra rows from `nodes` on, that
+    /// this rank's particles can reach: all of them on one rank; split, the partition's
+    /// node span and every extra row (those of other ranks' nodes stay massless).
+    pub fn spans(&self, len: usize, nodes: usize) -> [Range<usize>; 2] {
+        match &self.partition {
+            None => [0..len, len..len],
+            Some(p) => [p.span.clone(), nodes.min(len)..len],
+        }
+    }
+
+    /// Whether this rank owns tile `t` (every tile on one rank).
+    pub fn owns_tile(&self, t: u32) -> bool {
+        (self.partition.as_ref()).is_none_or(|p| p.owns_tile(t, self.comm.rank()))
     }
 
     /// Whether this rank counts node `n` in node sums (every node on one rank).
@@ -121,6 +132,56 @@ impl Domain {
     /// Whether `yes` holds on any rank.
     pub fn any(&self, yes: bool) -> bool {
         self.max(f64::from(u8::from(yes))) > 0.0
+    }
+
+    /// Every rank's `mine` (each in `key` order) as one list in `key` order, ties in rank
+    /// order: what one rank, holding every particle, would have listed (`mine` on one
+    /// rank).
+    pub fn in_order<T: Pod, K: Ord>(&self, mine: Vec<T>, key: impl Fn(&T) -> K) -> Vec<T> {
+        if !self.is_split() {
+            return mine;
+        }
+        let mut all: Vec<T> = (self.comm.all_gather(bytemuck::cast_slice(&mine).to_vec()))
+            .iter()
+            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, T>(b))
+            .collect();
+        // Stable: equal keys keep rank order.
+        all.sort_by_key(key);
+        all
+    }
+
+    /// `mine` and what the peers' lists hold on the nodes this rank shares with them, in
+    /// `key` order (each list in `key` order, no key on two ranks): the terms one rank,
+    /// holding every particle, would add on the nodes this rank reaches. `node` gives an
+    /// item's node.
+    pub fn with_shared<T: Pod, K: Ord>(
+        &self,
+        mut mine: Vec<T>,
+        node: impl Fn(&T) -> usize,
+        key: impl Fn(&T) -> K,
+    ) -> Vec<T> {
+        let Some(p) = &self.partition else {
+            return mine;
+        };
+        let out: Vec<Vec<u8>> = (p.shared.iter())
+            .map(|shared| {
+                let theirs: Vec<T> = mine.iter().filter(|t| shared[node(t)]).copied().collect();
+                bytemuck::cast_slice(&theirs).to_vec()
+            })
+            .collect();
+        for bytes in self.comm.exchange(&p.peers, &out) {
+            mine.extend(bytemuck::pod_collect_to_vec::<u8, T>(&bytes));
+        }
+        mine.sort_by_key(key);
+        mine
+    }
+
+    /// The union of every rank's `mine`, sorted and without repeats (`mine` on one rank,
+    /// which must be sorted and distinct).
+    pub fn union<T: Pod + Ord>(&self, mine: Vec<T>) -> Vec<T> {
+        let mut all = self.in_order(mine, |&t| t);
+        all.dedup();
+        all
     }
 
     /// Adds the other ranks' terms into `sums` (nothing on one rank).

@@ -74,6 +74,8 @@ pub struct Partition {
     pub owned_nodes: BitVec,
     /// Ranks whose tiles reach a node this rank's tiles reach, ascending.
     pub peers: Vec<usize>,
+    /// Per peer: the nodes both its tiles and this rank's reach.
+    pub shared: Vec<BitVec>,
     /// Per colour class, per peer: the shared nodes this rank sends after the class.
     pub sends: Vec<Vec<Vec<u32>>>,
     /// Per colour class, per peer: the shared nodes this rank receives after the class.
@@ -149,6 +151,9 @@ impl Partition {
                     .collect()
             })
             .collect();
+        let shared = (peers.iter())
+            .map(|&q| reached[q].clone() & &reached[me])
+            .collect();
         let mut owned_nodes = bitvec![0; total];
         let [nx, ny, _] = nodes;
         for n in 0..total {
@@ -171,6 +176,7 @@ impl Partition {
             owner,
             owned_nodes,
             peers,
+            shared,
             sends,
             receives,
             talks,

@@ -75,7 +75,16 @@ impl<'a, D: DimSystems> Run<'a, D> {
             checkpoint,
             fracture,
         } = scene;
-        distribute::split(&mut world, &mut probes, opts.comm.clone())?;
+        // What the scene holds, reported before each rank keeps its share of it.
+        let node_lines = reports::node_lines(&world);
+        let particles_on_cracks = reports::particles_on_cracks(&world);
+        let tips_on_lines = reports::tips_on_particle_lines(&world);
+        distribute::split(
+            &mut world,
+            &mut probes,
+            fracture.is_some(),
+            opts.comm.clone(),
+        )?;
         // Only the first rank writes the files (every rank its piece of a VTK frame).
         let out = opts.out.as_ref().filter(|_| opts.comm.is_root());
         let schedule = Schedule::for_world(&world, fracture.clone());
@@ -94,9 +103,6 @@ impl<'a, D: DimSystems> Run<'a, D> {
         };
         let crack_names: Option<Vec<String>> = (fracture.as_ref().and(world.cracks.as_ref()))
             .map(|c| c.topology.cracks().iter().map(|c| c.name.clone()).collect());
-        let node_lines = reports::node_lines(&world);
-        let particles_on_cracks = reports::particles_on_cracks(&world);
-        let tips_on_lines = reports::tips_on_particle_lines(&world);
         let growing: Option<(Vec<String>, bool)> = (world.cracks.as_ref())
             .filter(|c| c.topology.cracks().iter().any(|c| c.growth.is_some()))
             .map(|c| {

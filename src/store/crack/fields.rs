@@ -103,6 +103,16 @@ impl<D: Dim> Scratch<D> {
     pub fn color(&self, c: usize) -> u8 {
         self.colors.get(c).copied().unwrap_or(c as u8)
     }
+
+    /// Drops what refers to particles by index, once they were reordered (particles moved
+    /// between ranks): the next classification is a full pass.
+    pub fn forget_particles(&mut self) {
+        let f = &mut self.fields;
+        f.slot.fill(u32::MAX);
+        f.coded.clear();
+        f.targets.clear();
+        self.classified.x0.clear();
+    }
 }
 
 impl<D: Dim> Default for Scratch<D> {
@@ -246,6 +256,15 @@ impl Fields {
             }
             Some((n, self.nodes + start..self.nodes + k))
         })
+    }
+
+    /// The node of grid entry `e`: itself, or the node an extra row belongs to.
+    #[inline(always)]
+    pub fn node_of(&self, e: usize) -> usize {
+        match e.checked_sub(self.nodes) {
+            Some(r) if r < self.node.len() => self.node[r] as usize,
+            _ => e,
+        }
     }
 
     /// Grid entries of the extra fields of node `n`.
