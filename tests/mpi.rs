@@ -313,99 +313,14 @@ fn scene_file(scene: &str, name: &str) -> (std::path::PathBuf, std::path::PathBu
     (dir, file)
 }
 
-/// An edge crack with Coulomb faces to the middle of a square plate whose edge below the
-/// crack is driven into it (Lee & Freund's problem, coarse): the lower face bulges into the
-/// upper one and they slide. The plate fills 8 x 8 tiles, so the Morton curve divides them
-/// between 2 ranks half a cell below the crack and between 4 ranks at the tip too: the
-/// crack's fields lie on nodes the ranks share.
-#[cfg(feature = "mpi")]
-const SLIDING_CRACK_2D: &str = r#"
-name = "sliding_crack_2d"
-[simulation]
-dimension = 2
-plane = "strain"
-shape = "ugimp"
-update = "usavg"
-duration = 7.0e-6
-cfl = 0.5
-[grid]
-min = [-0.032, -0.032]
-max = [0.032, 0.032]
-cell = [0.001, 0.001]
-anchor = { point = [0.0, 0.0], offset = [0.0, 0.5] }
-[[material]]
-name = "steel"
-E = 211.0e9
-nu = 0.25
-rho = 7800.0
-[[body]]
-material = "steel"
-box = { min = [-0.03, -0.03], max = [0.03, 0.03] }
-[[crack]]
-name = "crack"
-line = { start = [-0.0305, 0.0], end = [0.004, 0.0], spacing = 2.5e-4 }
-contact = { law = "friction", friction = 0.3 }
-[[boundary]]
-region = { min = [-0.0321, -0.0301], max = [-0.03, -0.0005] }
-fix = ["x"]
-velocity = [16.5, 0.0]
-[[probe]]
-name = "mouth"
-region = { min = [-0.03, -0.002], max = [-0.028, 0.002] }
-quantity = "opening"
-component = "y"
-[output]
-interval = 1.0e-6
-history_interval = 1.0e-7
-"#;
-
-/// A penny crack with Coulomb faces in a block squeezed and sheared from its top face.
-#[cfg(feature = "mpi")]
-const SQUEEZED_PENNY_3D: &str = r#"
-name = "squeezed_penny_3d"
-[simulation]
-dimension = 3
-duration = 2.0e-6
-cfl = 0.5
-[grid]
-min = [-0.002, -0.002, -0.002]
-max = [0.014, 0.014, 0.014]
-cell = [0.001, 0.001, 0.001]
-[[material]]
-name = "steel"
-E = 200.0e9
-nu = 0.3
-rho = 7800.0
-[[body]]
-material = "steel"
-box = { min = [0.0, 0.0, 0.0], max = [0.012, 0.012, 0.012] }
-[[crack]]
-name = "penny"
-penny = { center = [0.006, 0.0065, 0.006], normal = [0.0, 1.0, 0.0], radius = 0.004 }
-contact = { law = "friction", friction = 0.3 }
-[[boundary]]
-region = { min = [-0.002, 0.0115, -0.002], max = [0.014, 0.014, 0.014] }
-fix = ["x", "y"]
-velocity = [3.0, -10.0, 0.0]
-[[boundary]]
-region = { min = [-0.002, -0.002, -0.002], max = [0.014, 0.0005, 0.014] }
-fix = ["x", "y", "z"]
-[[probe]]
-name = "centre"
-region = { min = [0.005, 0.0055, 0.005], max = [0.007, 0.0075, 0.007] }
-quantity = "opening"
-component = "y"
-[output]
-interval = 1.0e-6
-history_interval = 1.0e-7
-"#;
-
-/// `scene` (a crack with Coulomb faces) on 2, 3 and 4 ranks as on one process: energy.csv
+/// `scenarios/perf/<name>.toml` (a crack with Coulomb faces) on 2, 3 and 4 ranks as on one process: energy.csv
 /// (friction's work among it, which must be positive) and probes.csv byte for byte, the
-/// frames' particles, and the cracks' last frame (the advected vertices and surfaces).
+/// frames' particles, and the cracks' last frame (the advected vertices and surfaces); and
+/// a snapshot set of a 2-rank run resumed on 3 ranks.
 #[cfg(feature = "mpi")]
-fn cracks_slide_alike_on_ranks(scene: &str, name: &str) {
-    let (dir, file) = scene_file(scene, name);
+fn cracks_slide_alike_on_ranks(name: &str) {
+    let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_{name}", std::process::id()));
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenarios/perf/{name}.toml"));
     let file = file.to_str().unwrap();
     let serial = dir.join("serial");
     run(file, None, &serial, &[]);
@@ -427,19 +342,31 @@ fn cracks_slide_alike_on_ranks(scene: &str, name: &str) {
             "{name}: {crack} differs on {n} ranks"
         );
     }
+    // A set written on 2 ranks mid-run, resumed on 3, ends as the serial run.
+    let every = ["--set", "checkpoint.every_steps=20", "--threads", "1"];
+    let split = dir.join("ranks2_snapshots");
+    run(file, Some(2), &split, &every);
+    let mut sets: Vec<_> = (std::fs::read_dir(split.join("snapshots")).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "fsnap"))
+        .collect();
+    sets.sort();
+    let resumed = dir.join("resumed3");
+    succeeded(&resume(&sets[0], Some(3), &resumed));
+    same_outputs(&serial, &resumed, &format!("{name} resumed on 3 ranks"));
     std::fs::remove_dir_all(&dir).ok();
 }
 
 #[cfg(feature = "mpi")]
 #[test]
 fn a_sliding_crack_split_across_ranks_matches_one_process() {
-    cracks_slide_alike_on_ranks(SLIDING_CRACK_2D, "sliding_crack_2d");
+    cracks_slide_alike_on_ranks("sliding_crack_2d");
 }
 
 #[cfg(feature = "mpi")]
 #[test]
 fn a_squeezed_penny_split_across_ranks_matches_one_process() {
-    cracks_slide_alike_on_ranks(SQUEEZED_PENNY_3D, "squeezed_penny_3d");
+    cracks_slide_alike_on_ranks("squeezed_penny_3d");
 }
 
 #[cfg(feature = "mpi")]
