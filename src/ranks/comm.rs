@@ -38,6 +38,20 @@ pub struct Traffic {
     pub bytes: AtomicU64,
     /// Collective operations (sums, gathers).
     pub collectives: AtomicU64,
+    /// Nanoseconds spent inside the MPI calls: sending, receiving and waiting for peers.
+    pub inside: AtomicU64,
+}
+
+impl Traffic {
+    /// Runs `call`, adding its wall time to `inside`.
+    #[cfg(feature = "mpi")]
+    fn timed<T>(&self, call: impl FnOnce() -> T) -> T {
+        let t0 = std::time::Instant::now();
+        let out = call();
+        let nanos = u64::try_from(t0.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.inside.fetch_add(nanos, Ordering::Relaxed);
+        out
+    }
 }
 
 impl fmt::Debug for Comm {
@@ -58,10 +72,11 @@ impl Comm {
         }
     }
 
-    /// Messages, bytes and collectives this rank has sent so far.
-    pub fn traffic(&self) -> [u64; 3] {
+    /// Messages, bytes and collectives this rank has sent so far, and the nanoseconds it
+    /// spent inside MPI calls.
+    pub fn traffic(&self) -> [u64; 4] {
         let t = &self.traffic;
-        [&t.messages, &t.bytes, &t.collectives].map(|c| c.load(Ordering::Relaxed))
+        [&t.messages, &t.bytes, &t.collectives, &t.inside].map(|c| c.load(Ordering::Relaxed))
     }
 
     /// This rank (0-based).
@@ -90,7 +105,7 @@ impl Comm {
         #[cfg(feature = "mpi")]
         if let Some(w) = &self.world {
             self.traffic.collectives.fetch_add(1, Ordering::Relaxed);
-            w.sum_exact(sums);
+            self.traffic.timed(|| w.sum_exact(sums));
         }
         let _ = sums;
     }
@@ -104,7 +119,7 @@ impl Comm {
             t.messages.fetch_add(out.len() as u64, Ordering::Relaxed);
             let bytes = out.iter().map(|b| b.len() as u64).sum();
             t.bytes.fetch_add(bytes, Ordering::Relaxed);
-            return w.exchange(peers, out);
+            return t.timed(|| w.exchange(peers, out));
         }
         debug_assert!(peers.is_empty(), "one rank has no peers");
         let _ = out;
@@ -116,7 +131,7 @@ impl Comm {
         #[cfg(feature = "mpi")]
         if let Some(w) = &self.world {
             self.traffic.collectives.fetch_add(1, Ordering::Relaxed);
-            return w.all_gather(&mine);
+            return self.traffic.timed(|| w.all_gather(&mine));
         }
         vec![mine]
     }

@@ -276,9 +276,15 @@ pub(super) fn ranks<D: Dim>(world: &World<D>, steps: u64) -> Option<RanksReport>
     if !comm.is_split() {
         return None;
     }
-    let [messages, bytes, collectives] = comm.traffic();
-    let mine = [world.particles.len() as u64, messages, bytes, collectives];
-    let all: Vec<[u64; 4]> = (comm.all_gather(bytemuck::cast_slice(&mine).to_vec()).iter())
+    let [messages, bytes, collectives, inside] = comm.traffic();
+    let mine = [
+        world.particles.len() as u64,
+        messages,
+        bytes,
+        collectives,
+        inside,
+    ];
+    let all: Vec<[u64; 5]> = (comm.all_gather(bytemuck::cast_slice(&mine).to_vec()).iter())
         .map(|b| bytemuck::pod_read_unaligned(b))
         .collect();
     let per_step = |k: usize| all.iter().map(move |r| r[k] as f64 / steps.max(1) as f64);
@@ -293,6 +299,10 @@ pub(super) fn ranks<D: Dim>(world: &World<D>, steps: u64) -> Option<RanksReport>
         messages_per_step: [mean(1), most(1)],
         bytes_per_step: [mean(2), most(2)],
         collectives_per_step: mean(3),
+        mpi_seconds: [
+            all.iter().map(|r| r[4] as f64 * 1e-9).sum::<f64>() / all.len() as f64,
+            all.iter().map(|r| r[4] as f64 * 1e-9).fold(0.0, f64::max),
+        ],
         rebalances: world.domain.rebalances,
     })
 }

@@ -53,6 +53,9 @@ pub struct RanksReport {
     pub bytes_per_step: [f64; 2],
     /// Collective operations (exact sums, gathers) per step.
     pub collectives_per_step: f64,
+    /// Wall seconds a rank spent inside MPI calls over the run (sending, receiving, and
+    /// waiting for peers that had more to do): mean and most over the ranks.
+    pub mpi_seconds: [f64; 2],
     /// Times the tiles were divided anew as the particles moved.
     pub rebalances: u32,
 }
