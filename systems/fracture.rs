@@ -193,7 +193,7 @@ pub(crate) fn tip(
         window = window.min(s.grown);
     }
     let [d_i, d_ii] = opening_amplitudes(cracks, &walk, end, xt, dir, h, window);
-    let mat = &world.materials[world.particles.material[main.nearest] as usize];
+    let mat = &world.materials[main.material];
     let plane = world.settings.plane;
     let [o1, o2] = match running {
         // Until it has run three cells there are too few such faces to fit.
@@ -248,8 +248,8 @@ struct ContourJ {
     line: [f64; 2],
     /// Area integral over the particles inside the contour (J/m^2).
     area: [f64; 2],
-    /// Particle nearest the tip.
-    nearest: usize,
+    /// Material of the particle nearest the tip.
+    material: usize,
     /// Whether a particle within the interpolation reach of the contour has yielded: J is
     /// then taken through plastic material, and K (an elastic quantity) is not reported.
     plastic: bool,
@@ -419,11 +419,41 @@ impl<'a> Contour<'a> {
     }
 }
 
+/// One particle's mass-weighted values (Eq. 11) on one contour entry, the share `gather`
+/// adds there.
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+struct NodeShare {
+    /// The particle's index in the whole scene.
+    id: u64,
+    entry: u64,
+    f: [f64; 10],
+}
+
+/// What one particle near a contour adds besides its node shares.
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+struct Near {
+    /// The particle's index in the whole scene.
+    id: u64,
+    /// Its term of the area integral (Eq. 8), when `inside`.
+    area: [f64; 2],
+    /// Its squared distance to the tip (m^2).
+    d2: f64,
+    material: u32,
+    /// Whether it lies inside the contour (and the area term is asked for).
+    inside: u32,
+    /// Whether it has yielded within the interpolation reach of the contour.
+    plastic: u32,
+    _pad: u32,
+}
+
 /// Extrapolates the particles near contour `k` to its nodes' fields (mass-weighted sums
 /// into `acc`, Eq. 11) and, with `area_term`, integrates the area term (Eq. 8) over the
 /// particles inside it. Also finds the particle nearest the tip `xt` and whether a
 /// yielded particle lies on the contour's band (J is then not K's). The returned line
-/// integral is left at zero.
+/// integral is left at zero. Every sum is taken in particle order; split across ranks,
+/// each rank lists its particles' terms and all add every rank's, in that order.
 fn gather(
     world: &World<D2>,
     cracks: &Cracks<D2>,
@@ -439,22 +469,17 @@ fn gather(
     let shape = world.settings.shape;
     let (lo, hi) = (k.lo, k.hi);
     let reach = 2.0 * geom.h[0].max(geom.h[1]);
-    let mut area = [0.0; 2];
-    let mut nearest = (f64::INFINITY, 0usize);
-    let mut plastic = false;
     let half = 0.5 * (hi - lo).max_element();
     let centre = 0.5 * (lo + hi);
+    let (mut shares, mut nears) = (Vec::new(), Vec::new());
     for i in near(world, centre, half + reach) {
         let x = p.x[i];
         if x.cmplt(lo - reach).any() || x.cmpgt(hi + reach).any() {
             continue;
         }
-        let d2 = x.distance_squared(xt);
-        if d2 < nearest.0 {
-            nearest = (d2, i);
-        }
+        let id = p.id.get(i).copied().unwrap_or(i as u64);
         let well_inside = x.cmpgt(lo + reach).all() && x.cmplt(hi - reach).all();
-        plastic |= !well_inside && p.hardened.get(i).is_some_and(|h| h.equivalent > 0.0);
+        let plastic = !well_inside && p.hardened.get(i).is_some_and(|h| h.equivalent > 0.0);
         let m = p.mass[i];
         let mat = &world.materials[p.material[i] as usize];
         let st = p.stress[i].to_sym3();
@@ -485,10 +510,12 @@ fn gather(
         with_shape!(shape, S, N => {
             let st = Stencil::<N>::cached::<D2>(S, &world.tiles.stencils, i);
             let mut visit = |entry: usize, w: f64| {
-                if let Some(a) = acc.get_mut(&entry) {
-                    for (a, f) in a.iter_mut().zip(&f) {
-                        *a += f * w;
-                    }
+                if acc.contains_key(&entry) {
+                    shares.push(NodeShare {
+                        id,
+                        entry: entry as u64,
+                        f: f.map(|f| f * w),
+                    });
                 }
                 if inside {
                     accel += g.accel[entry] * w;
@@ -499,6 +526,7 @@ fn gather(
                 None => st.for_each::<D2>(&geom.stride, |n, w, _| visit(n, w)),
             }
         });
+        let mut area = [0.0; 2];
         if inside {
             // Eq. 8's area term: rho [a . du/dx_m - v . dv/dx_m] over the particle's area
             // V / thickness, with rho V = m.
@@ -510,14 +538,43 @@ fn gather(
                     D2::entry(&p.grad_u[i], 1, mm),
                 );
                 let dv = DVec2::new(D2::entry(&gv, 0, mm), D2::entry(&gv, 1, mm));
-                *a += scale * (accel.dot(du) - v.x * dv.x - v.y * dv.y);
+                *a = scale * (accel.dot(du) - v.x * dv.x - v.y * dv.y);
             }
+        }
+        nears.push(Near {
+            id,
+            area,
+            d2: x.distance_squared(xt),
+            material: u32::from(p.material[i]),
+            inside: u32::from(inside),
+            plastic: u32::from(plastic),
+            _pad: 0,
+        });
+    }
+    let domain = &world.domain;
+    for s in domain.in_order(shares, |s| s.id) {
+        let a = acc.get_mut(&(s.entry as usize)).expect("a contour entry");
+        for (a, f) in a.iter_mut().zip(&s.f) {
+            *a += f;
+        }
+    }
+    let mut area = [0.0; 2];
+    let mut nearest = (f64::INFINITY, 0u32);
+    let mut plastic = false;
+    for n in domain.in_order(nears, |n| n.id) {
+        if n.d2 < nearest.0 {
+            nearest = (n.d2, n.material);
+        }
+        plastic |= n.plastic != 0;
+        if n.inside != 0 {
+            area[0] += n.area[0];
+            area[1] += n.area[1];
         }
     }
     ContourJ {
         line: [0.0; 2],
         area,
-        nearest: nearest.1,
+        material: nearest.1 as usize,
         plastic,
     }
 }

@@ -185,8 +185,13 @@ struct Place {
 /// One particle's share of the four integrals (J and the interaction integrals of modes I,
 /// II, III): with q_r' = dq_r/dr and q_s' = dq_s/ds, the particle adds
 /// q_r' q_s c[0] + q_r q_s' c[1] + q_r q_s c[2] to each.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 struct Sample {
+    /// The particle's index in the whole scene (the order one rank adds the samples in).
+    id: u64,
+    /// Its squared distance to the front vertex (m^2).
+    d2: f64,
     /// r and s (m).
     r: f64,
     s: f64,
@@ -194,10 +199,10 @@ struct Sample {
     vol: f64,
     /// Coefficients of J and of modes I, II, III.
     c: [[f64; 3]; 4],
-    /// Whether the particle has yielded.
-    yielded: bool,
+    /// Whether the particle has yielded (1) or not (0).
+    yielded: u32,
     /// The particle's material index.
-    material: u16,
+    material: u32,
 }
 
 /// The actual fields at a particle, in the frame of its nearest front point.
@@ -268,12 +273,14 @@ impl Sample {
             c[m + 1] = cm;
         }
         Sample {
+            id: 0,
+            d2: 0.0,
             r,
             s: place.s,
             vol: f.vol,
             c,
-            yielded: f.yielded,
-            material: f.material,
+            yielded: u32::from(f.yielded),
+            material: u32::from(f.material),
         }
     }
 }
@@ -329,7 +336,7 @@ pub fn front_integrals(
     // at the vertex, inside the nearest particle of other elastic constants.
     let foreign = (samples.iter())
         .filter(|q| {
-            let e = elastic(q.material);
+            let e = elastic(q.material as u16);
             e.mu != el.mu || e.nu != el.nu
         })
         .map(|q| q.r)
@@ -339,7 +346,7 @@ pub fn front_integrals(
         if let Some((i, [j, j_volume])) = integrate(&samples, r, tube.length) {
             let (band, len) = (tube.step, tube.length);
             let plastic = samples.iter().any(|q| {
-                q.yielded
+                q.yielded != 0
                     && q.r < r
                     && q.s.abs() < len
                     && (q.r >= r - band || q.s.abs() >= len - band)
@@ -447,8 +454,9 @@ fn place(line: &FrontLine, idx: &[usize], arc: &[f64], p: DVec3) -> Place {
     }
 }
 
-/// The particles in the tube of `tube.radius` around vertex `k` of `line`, and the material
-/// of the one nearest the vertex; None when the tube holds no particle.
+/// The particles in the tube of `tube.radius` around vertex `k` of `line`, in particle order
+/// (every rank's, split across ranks), and the material of the one nearest the vertex;
+/// None when the tube holds no particle.
 fn gather(
     world: &World<D3>,
     cracks: &Cracks<D3>,
@@ -470,17 +478,12 @@ fn gather(
         .map(|f| frame.local(f.centroid - frame.x).y.abs())
         .fold(0.0, f64::max)
         + h;
-    let mut nearest = (f64::INFINITY, 0u16);
     let mut out = Vec::new();
     for i in near(world, frame.x, rad.hypot(len)) {
         let mut at = place(line, &idx, &arc, p.x[i]);
         let r = at.x1.hypot(at.x2);
         if r >= rad || at.s.abs() >= len {
             continue;
-        }
-        let d2 = (p.x[i] - frame.x).length_squared();
-        if d2 < nearest.0 {
-            nearest = (d2, p.material[i]);
         }
         if at.x1 < 0.0 && at.x2.abs() <= band {
             let side = facets
@@ -512,7 +515,19 @@ fn gather(
             yielded: p.hardened.get(i).is_some_and(|h| h.equivalent > 0.0),
             material: p.material[i],
         };
-        out.push(Sample::new(&at, &fields, &elastic(p.material[i])));
+        out.push(Sample {
+            id: p.id.get(i).copied().unwrap_or(i as u64),
+            d2: (p.x[i] - frame.x).length_squared(),
+            ..Sample::new(&at, &fields, &elastic(p.material[i]))
+        });
+    }
+    // Split across ranks, every rank integrates every rank's samples, in particle order.
+    let out = world.domain.in_order(out, |s| s.id);
+    let mut nearest = (f64::INFINITY, 0u16);
+    for q in &out {
+        if q.d2 < nearest.0 {
+            nearest = (q.d2, q.material as u16);
+        }
     }
     (!out.is_empty()).then_some((out, nearest.1))
 }

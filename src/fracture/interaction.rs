@@ -62,7 +62,11 @@ pub struct InteractionK {
 const FILLED: f64 = 0.98;
 
 /// One particle's data in tip axes.
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 struct Sample {
+    /// The particle's index in the whole scene (the order one rank adds the samples in).
+    id: u64,
     /// Position relative to the tip (m).
     x: DVec2,
     /// Area (m^2) and mass per unit thickness (kg/m).
@@ -93,6 +97,7 @@ impl Sample {
     ) -> Sample {
         let (aux_s, aux_g) = near_tip::unit_fields(x.x.hypot(x.y), theta, kap, mu);
         Sample {
+            id: 0,
             x,
             area,
             mass,
@@ -166,11 +171,11 @@ fn other_material_distance(world: &World<D2>, tip: Tip, reach: f64, mat: &Materi
     if !foreign.contains(&true) {
         return f64::INFINITY;
     }
-    near(world, x, reach)
-        .into_iter()
+    let mine = (near(world, x, reach).into_iter())
         .filter(|&i| foreign[p.material[i] as usize])
         .map(|i| p.x[i].distance(x))
-        .fold(f64::INFINITY, f64::min)
+        .fold(f64::INFINITY, f64::min);
+    world.domain.min(mine)
 }
 
 /// The interaction integrals of modes I and II over the disc of radius `r_max`, or None
@@ -279,7 +284,7 @@ fn gather(
             [D2::entry(g, 0, 0), D2::entry(g, 0, 1)],
             [D2::entry(g, 1, 0), D2::entry(g, 1, 1)],
         ]);
-        out.push(Sample::new(
+        let sample = Sample::new(
             x,
             theta,
             [p.volume[i] / thickness, p.mass[i] / thickness],
@@ -287,9 +292,14 @@ fn gather(
             gu,
             to_local(accel(world, cracks, i)),
             [kap, mu],
-        ));
+        );
+        out.push(Sample {
+            id: p.id.get(i).copied().unwrap_or(i as u64),
+            ..sample
+        });
     }
-    out
+    // Split across ranks, every rank integrates every rank's samples, in particle order.
+    world.domain.in_order(out, |s| s.id)
 }
 
 /// The particles that can lie within `reach` of `x`, in ascending index order: those binned

@@ -17,13 +17,7 @@ use std::borrow::Cow;
 /// Keeps this rank's particles of a scene every rank built whole: those in the tiles the
 /// partition gives it, numbered by their index in the whole scene. Loads and probes keep
 /// their whole lists, with the entries of other ranks' particles marked [`ABSENT`].
-/// `measures`: whether the scene measures J and K at its crack tips.
-pub fn split<D: Dim>(
-    world: &mut World<D>,
-    probes: &mut [Probe],
-    measures: bool,
-    comm: Comm,
-) -> anyhow::Result<()> {
+pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> anyhow::Result<()> {
     if !comm.is_split() {
         world.domain = Domain {
             comm,
@@ -31,7 +25,7 @@ pub fn split<D: Dim>(
         };
         return Ok(());
     }
-    refuse_unsupported(world, measures)?;
+    refuse_unsupported(world)?;
     bin::run(world).map_err(|u| anyhow::anyhow!("{u}"))?;
     let tiles = &world.tiles;
     let counts: Vec<u32> = tiles.start.windows(2).map(|w| w[1] - w[0]).collect();
@@ -69,17 +63,12 @@ pub fn split<D: Dim>(
 }
 
 /// What a split run cannot do yet, refused by name.
-fn refuse_unsupported<D: Dim>(world: &World<D>, measures: bool) -> anyhow::Result<()> {
+fn refuse_unsupported<D: Dim>(world: &World<D>) -> anyhow::Result<()> {
     let no = |what: &str| anyhow::anyhow!("{what} cannot yet run on more than one MPI rank");
-    if let Some(c) = &world.cracks {
-        if let Some(g) = c.topology.cracks().iter().find(|c| c.growth.is_some()) {
-            return Err(no(&format!("a growing crack (`{}`)", g.name)));
-        }
-        if measures {
-            return Err(no(
-                "measuring J and K at crack tips (the [fracture] section)",
-            ));
-        }
+    if let Some(c) = &world.cracks
+        && let Some(g) = c.topology.cracks().iter().find(|c| c.growth.is_some())
+    {
+        return Err(no(&format!("a growing crack (`{}`)", g.name)));
     }
     if world.settings.solver == Solver::Static {
         return Err(no("a static scene"));

@@ -129,6 +129,11 @@ impl Domain {
             .fold(x, f64::max)
     }
 
+    /// The smallest of every rank's `x`.
+    pub fn min(&self, x: f64) -> f64 {
+        -self.max(-x)
+    }
+
     /// Whether `yes` holds on any rank.
     pub fn any(&self, yes: bool) -> bool {
         self.max(f64::from(u8::from(yes))) > 0.0

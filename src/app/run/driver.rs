@@ -79,12 +79,7 @@ impl<'a, D: DimSystems> Run<'a, D> {
         let node_lines = reports::node_lines(&world);
         let particles_on_cracks = reports::particles_on_cracks(&world);
         let tips_on_lines = reports::tips_on_particle_lines(&world);
-        distribute::split(
-            &mut world,
-            &mut probes,
-            fracture.is_some(),
-            opts.comm.clone(),
-        )?;
+        distribute::split(&mut world, &mut probes, opts.comm.clone())?;
         // Only the first rank writes the files (every rank its piece of a VTK frame).
         let out = opts.out.as_ref().filter(|_| opts.comm.is_root());
         let schedule = Schedule::for_world(&world, fracture.clone());
