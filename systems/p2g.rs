@@ -118,18 +118,8 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
     if world.loads.is_empty() {
         return;
     }
-    let shares = load_shares(world);
-    let shares = if world.domain.is_split() {
-        let mine = bytemuck::cast_slice(&shares).to_vec();
-        let mut all: Vec<LoadShare<D>> = (world.domain.comm.all_gather(mine).iter())
-            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, LoadShare<D>>(b))
-            .collect();
-        // Stable: each particle's shares stay in stencil order.
-        all.sort_by_key(|s| (s.load, s.entry));
-        all
-    } else {
-        shares
-    };
+    // Stable: each particle's shares stay in stencil order.
+    let shares = (world.domain).in_order(load_shares(world), |s| (s.load, s.entry));
     for s in &shares {
         world.grid.force[s.node as usize] += s.force;
     }
