@@ -11,7 +11,9 @@ use crate::base::dim::D3;
 use crate::base::geometry::Element;
 use crate::base::geometry::point_triangle;
 use crate::fracture::front::{FrontFrame, front_line};
-use crate::fracture::front_integral::{Elastic3, Facet, FrontIntegrals, Tube, front_integrals};
+use crate::fracture::front_integral::{
+    Elastic3, Facet, FrontIntegrals, Tube, TubeSamples, front_integrals, tube_samples,
+};
 use crate::fracture::plan::{FracturePlan, KMethod, Measured, PathResult, TipResult, lower_g};
 use crate::store::crack::Cracks;
 use crate::store::world::World;
@@ -65,106 +67,186 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
     for front in cracks.topology.fronts() {
         let c = front.crack as usize;
         let line = front_line(cracks, front);
-        // Each vertex is measured on its own, in parallel; the rows keep the front's order.
-        let rows: Vec<(TipResult, Vec<PathResult>)> = (0..line.frames.len())
-            .into_par_iter()
-            .map(|k| {
-                let frame = &line.frames[k];
-                let tip = ordinal[c] + k as u32;
-                let within = |r: f64| -> Vec<Facet> {
-                    (facets.iter().zip(elem_crack))
-                        .filter(|&(f, &e)| {
-                            e as usize == c && (f.centroid - frame.x).length() < 2.0 * r + h
-                        })
-                        .map(|(f, _)| *f)
-                        .collect()
-                };
-                // A tube reaches sqrt(2) R from the vertex; it stays clear of other cracks.
-                let room = room(cracks, c, frame.x, SQRT_2 * reach + h) / SQRT_2;
-                let fits = |t: &Tube| t.radius <= room;
-                let mut own = tube;
-                while !fits(&own) && own.radius >= own.min_radius {
-                    own.radius -= h;
-                    own.length -= h;
-                }
-                let near = within(tube.radius);
-                let fi = front_integrals(world, cracks, &line, k, &near, own, elastic);
-                let wide = if paths.is_empty() {
-                    near
-                } else {
-                    within(reach)
-                };
-                let path_rows = (paths.iter())
-                    .map(|&t| {
-                        let p = if fits(&t) {
-                            front_integrals(world, cracks, &line, k, &wide, t, elastic)
-                        } else {
-                            FrontIntegrals::NONE
-                        };
-                        PathResult {
-                            step: world.step,
-                            time: world.time,
-                            crack: c as u32,
-                            tip,
-                            contour: (t.radius / h).round() as u32,
-                            line: [p.j - p.j_volume, f64::NAN],
-                            area: [p.j_volume, f64::NAN],
-                            direction: [1.0, 0.0],
-                        }
-                    })
-                    .collect();
-                let opening = opening(cracks, c, frame, h, plan.opening * h);
-                let (k_opening, k_mixity) = match fi.material.map(elastic) {
-                    Some(el) => (
-                        k_split(
-                            el,
-                            fi.j,
-                            [opening[0] / el.c1(), opening[1] / el.c1(), opening[2] / 4.0],
-                        ),
-                        k_split(el, fi.j, fi.k),
-                    ),
-                    None => ([f64::NAN; 3], [f64::NAN; 3]),
-                };
-                let row = TipResult {
-                    step: world.step,
-                    time: world.time,
-                    crack: c as u32,
-                    tip,
-                    x: frame.x.to_array(),
-                    j: [fi.j, f64::NAN],
-                    k: match plan.k_method {
-                        KMethod::Interaction => fi.k,
-                        KMethod::Mixity => k_mixity,
-                        KMethod::LowerG => lower_g(fi.k, k_mixity),
-                        KMethod::Opening => k_opening,
-                    },
-                    k_interaction: fi.k,
-                    k_opening,
-                    domain: fi.radius,
-                    length: f64::NAN,
-                    speed: 0.0,
-                };
-                // K comes from J only while the tube's surface runs through elastic material.
-                let row = if fi.plastic {
-                    TipResult {
-                        k: [f64::NAN; 3],
-                        k_interaction: [f64::NAN; 3],
-                        k_opening: [f64::NAN; 3],
-                        ..row
+        let n = line.frames.len();
+        // Each batch takes every `batches`-th vertex, so that it spans the whole front and
+        // every rank holds a like share of its samples.
+        let batches = n.div_ceil(BATCH);
+        let mut slots: Vec<Option<(TipResult, Vec<PathResult>)>> = vec![None; n];
+        for first in 0..batches {
+            // The batch's tubes, and their samples on this rank: the vertices in parallel.
+            let ks: Vec<usize> = (first..n).step_by(batches).collect();
+            let asks: Vec<Asks> = (ks.into_par_iter())
+                .map(|k| {
+                    let frame = &line.frames[k];
+                    let within = |r: f64| -> Vec<Facet> {
+                        (facets.iter().zip(elem_crack))
+                            .filter(|&(f, &e)| {
+                                e as usize == c && (f.centroid - frame.x).length() < 2.0 * r + h
+                            })
+                            .map(|(f, _)| *f)
+                            .collect()
+                    };
+                    // A tube reaches sqrt(2) R from the vertex; it stays clear of other cracks.
+                    let room = room(cracks, c, frame.x, SQRT_2 * reach + h) / SQRT_2;
+                    let mut own = tube;
+                    while own.radius > room && own.radius >= own.min_radius {
+                        own.radius -= h;
+                        own.length -= h;
                     }
-                } else {
-                    row
-                };
-                (row, path_rows)
-            })
-            .collect();
-        ordinal[c] += rows.len() as u32;
-        for (row, path_rows) in rows {
+                    Asks {
+                        k,
+                        own,
+                        near: within(tube.radius),
+                        paths: (paths.iter())
+                            .map(|t| (t.radius <= room).then_some(*t))
+                            .collect(),
+                        wide: if paths.is_empty() {
+                            Vec::new()
+                        } else {
+                            within(reach)
+                        },
+                    }
+                })
+                .collect();
+            let local: Vec<TubeSamples> = (asks.par_iter())
+                .flat_map_iter(|a| {
+                    let line = &line;
+                    (a.tubes()).map(move |(t, near)| {
+                        tube_samples(world, cracks, line, a.k, near, t, elastic)
+                    })
+                })
+                .collect();
+            // Split across ranks, one gather for the whole batch; then the integrals.
+            let mut merged = TubeSamples::merged(&world.domain, local).into_iter();
+            let sampled: Vec<(&Asks, Vec<TubeSamples>)> = (asks.iter())
+                .map(|a| (a, merged.by_ref().take(a.tubes().count()).collect()))
+                .collect();
+            let rows: Vec<(TipResult, Vec<PathResult>)> = (sampled.par_iter())
+                .map(|(a, samples)| {
+                    let tip = ordinal[c] + a.k as u32;
+                    let mut samples = samples.iter();
+                    let fi = front_integrals(samples.next().expect("the own tube"), a.own, elastic);
+                    let path_rows = (a.paths.iter().zip(&paths))
+                        .map(|(fits, t)| {
+                            let p = match fits {
+                                Some(t) => front_integrals(
+                                    samples.next().expect("a compared tube"),
+                                    *t,
+                                    elastic,
+                                ),
+                                None => FrontIntegrals::NONE,
+                            };
+                            PathResult {
+                                step: world.step,
+                                time: world.time,
+                                crack: c as u32,
+                                tip,
+                                contour: (t.radius / h).round() as u32,
+                                line: [p.j - p.j_volume, f64::NAN],
+                                area: [p.j_volume, f64::NAN],
+                                direction: [1.0, 0.0],
+                            }
+                        })
+                        .collect();
+                    let frame = &line.frames[a.k];
+                    let opening = opening(cracks, c, frame, h, plan.opening * h);
+                    let row = tip_row(world, plan, &fi, opening, elastic);
+                    let row = TipResult {
+                        crack: c as u32,
+                        tip,
+                        x: frame.x.to_array(),
+                        ..row
+                    };
+                    (row, path_rows)
+                })
+                .collect();
+            for (a, row) in asks.iter().zip(rows) {
+                slots[a.k] = Some(row);
+            }
+        }
+        for (row, path_rows) in slots.into_iter().flatten() {
             m.tips.push(row);
             m.paths.extend(path_rows);
         }
+        ordinal[c] += n as u32;
     }
     m
+}
+
+/// Most front vertices measured together: split across ranks, one gather carries all
+/// their tubes' samples. Bounds the samples held at once (a tube of 3 cells holds some
+/// 1,400 particles at 8 per cell, 144 bytes each).
+const BATCH: usize = 64;
+
+/// What vertex `k` measures: its own tube (shrunk to stay clear of other cracks) over the
+/// crack triangles `near`, and the compared tubes (those that fit) over `wide`.
+struct Asks {
+    k: usize,
+    own: Tube,
+    near: Vec<Facet>,
+    paths: Vec<Option<Tube>>,
+    wide: Vec<Facet>,
+}
+
+impl Asks {
+    /// The tubes to sample, the own first, with the triangles each reaches.
+    fn tubes(&self) -> impl Iterator<Item = (Tube, &[Facet])> {
+        std::iter::once((self.own, &self.near[..]))
+            .chain(self.paths.iter().flatten().map(|t| (*t, &self.wide[..])))
+    }
+}
+
+/// A vertex's row from its integrals `fi` and the crack's `opening` behind it: J, the
+/// three K (the plan's choice among the interaction integral, the mixity split of J and
+/// the opening split), none where the tube's surface has yielded.
+fn tip_row(
+    world: &World<D3>,
+    plan: &FracturePlan,
+    fi: &FrontIntegrals,
+    opening: [f64; 3],
+    elastic: impl Fn(u16) -> Elastic3,
+) -> TipResult {
+    let (k_opening, k_mixity) = match fi.material.map(elastic) {
+        Some(el) => (
+            k_split(
+                el,
+                fi.j,
+                [opening[0] / el.c1(), opening[1] / el.c1(), opening[2] / 4.0],
+            ),
+            k_split(el, fi.j, fi.k),
+        ),
+        None => ([f64::NAN; 3], [f64::NAN; 3]),
+    };
+    let row = TipResult {
+        step: world.step,
+        time: world.time,
+        crack: 0,
+        tip: 0,
+        x: [f64::NAN; 3],
+        j: [fi.j, f64::NAN],
+        k: match plan.k_method {
+            KMethod::Interaction => fi.k,
+            KMethod::Mixity => k_mixity,
+            KMethod::LowerG => lower_g(fi.k, k_mixity),
+            KMethod::Opening => k_opening,
+        },
+        k_interaction: fi.k,
+        k_opening,
+        domain: fi.radius,
+        length: f64::NAN,
+        speed: 0.0,
+    };
+    // K comes from J only while the tube's surface runs through elastic material.
+    if fi.plastic {
+        TipResult {
+            k: [f64::NAN; 3],
+            k_interaction: [f64::NAN; 3],
+            k_opening: [f64::NAN; 3],
+            ..row
+        }
+    } else {
+        row
+    }
 }
 
 /// How far `x` lies from the nearest triangle of a crack other than `c`, looking no further

@@ -296,16 +296,19 @@ fn first_crossing(cracks: &Cracks<D2>, f: usize, a: DVec2, b: DVec2) -> Option<f
 /// Whether `x` lies in the body: within three quarters of a particle spacing (from its
 /// area or volume) of some particle near it, along every axis. A crack runs half a spacing
 /// from the particle layers on either side of it, so half a spacing would leave it outside.
+/// Split over ranks, each looks among its own particles and every rank takes the answer of
+/// all (every rank calls it at the same point, as growth is decided alike on all).
 pub(crate) fn inside<D: Dim>(world: &World<D>, x: D::Vec) -> bool {
     let p = &world.particles;
     let thickness = world.settings.thickness;
     let h = (0..D::D).map(|a| world.grid.geom.h[a]).fold(0.0, f64::max);
-    near(world, x, h).into_iter().any(|i| {
+    let mine = near(world, x, h).into_iter().any(|i| {
         let spacing = if D::D == 2 {
             (p.volume[i] / thickness).sqrt()
         } else {
             p.volume[i].cbrt()
         };
         (0..D::D).all(|a| (x[a] - p.x[i][a]).abs() <= 0.75 * spacing)
-    })
+    });
+    world.domain.any(mine)
 }

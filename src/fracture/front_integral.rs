@@ -28,6 +28,7 @@ use crate::base::sym::SymTensor;
 use crate::fracture::front::{FrontFrame, FrontLine, tensor_to_local, to_local};
 use crate::fracture::interaction::{accel, near};
 use crate::physics::near_tip;
+use crate::ranks::domain::Domain;
 use crate::store::crack::Cracks;
 use crate::store::world::World;
 use glam::{DMat3, DVec3};
@@ -315,22 +316,37 @@ fn curved(place: &Place, s: &DMat3, gu: &DMat3, sa: &DMat3, ga: &DMat3, ua: DVec
     (g, compat + equil)
 }
 
-/// J and K at vertex `k` of `line` from the particles in the tube, shrunk by `tube.step`
-/// while particles do not fill it or it holds a material other than the vertex's. `facets` are the crack triangles within reach of the
-/// tube; `elastic` gives the material of each material index.
+/// The particles' shares of the integrals over one tube around a front vertex, in
+/// particle order ([`tube_samples`]); split across ranks, every rank's, once
+/// [`merged`](TubeSamples::merged).
+pub struct TubeSamples(Vec<Sample>);
+
+impl TubeSamples {
+    /// Each tube's samples from every rank, in whole-scene particle order, in one
+    /// collective for all the tubes (as they are on one rank).
+    pub fn merged(domain: &Domain, tubes: Vec<TubeSamples>) -> Vec<TubeSamples> {
+        let lists = tubes.into_iter().map(|t| t.0).collect();
+        (domain.in_order_each(lists, |s| s.id).into_iter())
+            .map(TubeSamples)
+            .collect()
+    }
+}
+
+/// J and K at a front vertex from the samples of its tube ([`TubeSamples::merged`]),
+/// shrunk by `tube.step` while particles do not fill it or it holds a material other than
+/// that of the particle nearest the vertex; `elastic` gives the material of each material
+/// index.
 pub fn front_integrals(
-    world: &World<D3>,
-    cracks: &Cracks<D3>,
-    line: &FrontLine,
-    k: usize,
-    facets: &[Facet],
+    samples: &TubeSamples,
     tube: Tube,
     elastic: impl Fn(u16) -> Elastic3,
 ) -> FrontIntegrals {
     let none = FrontIntegrals::NONE;
-    let Some((samples, material)) = gather(world, cracks, line, k, facets, tube, &elastic) else {
+    let samples = &samples.0;
+    let Some(nearest) = samples.iter().min_by(|a, b| a.d2.total_cmp(&b.d2)) else {
         return none;
     };
+    let material = nearest.material as u16;
     let el = elastic(material);
     // The auxiliary fields are those of a homogeneous body: the tube stays in the material
     // at the vertex, inside the nearest particle of other elastic constants.
@@ -343,7 +359,7 @@ pub fn front_integrals(
         .fold(f64::INFINITY, f64::min);
     let mut r = tube.radius.min(foreign - tube.step);
     while r >= tube.min_radius {
-        if let Some((i, [j, j_volume])) = integrate(&samples, r, tube.length) {
+        if let Some((i, [j, j_volume])) = integrate(samples, r, tube.length) {
             let (band, len) = (tube.step, tube.length);
             let plastic = samples.iter().any(|q| {
                 q.yielded != 0
@@ -454,18 +470,18 @@ fn place(line: &FrontLine, idx: &[usize], arc: &[f64], p: DVec3) -> Place {
     }
 }
 
-/// The particles in the tube of `tube.radius` around vertex `k` of `line`, in particle order
-/// (every rank's, split across ranks), and the material of the one nearest the vertex;
-/// None when the tube holds no particle.
-fn gather(
+/// This rank's particles in the tube of `tube.radius` around vertex `k` of `line`, in
+/// particle order, with their shares of the integrals. `facets` are the crack triangles
+/// within reach of the tube.
+pub fn tube_samples(
     world: &World<D3>,
     cracks: &Cracks<D3>,
     line: &FrontLine,
     k: usize,
     facets: &[Facet],
     tube: Tube,
-    elastic: &impl Fn(u16) -> Elastic3,
-) -> Option<(Vec<Sample>, u16)> {
+    elastic: impl Fn(u16) -> Elastic3,
+) -> TubeSamples {
     let p = &world.particles;
     let frame: &FrontFrame = &line.frames[k];
     let (rad, len) = (tube.radius, tube.length);
@@ -521,15 +537,7 @@ fn gather(
             ..Sample::new(&at, &fields, &elastic(p.material[i]))
         });
     }
-    // Split across ranks, every rank integrates every rank's samples, in particle order.
-    let out = world.domain.in_order(out, |s| s.id);
-    let mut nearest = (f64::INFINITY, 0u16);
-    for q in &out {
-        if q.d2 < nearest.0 {
-            nearest = (q.d2, q.material as u16);
-        }
-    }
-    (!out.is_empty()).then_some((out, nearest.1))
+    TubeSamples(out)
 }
 
 /// The interaction integrals of the three modes, and J with its part from the terms in q

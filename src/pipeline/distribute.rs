@@ -64,14 +64,8 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
 
 /// What a split run cannot do yet, refused by name.
 fn refuse_unsupported<D: Dim>(world: &World<D>) -> anyhow::Result<()> {
-    let no = |what: &str| anyhow::anyhow!("{what} cannot yet run on more than one MPI rank");
-    if let Some(c) = &world.cracks
-        && let Some(g) = c.topology.cracks().iter().find(|c| c.growth.is_some())
-    {
-        return Err(no(&format!("a growing crack (`{}`)", g.name)));
-    }
     if world.settings.solver == Solver::Static {
-        return Err(no("a static scene"));
+        anyhow::bail!("a static scene cannot yet run on more than one MPI rank");
     }
     Ok(())
 }

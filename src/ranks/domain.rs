@@ -143,15 +143,41 @@ impl Domain {
     /// order: what one rank, holding every particle, would have listed (`mine` on one
     /// rank).
     pub fn in_order<T: Pod, K: Ord>(&self, mine: Vec<T>, key: impl Fn(&T) -> K) -> Vec<T> {
+        let mut all = self.in_order_each(vec![mine], key);
+        all.pop().expect("one list")
+    }
+
+    /// [`in_order`](Self::in_order) for several lists at once, in one collective: the
+    /// `j`-th list returned holds every rank's `j`-th list (every rank passes as many).
+    pub fn in_order_each<T: Pod, K: Ord>(
+        &self,
+        mine: Vec<Vec<T>>,
+        key: impl Fn(&T) -> K,
+    ) -> Vec<Vec<T>> {
         if !self.is_split() {
             return mine;
         }
-        let mut all: Vec<T> = (self.comm.all_gather(bytemuck::cast_slice(&mine).to_vec()))
-            .iter()
-            .flat_map(|b| bytemuck::pod_collect_to_vec::<u8, T>(b))
-            .collect();
+        // Each rank's message: the lists' lengths, then their items.
+        let lens: Vec<u64> = mine.iter().map(|l| l.len() as u64).collect();
+        let mut bytes = bytemuck::cast_slice(&lens).to_vec();
+        for list in &mine {
+            bytes.extend_from_slice(bytemuck::cast_slice(list));
+        }
+        let size = std::mem::size_of::<T>();
+        let mut all: Vec<Vec<T>> = vec![Vec::new(); mine.len()];
+        for b in self.comm.all_gather(bytes) {
+            let (head, mut rest) = b.split_at(8 * mine.len());
+            let lens: Vec<u64> = bytemuck::pod_collect_to_vec(head);
+            for (list, &n) in all.iter_mut().zip(&lens) {
+                let (items, tail) = rest.split_at(n as usize * size);
+                list.extend(bytemuck::pod_collect_to_vec::<u8, T>(items));
+                rest = tail;
+            }
+        }
         // Stable: equal keys keep rank order.
-        all.sort_by_key(key);
+        for list in &mut all {
+            list.sort_by_key(&key);
+        }
         all
     }
 
