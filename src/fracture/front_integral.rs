@@ -384,6 +384,31 @@ pub fn front_integrals(
     }
 }
 
+/// The stretch of front a tube can reach: its vertices, and each segment's start, vector
+/// and squared length (the same for every particle the tube places).
+struct Stretch {
+    /// Vertex indices in order, and their arc lengths from the tube's vertex (m).
+    idx: Vec<usize>,
+    arc: Vec<f64>,
+    /// Per segment: start, vector to the next vertex, its squared length (m, m, m^2).
+    segs: Vec<(DVec3, DVec3, f64)>,
+}
+
+impl Stretch {
+    /// The stretch around vertex `k` for a tube of half-length `len` ([`stretch`]).
+    fn new(line: &FrontLine, k: usize, len: f64) -> Stretch {
+        let (idx, arc) = stretch(line, k, len);
+        let segs = (idx.windows(2))
+            .map(|w| {
+                let (a, b) = (line.frames[w[0]].x, line.frames[w[1]].x);
+                let ab = b - a;
+                (a, ab, ab.length_squared())
+            })
+            .collect();
+        Stretch { idx, arc, segs }
+    }
+}
+
 /// The stretch of `line` around vertex `k` that the tube of half-length `len` can reach:
 /// vertex indices in order with their arc lengths from vertex `k` (negative before it),
 /// one vertex past `len` each way where the front goes on.
@@ -420,14 +445,15 @@ fn stretch(line: &FrontLine, k: usize, len: f64) -> (Vec<usize>, Vec<f64>) {
 }
 
 /// Where particle position `p` lies in the front's curvilinear coordinates along the
-/// stretch (`idx`, `arc`) of `line`: the nearest point on the stretch's segments (the first
-/// of equals), the frame interpolated there.
-fn place(line: &FrontLine, idx: &[usize], arc: &[f64], p: DVec3) -> Place {
+/// stretch `st` of `line`: the nearest point on the stretch's segments (the first of
+/// equals), the frame interpolated there; None when that point lies `len` or more from the
+/// vertex along the front (outside the tube, known before the frame is built).
+fn place(line: &FrontLine, st: &Stretch, p: DVec3, len: f64) -> Option<Place> {
+    let (idx, arc) = (&st.idx, &st.arc);
     let f = |i: usize| &line.frames[idx[i]];
     let seg = |i: usize| {
-        let (a, b) = (f(i).x, f(i + 1).x);
-        let ab = b - a;
-        let u = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+        let (a, ab, ab2) = st.segs[i];
+        let u = ((p - a).dot(ab) / ab2).clamp(0.0, 1.0);
         ((p - (a + u * ab)).length_squared(), u)
     };
     let (i, u) = if idx.len() < 2 {
@@ -442,6 +468,14 @@ fn place(line: &FrontLine, idx: &[usize], arc: &[f64], p: DVec3) -> Place {
         }
         (best.0, best.1.1)
     };
+    let s = if idx.len() < 2 {
+        0.0
+    } else {
+        arc[i] + u * (arc[i + 1] - arc[i])
+    };
+    if s.abs() >= len {
+        return None;
+    }
     let (fa, fb) = if idx.len() < 2 {
         (f(0), f(0))
     } else {
@@ -452,22 +486,21 @@ fn place(line: &FrontLine, idx: &[usize], arc: &[f64], p: DVec3) -> Place {
     let e2t = lerp(fa.e[1], fb.e[1]);
     let e2 = (e2t - e2t.dot(e1) * e1).normalize();
     let e = [e1, e2, e1.cross(e2)];
-    let (s, de1, along) = if idx.len() < 2 {
-        (0.0, DVec3::ZERO, 1.0)
+    let (de1, along) = if idx.len() < 2 {
+        (DVec3::ZERO, 1.0)
     } else {
         let ds = arc[i + 1] - arc[i];
-        let along = (fb.x - fa.x).dot(e[2]).signum();
-        (arc[i] + u * ds, (fb.e[0] - fa.e[0]) / ds, along)
+        ((fb.e[0] - fa.e[0]) / ds, (fb.x - fa.x).dot(e[2]).signum())
     };
     let d = p - lerp(fa.x, fb.x);
-    Place {
+    Some(Place {
         e,
         de1: to_local(&e, de1),
         along,
         x1: d.dot(e1),
         x2: d.dot(e2),
         s,
-    }
+    })
 }
 
 /// This rank's particles in the tube of `tube.radius` around vertex `k` of `line`, in
@@ -485,7 +518,7 @@ pub fn tube_samples(
     let p = &world.particles;
     let frame: &FrontFrame = &line.frames[k];
     let (rad, len) = (tube.radius, tube.length);
-    let (idx, arc) = stretch(line, k, len);
+    let st = Stretch::new(line, k, len);
     let h = (0..3).map(|a| world.grid.geom.h[a]).fold(0.0, f64::max);
     // Only a particle within a cell of the band the facets span about the crack's plane at
     // the vertex can be on the other face from where the sign of x2 puts it.
@@ -496,9 +529,10 @@ pub fn tube_samples(
         + h;
     let mut out = Vec::new();
     for i in near(world, frame.x, rad.hypot(len)) {
-        let mut at = place(line, &idx, &arc, p.x[i]);
-        let r = at.x1.hypot(at.x2);
-        if r >= rad || at.s.abs() >= len {
+        let Some(mut at) = place(line, &st, p.x[i], len) else {
+            continue;
+        };
+        if at.x1.hypot(at.x2) >= rad {
             continue;
         }
         if at.x1 < 0.0 && at.x2.abs() <= band {
