@@ -150,12 +150,20 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                         .collect();
                     let frame = &line.frames[a.k];
                     let opening = opening(cracks, c, frame, h, plan.opening * h);
-                    let row = tip_row(world, plan, &fi, opening, elastic);
+                    let [k, k_interaction, k_opening] = vertex_k(plan, &fi, opening, elastic);
                     let row = TipResult {
+                        step: world.step,
+                        time: world.time,
                         crack: c as u32,
                         tip,
                         x: frame.x.to_array(),
-                        ..row
+                        j: [fi.j, f64::NAN],
+                        k,
+                        k_interaction,
+                        k_opening,
+                        domain: fi.radius,
+                        length: f64::NAN,
+                        speed: 0.0,
                     };
                     (row, path_rows)
                 })
@@ -196,16 +204,16 @@ impl Asks {
     }
 }
 
-/// A vertex's row from its integrals `fi` and the crack's `opening` behind it: J, the
-/// three K (the plan's choice among the interaction integral, the mixity split of J and
-/// the opening split), none where the tube's surface has yielded.
-fn tip_row(
-    world: &World<D3>,
+/// The K a vertex reports from its integrals `fi` and the crack's `opening` behind it: the
+/// plan's choice (the interaction integral, the mixity split of J or the opening split),
+/// the interaction integral's and the opening split's; all NaN where the tube's surface
+/// has yielded, for K comes from J only while it runs through elastic material.
+fn vertex_k(
     plan: &FracturePlan,
     fi: &FrontIntegrals,
     opening: [f64; 3],
     elastic: impl Fn(u16) -> Elastic3,
-) -> TipResult {
+) -> [[f64; 3]; 3] {
     let (k_opening, k_mixity) = match fi.material.map(elastic) {
         Some(el) => (
             k_split(
@@ -217,36 +225,16 @@ fn tip_row(
         ),
         None => ([f64::NAN; 3], [f64::NAN; 3]),
     };
-    let row = TipResult {
-        step: world.step,
-        time: world.time,
-        crack: 0,
-        tip: 0,
-        x: [f64::NAN; 3],
-        j: [fi.j, f64::NAN],
-        k: match plan.k_method {
-            KMethod::Interaction => fi.k,
-            KMethod::Mixity => k_mixity,
-            KMethod::LowerG => lower_g(fi.k, k_mixity),
-            KMethod::Opening => k_opening,
-        },
-        k_interaction: fi.k,
-        k_opening,
-        domain: fi.radius,
-        length: f64::NAN,
-        speed: 0.0,
-    };
-    // K comes from J only while the tube's surface runs through elastic material.
     if fi.plastic {
-        TipResult {
-            k: [f64::NAN; 3],
-            k_interaction: [f64::NAN; 3],
-            k_opening: [f64::NAN; 3],
-            ..row
-        }
-    } else {
-        row
+        return [[f64::NAN; 3]; 3];
     }
+    let k = match plan.k_method {
+        KMethod::Interaction => fi.k,
+        KMethod::Mixity => k_mixity,
+        KMethod::LowerG => lower_g(fi.k, k_mixity),
+        KMethod::Opening => k_opening,
+    };
+    [k, fi.k, k_opening]
 }
 
 /// How far `x` lies from the nearest triangle of a crack other than `c`, looking no further
