@@ -10,7 +10,7 @@
 use crate::base::dim::D3;
 use crate::base::geometry::Element;
 use crate::base::geometry::point_triangle;
-use crate::fracture::front::{FrontFrame, front_line};
+use crate::fracture::front::{FrontFrame, FrontLine, front_line};
 use crate::fracture::front_integral::{
     Elastic3, Facet, FrontIntegrals, Tube, TubeSamples, front_integrals, tube_samples,
 };
@@ -28,41 +28,7 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
     let Some(cracks) = &world.cracks else {
         return m;
     };
-    let geom = &world.grid.geom;
-    let h = (0..3).map(|a| geom.h[a]).fold(0.0, f64::max);
-    let tube = Tube {
-        radius: plan.domain * h,
-        step: h,
-        min_radius: 2.0 * h,
-        length: plan.domain * h,
-    };
-    let facets = facets(cracks);
-    let elem_crack = cracks.topology.elem_crack();
-    let elastic = |m: u16| {
-        let e = &world.materials[m as usize];
-        Elastic3 {
-            mu: e.mu,
-            nu: e.poisson,
-        }
-    };
-    // Path independence: J on tubes of the main and the compared sizes, none shrunk.
-    let paths: Vec<Tube> = if plan.compare.is_empty() {
-        Vec::new()
-    } else {
-        std::iter::once(plan.contour)
-            .chain(plan.compare.iter().copied())
-            .map(|n| {
-                let r = n as f64 * h;
-                Tube {
-                    radius: r,
-                    step: h,
-                    min_radius: r,
-                    length: r,
-                }
-            })
-            .collect()
-    };
-    let reach = paths.iter().fold(tube.radius, |r, t| r.max(t.radius));
+    let scope = Scope::new(world, cracks, plan);
     let mut ordinal = vec![0u32; cracks.topology.cracks().len()];
     for front in cracks.topology.fronts() {
         let c = front.crack as usize;
@@ -76,43 +42,13 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
             // The batch's tubes, and their samples on this rank: the vertices in parallel.
             let ks: Vec<usize> = (first..n).step_by(batches).collect();
             let asks: Vec<Asks> = (ks.into_par_iter())
-                .map(|k| {
-                    let frame = &line.frames[k];
-                    let within = |r: f64| -> Vec<Facet> {
-                        (facets.iter().zip(elem_crack))
-                            .filter(|&(f, &e)| {
-                                e as usize == c && (f.centroid - frame.x).length() < 2.0 * r + h
-                            })
-                            .map(|(f, _)| *f)
-                            .collect()
-                    };
-                    // A tube reaches sqrt(2) R from the vertex; it stays clear of other cracks.
-                    let room = room(cracks, c, frame.x, SQRT_2 * reach + h) / SQRT_2;
-                    let mut own = tube;
-                    while own.radius > room && own.radius >= own.min_radius {
-                        own.radius -= h;
-                        own.length -= h;
-                    }
-                    Asks {
-                        k,
-                        own,
-                        near: within(tube.radius),
-                        paths: (paths.iter())
-                            .map(|t| (t.radius <= room).then_some(*t))
-                            .collect(),
-                        wide: if paths.is_empty() {
-                            Vec::new()
-                        } else {
-                            within(reach)
-                        },
-                    }
-                })
+                .map(|k| scope.ask(&line, c, k))
                 .collect();
             let local: Vec<TubeSamples> = (asks.par_iter())
                 .flat_map_iter(|a| {
-                    let line = &line;
+                    let (line, scope) = (&line, &scope);
                     (a.tubes()).map(move |(t, near)| {
-                        tube_samples(world, cracks, line, a.k, near, t, elastic)
+                        tube_samples(world, cracks, line, a.k, near, t, |m| scope.elastic(m))
                     })
                 })
                 .collect();
@@ -122,51 +58,7 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                 .map(|a| (a, merged.by_ref().take(a.tubes().count()).collect()))
                 .collect();
             let rows: Vec<(TipResult, Vec<PathResult>)> = (sampled.par_iter())
-                .map(|(a, samples)| {
-                    let tip = ordinal[c] + a.k as u32;
-                    let mut samples = samples.iter();
-                    let fi = front_integrals(samples.next().expect("the own tube"), a.own, elastic);
-                    let path_rows = (a.paths.iter().zip(&paths))
-                        .map(|(fits, t)| {
-                            let p = match fits {
-                                Some(t) => front_integrals(
-                                    samples.next().expect("a compared tube"),
-                                    *t,
-                                    elastic,
-                                ),
-                                None => FrontIntegrals::NONE,
-                            };
-                            PathResult {
-                                step: world.step,
-                                time: world.time,
-                                crack: c as u32,
-                                tip,
-                                contour: (t.radius / h).round() as u32,
-                                line: [p.j - p.j_volume, f64::NAN],
-                                area: [p.j_volume, f64::NAN],
-                                direction: [1.0, 0.0],
-                            }
-                        })
-                        .collect();
-                    let frame = &line.frames[a.k];
-                    let opening = opening(cracks, c, frame, h, plan.opening * h);
-                    let [k, k_interaction, k_opening] = vertex_k(plan, &fi, opening, elastic);
-                    let row = TipResult {
-                        step: world.step,
-                        time: world.time,
-                        crack: c as u32,
-                        tip,
-                        x: frame.x.to_array(),
-                        j: [fi.j, f64::NAN],
-                        k,
-                        k_interaction,
-                        k_opening,
-                        domain: fi.radius,
-                        length: f64::NAN,
-                        speed: 0.0,
-                    };
-                    (row, path_rows)
-                })
+                .map(|(a, samples)| scope.rows(&line, c, ordinal[c] + a.k as u32, a, samples))
                 .collect();
             for (a, row) in asks.iter().zip(rows) {
                 slots[a.k] = Some(row);
@@ -179,6 +71,160 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
         ordinal[c] += n as u32;
     }
     m
+}
+
+/// What the measurement of every front vertex shares: the scene, the tubes' sizes and the
+/// crack triangles.
+struct Scope<'a> {
+    world: &'a World<D3>,
+    cracks: &'a Cracks<D3>,
+    plan: &'a FracturePlan,
+    /// The largest cell side (m).
+    h: f64,
+    /// The main tube as asked.
+    tube: Tube,
+    /// Path independence: the tubes of the main and the compared sizes, none shrunk (empty
+    /// without `compare`).
+    paths: Vec<Tube>,
+    /// The largest radius of them all (m).
+    reach: f64,
+    /// Every crack triangle, in element order.
+    facets: Vec<Facet>,
+}
+
+impl<'a> Scope<'a> {
+    fn new(world: &'a World<D3>, cracks: &'a Cracks<D3>, plan: &'a FracturePlan) -> Self {
+        let geom = &world.grid.geom;
+        let h = (0..3).map(|a| geom.h[a]).fold(0.0, f64::max);
+        let tube = Tube {
+            radius: plan.domain * h,
+            step: h,
+            min_radius: 2.0 * h,
+            length: plan.domain * h,
+        };
+        let paths: Vec<Tube> = if plan.compare.is_empty() {
+            Vec::new()
+        } else {
+            std::iter::once(plan.contour)
+                .chain(plan.compare.iter().copied())
+                .map(|n| {
+                    let r = n as f64 * h;
+                    Tube {
+                        radius: r,
+                        step: h,
+                        min_radius: r,
+                        length: r,
+                    }
+                })
+                .collect()
+        };
+        let reach = paths.iter().fold(tube.radius, |r, t| r.max(t.radius));
+        Scope {
+            world,
+            cracks,
+            plan,
+            h,
+            tube,
+            paths,
+            reach,
+            facets: facets(cracks),
+        }
+    }
+
+    /// The elastic constants of material `m`.
+    fn elastic(&self, m: u16) -> Elastic3 {
+        let e = &self.world.materials[m as usize];
+        Elastic3 {
+            mu: e.mu,
+            nu: e.poisson,
+        }
+    }
+
+    /// What vertex `k` of `line`, on crack `c`, measures.
+    fn ask(&self, line: &FrontLine, c: usize, k: usize) -> Asks {
+        let (frame, h) = (&line.frames[k], self.h);
+        let elem_crack = self.cracks.topology.elem_crack();
+        let within = |r: f64| -> Vec<Facet> {
+            (self.facets.iter().zip(elem_crack))
+                .filter(|&(f, &e)| e as usize == c && (f.centroid - frame.x).length() < 2.0 * r + h)
+                .map(|(f, _)| *f)
+                .collect()
+        };
+        // A tube reaches sqrt(2) R from the vertex; it stays clear of other cracks.
+        let room = room(self.cracks, c, frame.x, SQRT_2 * self.reach + h) / SQRT_2;
+        let mut own = self.tube;
+        while own.radius > room && own.radius >= own.min_radius {
+            own.radius -= h;
+            own.length -= h;
+        }
+        Asks {
+            k,
+            own,
+            near: within(self.tube.radius),
+            paths: (self.paths.iter())
+                .map(|t| (t.radius <= room).then_some(*t))
+                .collect(),
+            wide: if self.paths.is_empty() {
+                Vec::new()
+            } else {
+                within(self.reach)
+            },
+        }
+    }
+
+    /// The rows of vertex `a.k` of `line` on crack `c`, numbered `tip`, from its tubes'
+    /// merged samples (the own first): its fracture.csv row and its paths.csv rows.
+    fn rows(
+        &self,
+        line: &FrontLine,
+        c: usize,
+        tip: u32,
+        a: &Asks,
+        samples: &[TubeSamples],
+    ) -> (TipResult, Vec<PathResult>) {
+        let (world, h) = (self.world, self.h);
+        let elastic = |m| self.elastic(m);
+        let mut samples = samples.iter();
+        let fi = front_integrals(samples.next().expect("the own tube"), a.own, elastic);
+        let path_rows = (a.paths.iter().zip(&self.paths))
+            .map(|(fits, t)| {
+                let p = match fits {
+                    Some(t) => {
+                        front_integrals(samples.next().expect("a compared tube"), *t, elastic)
+                    }
+                    None => FrontIntegrals::NONE,
+                };
+                PathResult {
+                    step: world.step,
+                    time: world.time,
+                    crack: c as u32,
+                    tip,
+                    contour: (t.radius / h).round() as u32,
+                    line: [p.j - p.j_volume, f64::NAN],
+                    area: [p.j_volume, f64::NAN],
+                    direction: [1.0, 0.0],
+                }
+            })
+            .collect();
+        let frame = &line.frames[a.k];
+        let opening = opening(self.cracks, c, frame, h, self.plan.opening * h);
+        let [k, k_interaction, k_opening] = vertex_k(self.plan, &fi, opening, elastic);
+        let row = TipResult {
+            step: world.step,
+            time: world.time,
+            crack: c as u32,
+            tip,
+            x: frame.x.to_array(),
+            j: [fi.j, f64::NAN],
+            k,
+            k_interaction,
+            k_opening,
+            domain: fi.radius,
+            length: f64::NAN,
+            speed: 0.0,
+        };
+        (row, path_rows)
+    }
 }
 
 /// Most front vertices measured together: split across ranks, one gather carries all
