@@ -260,6 +260,9 @@ fn vertex_k(
     opening: [f64; 3],
     elastic: impl Fn(u16) -> Elastic3,
 ) -> [[f64; 3]; 3] {
+    if fi.plastic {
+        return [[f64::NAN; 3]; 3];
+    }
     let (k_opening, k_mixity) = match fi.material.map(elastic) {
         Some(el) => (
             k_split(
@@ -271,9 +274,6 @@ fn vertex_k(
         ),
         None => ([f64::NAN; 3], [f64::NAN; 3]),
     };
-    if fi.plastic {
-        return [[f64::NAN; 3]; 3];
-    }
     let k = match plan.k_method {
         KMethod::Interaction => fi.k,
         KMethod::Mixity => k_mixity,

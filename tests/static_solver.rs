@@ -359,12 +359,7 @@ fn direct_and_iterative_solves_agree() {
 fn centre_crack_solved_static() {
     let opts = fissure::app::run::RunOptions::default();
     let out = fissure::app::run::run(&switched("centre_crack_2d"), &opts).unwrap();
-    let (a, b, pi) = (0.01f64, 0.02f64, std::f64::consts::PI);
-    let r = a / b;
-    let want = 100e6
-        * (pi * a).sqrt()
-        * (1.0 - 0.025 * r * r + 0.06 * r.powi(4))
-        * (1.0 / (pi * a / (2.0 * b)).cos()).sqrt();
+    let want = common::feddersen(100e6, 0.01, 0.02);
     let last = out.history.fracture.iter().map(|t| t.step).max().unwrap();
     let tips: Vec<_> = (out.history.fracture.iter())
         .filter(|t| t.step == last)
@@ -425,12 +420,7 @@ fn compressed(law: Option<&str>) -> (f64, f64, usize) {
 /// as in tension).
 #[test]
 fn a_crack_under_compression_closes() {
-    let (a, b, pi) = (0.01f64, 0.02f64, std::f64::consts::PI);
-    let r = a / b;
-    let tada = 100e6
-        * (pi * a).sqrt()
-        * (1.0 - 0.025 * r * r + 0.06 * r.powi(4))
-        * (1.0 / (pi * a / (2.0 * b)).cos()).sqrt();
+    let tada = common::feddersen(100e6, 0.01, 0.02);
     let (whole, _, _) = compressed(None);
     let (closed, k_closed, faces) = compressed(Some("frictionless"));
     let (open, k_open, none) = compressed(Some("none"));

@@ -456,3 +456,13 @@ pub fn plastic(text: &str, sigma_y: f64, hardening: &str) -> String {
         &text[end..]
     )
 }
+
+/// K_I of a centre crack of half-length `a` in a plate of half-width `b` under remote
+/// tension `s`: Tada's form of Feddersen's formula (scenarios/reference/README.md), good to
+/// 0.1 %.
+pub fn feddersen(s: f64, a: f64, b: f64) -> f64 {
+    let (r, pi) = (a / b, std::f64::consts::PI);
+    s * (pi * a).sqrt()
+        * (1.0 - 0.025 * r * r + 0.06 * r.powi(4))
+        * (1.0 / (pi * a / (2.0 * b)).cos()).sqrt()
+}
