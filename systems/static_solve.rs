@@ -21,6 +21,7 @@ use crate::systems::{bin, classify, crack_advect, p2g};
 use crate::with_shape;
 
 mod cg;
+mod dilatation;
 mod direct;
 mod faces;
 mod frame;
@@ -98,7 +99,7 @@ pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Option<Analysis>) -> Result<
     let work = load_work(world, &before, &after, t_start, t_end)
         + supports::work(world, &start_forces, t_start, t_end);
     world.work.external += work;
-    set_particles(world, &u, &after);
+    set_particles(world, &dofs, &u, &after);
     Ok(solved)
 }
 
@@ -448,15 +449,17 @@ fn gather<D: Dim>(world: &World<D>, u: &[D::Vec]) -> Vec<D::Vec> {
 }
 
 /// Each particle at the solution: x = x0 + its displacement `disp` (interpolated from the
-/// entries' `u`), at rest, with grad u (when kept) and the stress C : sym(grad u).
-fn set_particles<D: Dim>(world: &mut World<D>, u: &[D::Vec], disp: &[D::Vec]) {
+/// entries' `u`), at rest, with grad u (when kept) and the stress C : sym(grad u) (its
+/// dilatation its group's mean, with `dofs`' groups).
+fn set_particles<D: Dim>(world: &mut World<D>, dofs: &Unknowns<D>, u: &[D::Vec], disp: &[D::Vec]) {
     let plane = world.settings.plane;
     let keep = !world.particles.grad_u.is_empty();
+    let grouped = dofs.groups.as_ref().map(|g| g.gradients(world, u));
     for (i, &d) in disp.iter().enumerate() {
         let l = gradient(world, i, u);
         let p = &mut world.particles;
         let m = &world.materials[p.material[i] as usize];
-        p.stress[i] = elastic::<D>(m, plane, &l);
+        p.stress[i] = elastic::<D>(m, plane, grouped.as_ref().map_or(&l, |g| &g[i]));
         if keep {
             p.grad_u[i] = l;
         }

@@ -38,6 +38,19 @@ pub enum Solver {
     Static,
 }
 
+/// Which volumetric strain a particle's stress sees (`[simulation] dilatation`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Dilatation {
+    /// Its own.
+    #[default]
+    Particle,
+    /// The volume-weighted mean over the particles of its cell, material and crack side
+    /// (`systems::static_solve::dilatation`): relieves the volumetric locking of
+    /// isochoric plastic flow in plane strain and 3D.
+    CellMean,
+}
+
 /// How a static scene's linear systems are solved (`[simulation] linear`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -72,6 +85,8 @@ pub struct Settings<D: Dim> {
     pub linear: LinearSolver,
     /// Shape function.
     pub shape: ShapeKind,
+    /// Each particle's own volumetric strain, or its cell's mean.
+    pub dilatation: Dilatation,
     /// Stress-update order.
     pub update: Update,
     /// Out-of-plane treatment (None in 3D).

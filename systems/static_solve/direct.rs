@@ -5,6 +5,7 @@
 //! serve every factorization on it: each Newton iteration, and the next load steps while
 //! the pattern holds.
 
+use super::dilatation::{Groups, isotropic, trace};
 use super::frame::Frame;
 use super::operator::{Law, apply};
 use super::unknowns::Unknowns;
@@ -12,6 +13,7 @@ use super::vectors::dot;
 use super::{each_entry, fields, rigid};
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
+use crate::base::sym::SymTensor;
 use crate::record::solve_log::Solved;
 use crate::store::disjoint::Disjoint;
 use crate::store::world::World;
@@ -64,7 +66,7 @@ impl<D: Dim> Direct<D> {
         kept: &mut Option<Analysis>,
     ) -> Result<Self, String> {
         let layout = Layout::new(dofs, modes);
-        let pattern = pattern(world, &layout);
+        let pattern = pattern(world, &layout, dofs.groups.as_ref());
         let same = |a: &&mut Analysis| {
             a.pattern.col_ptr() == pattern.col_ptr() && a.pattern.row_idx() == pattern.row_idx()
         };
@@ -124,7 +126,7 @@ impl<D: Dim> Direct<D> {
         if norm_f == 0.0 {
             return Ok((vec![D::zero(); n], Solved::default()));
         }
-        let values = self.assemble(world, law, &frame.ghost);
+        let values = self.assemble(world, law, &frame.ghost, dofs.groups.as_ref());
         let Analysis { pattern, symbolic } = &self.analysis;
         let matrix = SparseColMatRef::new(pattern.as_ref(), &values);
         let mut factor = vec![0.0; symbolic.len_val()];
@@ -186,27 +188,59 @@ impl<D: Dim> Direct<D> {
         ))
     }
 
-    /// K's lower triangle on the pattern: each particle's V B^T C B under `law`, free
-    /// particles tile by tile in colour classes, then the particles near a crack in order
-    /// (the same sums in the same order for any thread count), and the ghost stiffness.
-    fn assemble(&self, world: &World<D>, law: Law<D>, ghost: &[D::Vec]) -> Vec<f64> {
+    /// K's lower triangle on the pattern: each particle's V B^T C B under `law` (B-bar
+    /// with mean-dilatation `groups`, group by group), free particles tile by tile in
+    /// colour classes, then the particles near a crack in order (the same sums in the same
+    /// order for any thread count), and the ghost stiffness.
+    fn assemble(
+        &self,
+        world: &World<D>,
+        law: Law<D>,
+        ghost: &[D::Vec],
+        groups: Option<&Groups>,
+    ) -> Vec<f64> {
         let mut values = vec![0.0; self.analysis.pattern.compute_nnz()];
         let tiles = &world.tiles;
         let fields = fields(world);
         let writer = Disjoint::new(&mut values);
-        tiles.for_each_coloured(|t| {
-            for &i in tiles.particles(t) {
-                if crate::systems::is_free(fields, i as usize) {
-                    // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), each
-                    // tile is handled by one thread, and a particle writes only the columns
-                    // of its own nodes' unknowns.
+        let coded = fields.map_or(&[][..], |f| &f.coded[..]);
+        match groups {
+            None => {
+                tiles.for_each_coloured(|t| {
+                    for &i in tiles.particles(t) {
+                        if crate::systems::is_free(fields, i as usize) {
+                            // SAFETY: tiles of one colour class touch disjoint nodes
+                            // (tiles.rs), each tile is handled by one thread, and a particle
+                            // writes only the columns of its own nodes' unknowns.
+                            unsafe { self.add_particle(world, law, i as usize, &writer) };
+                        }
+                    }
+                });
+                for &i in coded {
+                    // SAFETY: the coloured pass is over; this loop is the only writer.
                     unsafe { self.add_particle(world, law, i as usize, &writer) };
                 }
             }
-        });
-        for &i in fields.map_or(&[][..], |f| &f.coded[..]) {
-            // SAFETY: the coloured pass is over; this loop is the only writer.
-            unsafe { self.add_particle(world, law, i as usize, &writer) };
+            Some(groups) => {
+                // The groups with a member near a crack, in group order, after the others.
+                let mut near: Vec<usize> = coded.iter().map(|&i| groups.of(i as usize)).collect();
+                near.sort_unstable();
+                near.dedup();
+                tiles.for_each_coloured(|t| {
+                    for &i in tiles.particles(t) {
+                        let g = groups.of(i as usize);
+                        if groups.leads(i as usize) && near.binary_search(&g).is_err() {
+                            // SAFETY: as above; a group's members share a cell, so its
+                            // entries are its tile's.
+                            unsafe { self.add_group(world, law, groups, g, &writer) };
+                        }
+                    }
+                });
+                for g in near {
+                    // SAFETY: the coloured pass is over; this loop is the only writer.
+                    unsafe { self.add_group(world, law, groups, g, &writer) };
+                }
+            }
         }
         for (e, own) in self.layout.own.iter().enumerate() {
             for &(i, bi) in own {
@@ -220,9 +254,7 @@ impl<D: Dim> Direct<D> {
         values
     }
 
-    /// Adds particle `i`'s stiffness under `law`: for each stencil entry k and axis b, the
-    /// stress of the unit gradient e_b (x) grad S_k, and its force V sigma . grad S_l on
-    /// each entry l, carried to the unknowns each entry's displacement is made of.
+    /// Adds particle `i`'s stiffness under `law`, on its own stencil.
     ///
     /// # Safety
     /// No other thread may write the columns of the particle's entries' unknowns.
@@ -233,26 +265,99 @@ impl<D: Dim> Direct<D> {
             support[count] = (n, g);
             count += 1;
         });
-        let support = &support[..count];
+        // SAFETY: passed on from the caller.
+        unsafe { self.add_support(world, law, i, &support[..count], None, values) };
+    }
+
+    /// Adds the stiffness of mean-dilatation group `g` ([`Groups`]): each member's V
+    /// B-bar^T C B-bar on the entries any member reaches, B-bar built from its own
+    /// gradients and the group's volume-weighted mean gradients.
+    ///
+    /// # Safety
+    /// No other thread may write the columns of the group's entries' unknowns.
+    unsafe fn add_group(
+        &self,
+        world: &World<D>,
+        law: Law<D>,
+        groups: &Groups,
+        g: usize,
+        values: &Disjoint<f64>,
+    ) {
+        let members = groups.members(g);
+        let mut union: Vec<usize> = Vec::with_capacity(4 * MOST_NODES);
+        for &i in members {
+            each_entry(world, i as usize, |n, _, _| union.push(n));
+        }
+        union.sort_unstable();
+        union.dedup();
+        let width = union.len();
+        let volume = &world.particles.volume;
+        let mut grads = vec![D::zero(); width * members.len()];
+        let mut mean = vec![D::zero(); width];
+        for (k, &i) in members.iter().enumerate() {
+            each_entry(world, i as usize, |n, _, grad| {
+                let at = union.partition_point(|&m| m < n);
+                grads[k * width + at] = grad;
+                mean[at] += grad * volume[i as usize];
+            });
+        }
+        let v_g = groups.volume(g);
+        mean.iter_mut().for_each(|m| *m *= 1.0 / v_g);
+        for (k, &i) in members.iter().enumerate() {
+            let own = &grads[k * width..(k + 1) * width];
+            let support: Vec<(usize, D::Vec)> =
+                union.iter().copied().zip(own.iter().copied()).collect();
+            // SAFETY: passed on from the caller.
+            unsafe { self.add_support(world, law, i as usize, &support, Some(&mean), values) };
+        }
+    }
+
+    /// Adds particle `i`'s stiffness under `law` on the entries of `support` (entry, grad
+    /// S): for each entry k and axis b, the stress of the unit strain of e_b (x) grad S_k,
+    /// and its force V sigma . grad S_l on each entry l, carried to the unknowns each
+    /// entry's displacement is made of. With the group's `mean` gradients the strain's
+    /// in-plane trace is the group's and the force carries the mean pressure (B-bar).
+    ///
+    /// # Safety
+    /// No other thread may write the columns of the support's entries' unknowns.
+    unsafe fn add_support(
+        &self,
+        world: &World<D>,
+        law: Law<D>,
+        i: usize,
+        support: &[(usize, D::Vec)],
+        mean: Option<&[D::Vec]>,
+        values: &Disjoint<f64>,
+    ) {
         let p = &world.particles;
         let m = &world.materials[p.material[i] as usize];
         let (plane, volume) = (world.settings.plane, p.volume[i]);
+        let per_axis = 1.0 / D::D as f64;
         // stress[k * D + b]: the stress of the unit gradient e_b (x) grad S_k.
-        let mut stress = [D::Sym::default(); 3 * MOST_NODES];
+        let mut stress = vec![D::Sym::default(); D::D * support.len()];
         for (k, &(_, g)) in support.iter().enumerate() {
             for b in 0..D::D {
                 let mut e = D::zero();
                 e[b] = 1.0;
-                stress[k * D::D + b] = law.stress(m, plane, i, &D::outer(e, g));
+                let mut l = D::outer(e, g);
+                if let Some(mean) = mean {
+                    l = l + isotropic::<D>((mean[k][b] - g[b]) * per_axis);
+                }
+                stress[k * D::D + b] = law.stress(m, plane, i, &l);
             }
         }
         let comb = &self.layout.comb;
         let mut block = [D::zero(); 3];
-        for &(l, gl) in support {
+        for (lk, &(l, gl)) in support.iter().enumerate() {
             for (k, &(kn, _)) in support.iter().enumerate() {
                 // block[b][a]: the force on entry l, axis a, per unit motion of k along b.
                 for (b, f) in block.iter_mut().enumerate().take(D::D) {
-                    *f = D::stress_dot(&stress[k * D::D + b], gl) * volume;
+                    let s = &stress[k * D::D + b];
+                    *f = D::stress_dot(s, gl);
+                    if let Some(mean) = mean {
+                        *f += (mean[lk] - gl) * (trace::<D>(&s.to_sym3()) * per_axis);
+                    }
+                    *f *= volume;
                 }
                 for &(r, cr) in &comb[l] {
                     for &(c, cc) in comb[kn].iter().filter(|(c, _)| *c <= r) {
@@ -438,18 +543,40 @@ fn pins<D: Dim>(dirs: &[Vec<D::Vec>], modes: &[Vec<D::Vec>]) -> Vec<usize> {
 }
 
 /// K's pattern (lower triangle, rows sorted in each column): unknowns i and j are coupled
-/// when one particle reaches an entry made of i and an entry made of j. Particles of one
-/// cell share their stencil's entries, so the distinct stencils are collected first.
-fn pattern<D: Dim>(world: &World<D>, layout: &Layout<D>) -> SymbolicSparseColMat<usize> {
+/// when one particle (with mean-dilatation `groups`, one group) reaches an entry made of
+/// i and an entry made of j. Particles of one cell share their stencil's entries, so the
+/// distinct stencils are collected first.
+fn pattern<D: Dim>(
+    world: &World<D>,
+    layout: &Layout<D>,
+    groups: Option<&Groups>,
+) -> SymbolicSparseColMat<usize> {
     let entries = layout.comb.len();
     let mut stencils: HashSet<Vec<u32>> = HashSet::new();
     let mut support = Vec::with_capacity(27);
-    for i in 0..world.particles.len() {
-        support.clear();
-        each_entry(world, i, |n, _, _| support.push(n as u32));
+    let mut add = |support: &mut Vec<u32>| {
         support.sort_unstable();
-        if !stencils.contains(&support) {
+        support.dedup();
+        if !stencils.contains(support) {
             stencils.insert(support.clone());
+        }
+    };
+    match groups {
+        None => {
+            for i in 0..world.particles.len() {
+                support.clear();
+                each_entry(world, i, |n, _, _| support.push(n as u32));
+                add(&mut support);
+            }
+        }
+        Some(groups) => {
+            for g in 0..groups.len() {
+                support.clear();
+                for &i in groups.members(g) {
+                    each_entry(world, i as usize, |n, _, _| support.push(n as u32));
+                }
+                add(&mut support);
+            }
         }
     }
     let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); entries];

@@ -209,7 +209,7 @@ fn residual<D: Dim>(
     load: &Load<D>,
     du: &[D::Vec],
 ) -> Residual<D> {
-    let returned = return_map(world, du);
+    let returned = return_map(world, dofs, du);
     let mut f_int = vec![D::zero(); du.len()];
     stiffness(world, Law::Given(&returned.stress), du, dofs, &mut f_int);
     let scale = load.norm2.max(dot::<D>(&f_int, &f_int)).sqrt();
@@ -244,15 +244,19 @@ fn continuum<D: Dim>(world: &World<D>) -> Vec<Option<Tangent>> {
 }
 
 /// Every particle's state at the increment `du`: the committed stress plus the elastic
-/// increment of sym(grad du), returned to the yield surface of the committed hardening.
-fn return_map<D: Dim>(world: &World<D>, du: &[D::Vec]) -> Returned<D> {
+/// increment of sym(grad du) (its dilatation its group's mean, with `dofs`' groups),
+/// returned to the yield surface of the committed hardening.
+fn return_map<D: Dim>(world: &World<D>, dofs: &Unknowns<D>, du: &[D::Vec]) -> Returned<D> {
     let p = &world.particles;
     let plane = world.settings.plane;
+    let grouped = dofs.groups.as_ref().map(|g| g.gradients(world, du));
     let states: Vec<_> = (0..p.len())
         .into_par_iter()
         .map(|i| {
             let m = &world.materials[p.material[i] as usize];
-            let l = gradient(world, i, du);
+            let l = grouped
+                .as_ref()
+                .map_or_else(|| gradient(world, i, du), |g| g[i]);
             let mut s = p.stress[i].to_sym3();
             let mut plastic = p.plastic_strain[i].to_sym3();
             let mut h = p.hardened[i];

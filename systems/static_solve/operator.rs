@@ -61,7 +61,9 @@ pub(super) fn elastic<D: Dim>(m: &Material, plane: Plane, l: &D::Mat) -> D::Sym 
 /// y = K x, particle by particle: grad x gathered at each particle (tied entries taking
 /// the value of the entry they move with), the stress it gives under `law`, and that stress's nodal
 /// force, tile by tile in colour classes (the same scatter, in the same order, for any
-/// thread count), tied entries' forces folded into their partners'.
+/// thread count), tied entries' forces folded into their partners'. With mean-dilatation
+/// groups the stresses come first, from the group-mean strains, and scatter with their
+/// groups' mean pressure ([`Groups`](super::dilatation::Groups)).
 pub(super) fn stiffness<D: Dim>(
     world: &World<D>,
     law: Law<D>,
@@ -77,6 +79,26 @@ pub(super) fn stiffness<D: Dim>(
         dofs.expand(&mut e);
         expanded = e;
         &expanded[..]
+    };
+    let grouped;
+    let law = match &dofs.groups {
+        Some(groups) => {
+            let p = &world.particles;
+            let stresses: Vec<D::Sym> = match law {
+                Law::Given(s) => s.to_vec(),
+                _ => {
+                    let plane = world.settings.plane;
+                    (groups.gradients(world, x).par_iter().enumerate())
+                        .map(|(i, l)| {
+                            law.stress(&world.materials[p.material[i] as usize], plane, i, l)
+                        })
+                        .collect()
+                }
+            };
+            grouped = groups.effective(world, &stresses);
+            Law::Given(&grouped)
+        }
+        None => law,
     };
     y.par_chunks_mut(CHUNK).for_each(|c| c.fill(D::zero()));
     let (shape, plane) = (world.settings.shape, world.settings.plane);

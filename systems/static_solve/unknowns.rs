@@ -3,10 +3,11 @@
 //! of mass, tied to their node's heaviest entry, and the closed frictionless crack faces,
 //! tied along the crack's normal.
 
+use super::dilatation::Groups;
 use super::faces::Pair;
 use super::{entries, fields};
 use crate::base::dim::Dim;
-use crate::store::world::World;
+use crate::store::world::{Dilatation, World};
 
 /// Which entry components are unknowns, and which entries move with another.
 pub(super) struct Unknowns<D: Dim> {
@@ -17,6 +18,8 @@ pub(super) struct Unknowns<D: Dim> {
     /// (tied entry, its partner, the unit normal along which they move together): closed
     /// frictionless pairs. The tied entry's normal component is not an unknown.
     pub normal_ties: Vec<(usize, usize, D::Vec)>,
+    /// The particles' mean-dilatation groups (`dilatation = "cell_mean"`), else None.
+    pub groups: Option<Groups>,
 }
 
 impl<D: Dim> Unknowns<D> {
@@ -44,10 +47,13 @@ impl<D: Dim> Unknowns<D> {
         for &(s, _) in &ties {
             free[s] = D::zero();
         }
+        let groups =
+            (world.settings.dilatation == Dilatation::CellMean).then(|| Groups::new(world));
         Unknowns {
             free,
             ties,
             normal_ties,
+            groups,
         }
     }
 

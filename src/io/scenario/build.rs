@@ -77,6 +77,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             tolerance: s.tolerance.unwrap_or(STATIC_TOLERANCE),
             linear: s.linear.unwrap_or_default(),
             shape: s.shape,
+            dilatation: s.dilatation,
             update: s.update,
             plane: sim.plane,
             damping: s.damping,

@@ -2,7 +2,7 @@
 
 use crate::physics::shape::ShapeKind;
 use crate::physics::timefn::TimeFn;
-use crate::store::world::{LinearSolver, Solver, Update};
+use crate::store::world::{Dilatation, LinearSolver, Solver, Update};
 use serde::Deserialize;
 
 /// A whole scenario file.
@@ -88,6 +88,10 @@ pub struct Simulation {
     pub tolerance: Option<f64>,
     /// A static scene's linear solver: "auto" (default), "direct" or "cg".
     pub linear: Option<LinearSolver>,
+    /// The volumetric strain a particle's stress sees: "particle" (its own, default) or
+    /// "cell_mean" (its cell's mean: static scenes in plane strain and 3D).
+    #[serde(default)]
+    pub dilatation: Dilatation,
 }
 
 /// `[grid]`.

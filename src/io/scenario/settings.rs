@@ -7,7 +7,7 @@ use crate::base::dim::Dim;
 use crate::physics::material::{Material, Plane};
 use crate::store::grid::GridGeom;
 use crate::store::tiles::MIN_TILE;
-use crate::store::world::Solver;
+use crate::store::world::{Dilatation, Solver};
 
 /// Most time steps a run may take (a duration or `--until` needing more is refused).
 pub const MAX_STEPS: f64 = 1e10;
@@ -51,6 +51,22 @@ pub(super) fn simulation<D: Dim>(src: &Source) -> R<Simulation> {
         (_, Some(_)) => return Err(src.error("simulation.plane", "applies to 2D scenes only")),
         _ => Plane::None,
     };
+    if sim.dilatation == Dilatation::CellMean {
+        if plane == Plane::Stress {
+            return Err(src.error(
+                "simulation.dilatation",
+                "\"cell_mean\" relieves a volume constraint that plane stress does not have \
+                 (sigma_zz = 0 lets the thickness change): use it in plane strain or 3D",
+            ));
+        }
+        if sim.solver != Solver::Static {
+            return Err(src.error(
+                "simulation.dilatation",
+                "\"cell_mean\" is implemented in the static solver only so far: add \
+                 solver = \"static\" to [simulation]",
+            ));
+        }
+    }
     let thickness = match (D::D, sim.thickness) {
         (2, Some(t)) => positive(src, "simulation.thickness", t, "m")?,
         (2, None) => 1.0,
