@@ -858,23 +858,51 @@ fn a_plane_stress_plastic_bar_solves_static() {
     );
 }
 
-/// A quarter of a thick cylinder (bore a = 0.1 m, outside b = 0.2 m) in plane strain under
-/// a bore pressure of 100 MPa, 5 mm cells, `nu` and the dilatation given, solved static in
-/// one step; probes the x displacement at r = 0.15 m on the x axis and on the diagonal.
-fn pressed_ring(nu: f64, dilatation: &str) -> (f64, f64) {
+/// A thick shell (bore a = 0.1 m, outside b = 0.2 m) under a bore pressure of 100 MPa: in
+/// 2D a quarter of a cylinder in plane strain on 5 mm cells, in 3D an eighth of a sphere
+/// on 10 mm cells (29,318 particles, the direct solver); `nu` and the dilatation given,
+/// solved static in one step. Probes the x displacement at r = 0.15 m next to the x axis
+/// and on the diagonal.
+fn pressed_shell(dim: usize, nu: f64, dilatation: &str) -> (f64, f64) {
+    let (extra, cell, body, reach, axis, diagonal) = if dim == 2 {
+        (
+            "plane = \"strain\"",
+            0.005,
+            "disc = { center = [0.0, 0.0], radius = 0.2, inner_radius = 0.1 }\n\
+             clip = { polygon = [[0.0, 0.0], [0.21, 0.0], [0.21, 0.21], [0.0, 0.21]] }",
+            0.1025,
+            "center = [0.15, 0.0025], radius = 0.003",
+            "center = [0.10607, 0.10607], radius = 0.004",
+        )
+    } else {
+        (
+            "linear = \"direct\"",
+            0.01,
+            "sphere = { center = [0.0, 0.0, 0.0], radius = 0.2, inner_radius = 0.1 }\n\
+             clip = { min = [0.0, 0.0, 0.0], max = [0.21, 0.21, 0.21] }",
+            0.105,
+            "center = [0.15, 0.0025, 0.0025], radius = 0.006",
+            "center = [0.0866, 0.0866, 0.0866], radius = 0.006",
+        )
+    };
+    let planes: String = ["x", "y", "z"][..dim]
+        .iter()
+        .map(|a| format!("[[boundary]]\nplane = {{ axis = \"{a}\", at = 0.0 }}\n"))
+        .collect();
+    let o = common::v(dim, 0.0, 0.0);
     let text = format!(
         r#"
 [simulation]
-dimension = 2
-plane = "strain"
+dimension = {dim}
+{extra}
 solver = "static"
 duration = 1.0
 load_steps = 1
 dilatation = "{dilatation}"
 [grid]
-min = [-0.01, -0.01]
-max = [0.21, 0.21]
-cell = [0.005, 0.005]
+min = {}
+max = {}
+cell = {}
 [[material]]
 name = "m"
 E = 200e9
@@ -882,27 +910,26 @@ nu = {nu}
 rho = 7800.0
 [[body]]
 material = "m"
-disc = {{ center = [0.0, 0.0], radius = 0.2, inner_radius = 0.1 }}
-clip = {{ polygon = [[0.0, 0.0], [0.21, 0.0], [0.21, 0.21], [0.0, 0.21]] }}
-[[boundary]]
-plane = {{ axis = "x", at = 0.0 }}
-[[boundary]]
-plane = {{ axis = "y", at = 0.0 }}
+{body}
+{planes}
 [[load]]
-region = {{ center = [0.0, 0.0], radius = 0.1025 }}
-pressure = {{ value = 100e6, center = [0.0, 0.0], face = "inner" }}
+region = {{ center = {o}, radius = {reach} }}
+pressure = {{ value = 100e6, center = {o}, face = "inner" }}
 time = {{ kind = "table", points = [[0.0, 0.0], [1.0, 1.0]] }}
 [[probe]]
 name = "axis"
-region = {{ center = [0.15, 0.0025], radius = 0.003 }}
+region = {{ {axis} }}
 quantity = "displacement"
 component = "x"
 [[probe]]
 name = "diagonal"
-region = {{ center = [0.10607, 0.10607], radius = 0.004 }}
+region = {{ {diagonal} }}
 quantity = "displacement"
 component = "x"
-"#
+"#,
+        common::v(dim, -0.01, -0.01),
+        common::v(dim, 0.21, 0.21),
+        common::v(dim, cell, cell),
     );
     let h = history(&text);
     (*h.probes[0].last().unwrap(), *h.probes[1].last().unwrap())
@@ -926,7 +953,7 @@ fn cell_mean_dilatation_unlocks_a_nearly_incompressible_cylinder() {
     let (axis_r, diagonal_r) = (0.15f64.hypot(0.0025), 0.15);
     let cos45 = 0.5f64.sqrt();
     for nu in [0.3, 0.4999] {
-        let (axis, diagonal) = pressed_ring(nu, "cell_mean");
+        let (axis, diagonal) = pressed_shell(2, nu, "cell_mean");
         let want_axis = lame(nu, axis_r) * 0.15 / axis_r;
         let want_diagonal = lame(nu, diagonal_r) * cos45;
         assert!(
@@ -938,7 +965,7 @@ fn cell_mean_dilatation_unlocks_a_nearly_incompressible_cylinder() {
             "nu {nu}: {diagonal} vs {want_diagonal}"
         );
     }
-    let (_, locked) = pressed_ring(0.4999, "particle");
+    let (_, locked) = pressed_shell(2, 0.4999, "particle");
     let want = lame(0.4999, diagonal_r) * cos45;
     assert!(
         locked < 0.8 * want,
@@ -981,59 +1008,6 @@ fn cell_mean_dilatation_assembles_the_operator_it_applies() {
     assert!(most_direct <= 6 && most_cg <= 7, "{most_direct}, {most_cg}");
 }
 
-/// An eighth of a thick sphere (bore a = 0.1 m, outside b = 0.2 m) under a bore pressure
-/// of 100 MPa, 10 mm cells (10 across the wall, 29,318 particles), `nu` and the dilatation
-/// given, solved static in one step by the direct solver; probes the x displacement at r
-/// = 0.15 m on the diagonal and next to the x axis.
-fn pressed_sphere(nu: f64, dilatation: &str) -> (f64, f64) {
-    let text = format!(
-        r#"
-[simulation]
-dimension = 3
-solver = "static"
-duration = 1.0
-load_steps = 1
-linear = "direct"
-dilatation = "{dilatation}"
-[grid]
-min = [-0.01, -0.01, -0.01]
-max = [0.21, 0.21, 0.21]
-cell = [0.01, 0.01, 0.01]
-[[material]]
-name = "m"
-E = 200e9
-nu = {nu}
-rho = 7800.0
-[[body]]
-material = "m"
-sphere = {{ center = [0.0, 0.0, 0.0], radius = 0.2, inner_radius = 0.1 }}
-clip = {{ min = [0.0, 0.0, 0.0], max = [0.21, 0.21, 0.21] }}
-[[boundary]]
-plane = {{ axis = "x", at = 0.0 }}
-[[boundary]]
-plane = {{ axis = "y", at = 0.0 }}
-[[boundary]]
-plane = {{ axis = "z", at = 0.0 }}
-[[load]]
-region = {{ center = [0.0, 0.0, 0.0], radius = 0.105 }}
-pressure = {{ value = 100e6, center = [0.0, 0.0, 0.0], face = "inner" }}
-time = {{ kind = "table", points = [[0.0, 0.0], [1.0, 1.0]] }}
-[[probe]]
-name = "diagonal"
-region = {{ center = [0.0866, 0.0866, 0.0866], radius = 0.006 }}
-quantity = "displacement"
-component = "x"
-[[probe]]
-name = "axis"
-region = {{ center = [0.15, 0.0025, 0.0025], radius = 0.006 }}
-quantity = "displacement"
-component = "x"
-"#
-    );
-    let h = history(&text);
-    (*h.probes[0].last().unwrap(), *h.probes[1].last().unwrap())
-}
-
 /// Lame's thick sphere in 3D, u(r) = p a^3 / (E (b^3 - a^3)) ((1 - 2 nu) r + (1 + nu) b^3
 /// / (2 r^2)), nearly incompressible (nu = 0.499): with each particle's own dilatation
 /// the 2 x 2 x 2 particles of a cell lock it, and the diagonal reads 43 % low (the axis 13 %
@@ -1048,7 +1022,7 @@ fn cell_mean_dilatation_unlocks_a_nearly_incompressible_sphere() {
             * ((1.0 - 2.0 * nu) * r + (1.0 + nu) * b.powi(3) / (2.0 * r * r))
     };
     for nu in [0.3, 0.499] {
-        let (diagonal, axis) = pressed_sphere(nu, "cell_mean");
+        let (axis, diagonal) = pressed_shell(3, nu, "cell_mean");
         let want_diagonal = lame(nu, 0.15) / 3f64.sqrt();
         let want_axis = lame(nu, 0.15);
         assert!(
@@ -1060,7 +1034,7 @@ fn cell_mean_dilatation_unlocks_a_nearly_incompressible_sphere() {
             "nu {nu}: {axis} vs {want_axis}"
         );
     }
-    let (locked, _) = pressed_sphere(0.499, "particle");
+    let (_, locked) = pressed_shell(3, 0.499, "particle");
     let want = lame(0.499, 0.15) / 3f64.sqrt();
     assert!(
         locked < 0.8 * want,
