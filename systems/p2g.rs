@@ -119,10 +119,20 @@ fn scatter_loads<D: Dim>(world: &mut World<D>) {
         return;
     }
     // Stable: each particle's shares stay in stencil order.
-    let shares = (world.domain).in_order(load_shares(world), |s| (s.load, s.entry));
+    let shares = (world.domain).in_order(load_shares(world, world.time), |s| (s.load, s.entry));
     for s in &shares {
         world.grid.force[s.node as usize] += s.force;
     }
+}
+
+/// The particle loads' forces on the grid entries at time `t`, added as [`scatter_loads`]
+/// adds them (the static solve's supports need them at a step's start).
+pub(crate) fn load_forces<D: Dim>(world: &World<D>, t: f64) -> Vec<D::Vec> {
+    let mut f = vec![D::zero(); world.grid.mass.len()];
+    for s in (world.domain).in_order(load_shares(world, t), |s| (s.load, s.entry)) {
+        f[s.node as usize] += s.force;
+    }
+    f
 }
 
 /// One loaded particle's force on one grid entry: load `load`'s entry `entry`.
@@ -142,8 +152,7 @@ unsafe impl<D: Dim> bytemuck::Zeroable for LoadShare<D> {}
 unsafe impl<D: Dim> bytemuck::Pod for LoadShare<D> {}
 
 /// The loads' shares on this rank's particles, in load, entry and stencil order.
-fn load_shares<D: Dim>(world: &World<D>) -> Vec<LoadShare<D>> {
-    let t = world.time;
+fn load_shares<D: Dim>(world: &World<D>, t: f64) -> Vec<LoadShare<D>> {
     let geom = &world.grid.geom;
     let shape = world.settings.shape;
     let mut out = Vec::new();

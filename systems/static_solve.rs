@@ -13,7 +13,9 @@
 
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
+use crate::base::exact_sum::ExactSum;
 use crate::physics::shape::{ShapeKind, Stencil};
+use crate::ranks::ABSENT;
 use crate::record::solve_log::Solved;
 use crate::store::crack::Fields;
 use crate::store::world::World;
@@ -28,6 +30,7 @@ mod frame;
 mod newton;
 mod operator;
 mod rigid;
+mod scatter;
 mod solver;
 mod supports;
 mod unknowns;
@@ -35,9 +38,10 @@ mod vectors;
 
 pub use direct::Analysis;
 use operator::{Law, elastic, mask, stiffness};
+use scatter::entry_sums;
 use solver::Solver;
-use unknowns::Unknowns;
-use vectors::dot;
+use unknowns::{Unknowns, ones};
+use vectors::Sums;
 
 /// Most of the load (as a fraction of its norm) a body free to move may leave unbalanced:
 /// the discrete imbalance of balanced tractions is far below it; a load that would
@@ -92,7 +96,10 @@ pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Option<Analysis>) -> Result<
         let ends = (t_start, t_end);
         return plastic_step(world, kept, held, &start_forces, &before, ends);
     }
-    let Solution { u, dofs, solved } = with_contact(world, kept, held.as_deref(), t_end)?;
+    // Conjugate gradients start from the last load step's answer, carried by the
+    // particles: a step whose load and cracks changed little needs fewer iterations.
+    let guess = (world.step > 0).then(|| entry_displacements(world, &before));
+    let Solution { u, dofs, solved } = with_contact(world, kept, held.as_deref(), guess, t_end)?;
     reactions(world, &dofs, Law::Elastic, &u);
     let after = gather(world, &u);
     move_cracks(world, &before, &after);
@@ -120,9 +127,10 @@ fn plastic_step<D: Dim>(
         end
     });
     let pairs = faces::pairs(world);
+    let any_pairs = world.domain.any(!pairs.is_empty());
     let mut closed = vec![false; pairs.len()];
     // The entries' displacement at the step's start, which the faces' overlap adds to.
-    let start = if pairs.is_empty() {
+    let start = if !any_pairs {
         Vec::new()
     } else {
         entry_displacements(world, before)
@@ -136,7 +144,7 @@ fn plastic_step<D: Dim>(
         factorizations += step.solved.factorizations;
         newton += step.solved.newton;
         rounds += 1;
-        if pairs.is_empty() {
+        if !any_pairs {
             break (dofs, step);
         }
         let u: Vec<D::Vec> = (start.iter().zip(&step.du)).map(|(&a, &d)| a + d).collect();
@@ -154,7 +162,7 @@ fn plastic_step<D: Dim>(
     step.solved.factorizations = factorizations;
     step.solved.newton = newton;
     step.solved.contact_rounds = rounds;
-    step.solved.closed_faces = closed.iter().filter(|&&c| c).count();
+    step.solved.closed_faces = closed_count(world, &pairs, &closed);
     reactions(world, &dofs, Law::Given(&step.returned.stress), &step.du);
     let after: Vec<D::Vec> = (before.iter().zip(gather(world, &step.du)))
         .map(|(&b, d)| b + d)
@@ -172,11 +180,8 @@ fn plastic_step<D: Dim>(
 /// contact measures it, Guo & Nairn 3D (2006) Eq. 68); zero on an entry without mass.
 fn entry_displacements<D: Dim>(world: &World<D>, disp: &[D::Vec]) -> Vec<D::Vec> {
     let mass = &world.grid.mass;
-    let mut sums = vec![D::zero(); mass.len()];
-    for (i, &d) in disp.iter().enumerate() {
-        let md = d * world.particles.mass[i];
-        each_entry(world, i, |n, w, _| sums[n] += md * w);
-    }
+    let p = &world.particles;
+    let sums = entry_sums(world, |i, w, _| disp[i] * (p.mass[i] * w));
     (sums.into_iter().zip(mass))
         .map(|(s, &m)| if m > 0.0 { s * (1.0 / m) } else { D::zero() })
         .collect()
@@ -206,18 +211,21 @@ struct Solution<D: Dim> {
 }
 
 /// The load step's equilibrium with its crack faces' contact settled: solves until the
-/// active set of closed face pairs changes no more (one solve without such faces).
+/// active set of closed face pairs changes no more (one solve without such faces); the
+/// first conjugate-gradient solve starts from `guess` (every entry's displacement).
 fn with_contact<D: Dim>(
     world: &World<D>,
     kept: &mut Option<Analysis>,
     held: Option<&[D::Vec]>,
+    guess: Option<Vec<D::Vec>>,
     t_end: f64,
 ) -> Result<Solution<D>, Unstable> {
     let pairs = faces::pairs(world);
+    let any_pairs = world.domain.any(!pairs.is_empty());
     let mut closed = vec![false; pairs.len()];
     let (mut iterations, mut factorizations) = (0, 0);
     let mut rounds = 0;
-    let mut last: Option<Vec<D::Vec>> = None;
+    let mut last = guess;
     let (u, dofs, mut solved) = loop {
         let dofs = Unknowns::new(world, &pairs, &closed);
         let solver = Solver::new(world, &dofs, kept)?;
@@ -227,7 +235,7 @@ fn with_contact<D: Dim>(
         iterations += solved.iterations;
         factorizations += solved.factorizations;
         rounds += 1;
-        if pairs.is_empty() {
+        if !any_pairs {
             break (u, dofs, solved);
         }
         let changes = faces_round(world, &pairs, &mut closed, &u, (Law::Elastic, &u));
@@ -242,7 +250,7 @@ fn with_contact<D: Dim>(
     solved.iterations = iterations;
     solved.factorizations = factorizations;
     solved.contact_rounds = rounds;
-    solved.closed_faces = closed.iter().filter(|&&c| c).count();
+    solved.closed_faces = closed_count(world, &pairs, &closed);
     Ok(Solution { u, dofs, solved })
 }
 
@@ -288,6 +296,7 @@ fn equilibrium<D: Dim>(
     guess: Option<&[D::Vec]>,
 ) -> Result<(Vec<D::Vec>, Solved), Unstable> {
     let t_end = end_time(world);
+    let sums = Sums::of(world);
     let free = &dofs.free;
     if let Some(u_c) = held {
         let mut k_c = vec![D::zero(); u_c.len()];
@@ -300,10 +309,10 @@ fn equilibrium<D: Dim>(
     }
     dofs.project(&mut load);
     let modes = &solver.frame.modes;
-    let norm = dot::<D>(&load, &load).sqrt();
-    rigid::deflate::<D>(&mut load, modes);
+    let norm = sums.dot::<D>(&load, &load).sqrt();
+    rigid::deflate::<D>(sums, &mut load, modes);
     let imbalance = if norm > 0.0 {
-        1.0 - dot::<D>(&load, &load).sqrt() / norm
+        1.0 - sums.dot::<D>(&load, &load).sqrt() / norm
     } else {
         0.0
     };
@@ -325,7 +334,7 @@ fn equilibrium<D: Dim>(
             .map(|(e, &x)| mask::<D>(x - held.map_or(D::zero(), |h| h[e]), free[e]))
             .collect();
         dofs.project(&mut s);
-        rigid::deflate::<D>(&mut s, modes);
+        rigid::deflate::<D>(sums, &mut s, modes);
         s
     });
     let (mut u, mut solved) =
@@ -360,11 +369,26 @@ fn faces_round<D: Dim>(
             .map(|x| D::dot(*x, *x).sqrt())
             .fold(0.0, f64::max)
     };
-    let force_tol = 1e-8 * largest(&r);
+    let sums = Sums::of(world);
+    let force_tol = 1e-8 * sums.max(largest(&r));
     r.iter_mut()
         .zip(&world.grid.force)
         .for_each(|(r, &f)| *r -= f);
-    faces::update::<D>(pairs, closed, u, &r, 1e-9 * largest(u), force_tol)
+    let gap_tol = 1e-9 * sums.max(largest(u));
+    // Split across ranks, a pair on a shared node changes alike on each: its owner counts it.
+    let counted = |p: &faces::Pair<D::Vec>| sums.owns(p.own);
+    let mine = faces::update::<D>(pairs, closed, u, &r, (gap_tol, force_tol), counted);
+    faces::Changes {
+        closed: sums.count(mine.closed),
+        opened: sums.count(mine.opened),
+    }
+}
+
+/// How many of the face `pairs` are `closed`, over all ranks.
+fn closed_count<D: Dim>(world: &World<D>, pairs: &[faces::Pair<D::Vec>], closed: &[bool]) -> usize {
+    let sums = Sums::of(world);
+    let mine = (pairs.iter().zip(closed)).filter(|(p, c)| **c && sums.owns(p.own));
+    sums.count(mine.count())
 }
 
 /// Each support's reaction on the body, f_int - f_ext on its held components (f_int the
@@ -407,18 +431,20 @@ fn load_work<D: Dim>(
     let p = &world.particles;
     let step = |i: usize| after[i] - before[i];
     let first = world.step == 0;
-    let mut work = 0.0;
+    let mut work = ExactSum::new();
     for load in &world.loads {
         let start = if first { 0.0 } else { load.time.at(t_start) };
         let mean = 0.5 * (start + load.time.at(t_end));
         for (&i, &f) in load.particles.iter().zip(&load.forces) {
-            work += D::dot(f * mean, step(i as usize));
+            if i != ABSENT {
+                work.add(D::dot(f * mean, step(i as usize)));
+            }
         }
     }
     let g = world.settings.gravity * if first { 0.5 } else { 1.0 };
-    work + (0..p.len())
-        .map(|i| p.mass[i] * D::dot(g, step(i)))
-        .sum::<f64>()
+    (0..p.len()).for_each(|i| work.add(p.mass[i] * D::dot(g, step(i))));
+    world.domain.sum(std::slice::from_mut(&mut work));
+    work.value()
 }
 
 /// Moves the cracks' vertices and surfaces over the step as the explicit solver would
@@ -428,12 +454,8 @@ fn move_cracks<D: Dim>(world: &mut World<D>, before: &[D::Vec], after: &[D::Vec]
     if world.cracks.is_none() {
         return;
     }
-    let mut moved = vec![D::zero(); world.grid.mass.len()];
     let mass = &world.particles.mass;
-    for (i, (&b, &a)) in before.iter().zip(after).enumerate() {
-        let d = (a - b) * mass[i];
-        each_entry(world, i, |n, w, _| moved[n] += d * w);
-    }
+    let moved = entry_sums(world, |i, w, _| (after[i] - before[i]) * (mass[i] * w));
     crack_advect::displace(world, &moved);
 }
 
@@ -484,10 +506,13 @@ fn leans_on_ghost<D: Dim>(
     f: &[D::Vec],
     t_end: f64,
 ) -> Result<(), Unstable> {
-    let held: f64 = (u.iter().zip(ghost).zip(&dofs.free))
-        .map(|((u, g), k)| (0..D::D).map(|a| g[a] * k[a] * u[a] * u[a]).sum::<f64>())
-        .sum();
-    let total = dot::<D>(f, u);
+    let sums = Sums::of(world);
+    let held = sums.total(u.len(), |e| {
+        (0..D::D)
+            .map(|a| ghost[e][a] * dofs.free[e][a] * u[e][a] * u[e][a])
+            .sum()
+    });
+    let total = sums.dot::<D>(f, u);
     if held <= GHOST_SHARE * total.abs() {
         return Ok(());
     }
@@ -516,18 +541,19 @@ fn leans_on_ghost<D: Dim>(
 /// sides' entries and the nodes they share) and on the light ones (below [`LIGHT`] of the
 /// heaviest), zero elsewhere.
 fn ghost_stiffness<D: Dim>(world: &World<D>, diag: &[D::Vec]) -> Vec<D::Vec> {
-    let mut ghost = vec![D::zero(); diag.len()];
-    for &i in fields(world).map_or(&[][..], |f| &f.coded[..]) {
-        each_entry(world, i as usize, |n, _, _| ghost[n] = diag[n] * GHOST);
-    }
+    // Split across ranks, a shared node is marked where any rank's particles reach it.
+    let mut near = vec![D::zero(); diag.len()];
+    scatter::near_crack_sums(world, &mut near, |i, mark| {
+        each_entry(world, i, |n, _, _| mark(n, ones::<D>()))
+    });
     let mass = &world.grid.mass;
-    let full = mass.iter().copied().fold(0.0, f64::max);
-    for (e, &m) in mass.iter().enumerate() {
-        if m < LIGHT * full {
-            ghost[e] = diag[e] * GHOST;
-        }
-    }
-    ghost
+    let full = Sums::of(world).max(mass.iter().copied().fold(0.0, f64::max));
+    (0..diag.len())
+        .map(|e| match near[e] != D::zero() || mass[e] < LIGHT * full {
+            true => diag[e] * GHOST,
+            false => D::zero(),
+        })
+        .collect()
 }
 
 /// The node of grid entry `e` (a crack field's row belongs to a node).

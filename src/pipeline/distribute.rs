@@ -10,7 +10,7 @@ use crate::ranks::domain::Domain;
 use crate::ranks::partition::{Partition, TileGrid};
 use crate::record::probe::Probe;
 use crate::store::particles::{ColumnOp, Particles};
-use crate::store::world::{Solver, World};
+use crate::store::world::{LinearSolver, Solver, World};
 use crate::systems::bin;
 use std::borrow::Cow;
 
@@ -26,7 +26,7 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
         return Ok(());
     }
     refuse_unsupported(world)?;
-    bin::run(world).map_err(|u| anyhow::anyhow!("{u}"))?;
+    bin_for_split(world).map_err(|u| anyhow::anyhow!("{u}"))?;
     let tiles = &world.tiles;
     let counts: Vec<u32> = tiles.start.windows(2).map(|w| w[1] - w[0]).collect();
     let grid = TileGrid {
@@ -62,10 +62,29 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
     Ok(())
 }
 
+/// Bins the particles where the run will use them: where they are, or, in a static scene
+/// (whose solves place its particles at their initial positions), where they started.
+fn bin_for_split<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
+    if world.settings.solver != Solver::Static {
+        return bin::run(world);
+    }
+    let p = &world.particles;
+    let (geom, shape) = (&world.grid.geom, world.settings.shape);
+    bin::place(&p.x0, &p.half, geom, shape, &mut world.tiles, &())
+        .map_err(|i| bin::outside(world, i, world.step, world.time))
+}
+
 /// What a split run cannot do yet, refused by name.
 fn refuse_unsupported<D: Dim>(world: &World<D>) -> anyhow::Result<()> {
-    if world.settings.solver == Solver::Static {
-        anyhow::bail!("a static scene cannot yet run on more than one MPI rank");
+    if world.settings.solver != Solver::Static {
+        return Ok(());
+    }
+    if world.settings.linear == LinearSolver::Direct {
+        anyhow::bail!(
+            "simulation.linear = \"direct\": the sparse direct solver runs on one process \
+             only; give linear = \"cg\" (or \"auto\", which takes conjugate gradients on \
+             several ranks)"
+        );
     }
     Ok(())
 }
@@ -89,6 +108,11 @@ pub fn migrate<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<boo
     let Some(partition) = &world.domain.partition else {
         return Ok(false);
     };
+    // A static scene's particles are quadrature points at their initial places: each keeps
+    // the tile (and the rank) it started in.
+    if world.settings.solver == Solver::Static {
+        return Ok(false);
+    }
     let me = world.domain.comm.rank();
     let p = &world.particles;
     let mut leaving: Vec<Vec<u32>> = vec![Vec::new(); partition.peers.len()];
@@ -199,9 +223,13 @@ const IMBALANCE: f64 = 1.25;
 /// Every [`BALANCE_EVERY`] steps, when a rank holds more than [`IMBALANCE`] times the mean
 /// particle count, divides the tiles anew by where the particles are now and moves each to
 /// its tile's new owner. The results do not change (node sums and reductions do not depend
-/// on the split). Every rank of a split run calls it at the same point of each step.
+/// on the split). Every rank of a split run calls it at the same point of each step. A
+/// static scene keeps its split: its particles do not move from where its solves use them.
 pub fn rebalance<D: Dim>(world: &mut World<D>, probes: &mut [Probe]) -> Result<bool, Unstable> {
-    if !world.domain.is_split() || !world.step.is_multiple_of(BALANCE_EVERY) {
+    if !world.domain.is_split()
+        || !world.step.is_multiple_of(BALANCE_EVERY)
+        || world.settings.solver == Solver::Static
+    {
         return Ok(false);
     }
     let comm = world.domain.comm.clone();

@@ -1,11 +1,12 @@
 //! Preconditioned conjugate gradients (Hestenes & Stiefel 1952) on a static scene's K,
-//! matrix-free, with sums in fixed chunks so that every thread count gives the same bits.
+//! matrix-free, with exact sums over the entries so that every thread count and every split
+//! across ranks gives the same bits.
 
 use super::frame::Frame;
 use super::operator::{Law, apply};
 use super::rigid;
 use super::unknowns::Unknowns;
-use super::vectors::dot;
+use super::vectors::Sums;
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::record::solve_log::Solved;
@@ -32,7 +33,8 @@ pub(super) fn conjugate_gradients<D: Dim>(
         diag, ghost, modes, ..
     } = frame;
     let n = f.len();
-    let norm_f = dot::<D>(f, f).sqrt();
+    let sums = Sums::of(world);
+    let norm_f = sums.dot::<D>(f, f).sqrt();
     if norm_f == 0.0 {
         return Ok((vec![D::zero(); n], Solved::default()));
     }
@@ -58,7 +60,7 @@ pub(super) fn conjugate_gradients<D: Dim>(
         }
         None => vec![D::zero(); n],
     };
-    let residual = dot::<D>(&r, &r).sqrt() / norm_f;
+    let residual = sums.dot::<D>(&r, &r).sqrt() / norm_f;
     if residual <= tolerance {
         let solved = Solved {
             residual,
@@ -68,18 +70,22 @@ pub(super) fn conjugate_gradients<D: Dim>(
     }
     let mut z = precondition(&r);
     dofs.project(&mut z);
-    rigid::deflate::<D>(&mut z, modes);
+    rigid::deflate::<D>(sums, &mut z, modes);
     let mut dir = z.clone();
-    let mut rz = dot::<D>(&r, &z);
+    let mut rz = sums.dot::<D>(&r, &z);
     let mut q = vec![D::zero(); n];
     let cells = world.grid.geom.cells;
     let most = ITERATIONS_PER_NODE * (cells[0].max(cells[1]).max(cells[2]) + 1);
     for k in 1..=most {
         apply(world, law, &dir, dofs, Some(ghost), &mut q);
-        let pq = dot::<D>(&dir, &q);
+        let pq = sums.dot::<D>(&dir, &q);
         // A direction of no stiffness (or NaN): K is singular on what the loads start.
         if pq.is_nan() || pq <= 0.0 {
-            return Err(not_converged(world, k, dot::<D>(&r, &r).sqrt() / norm_f));
+            return Err(not_converged(
+                world,
+                k,
+                sums.dot::<D>(&r, &r).sqrt() / norm_f,
+            ));
         }
         let alpha = rz / pq;
         u.par_iter_mut()
@@ -89,7 +95,7 @@ pub(super) fn conjugate_gradients<D: Dim>(
                 *u += p * alpha;
                 *r -= q * alpha;
             });
-        let residual = dot::<D>(&r, &r).sqrt() / norm_f;
+        let residual = sums.dot::<D>(&r, &r).sqrt() / norm_f;
         if residual <= tolerance {
             return Ok((
                 u,
@@ -102,15 +108,19 @@ pub(super) fn conjugate_gradients<D: Dim>(
         }
         z = precondition(&r);
         dofs.project(&mut z);
-        rigid::deflate::<D>(&mut z, modes);
-        let rz_next = dot::<D>(&r, &z);
+        rigid::deflate::<D>(sums, &mut z, modes);
+        let rz_next = sums.dot::<D>(&r, &z);
         let beta = rz_next / rz;
         rz = rz_next;
         dir.par_iter_mut()
             .zip(z.par_iter())
             .for_each(|(p, &z)| *p = z + *p * beta);
     }
-    Err(not_converged(world, most, dot::<D>(&r, &r).sqrt() / norm_f))
+    Err(not_converged(
+        world,
+        most,
+        sums.dot::<D>(&r, &r).sqrt() / norm_f,
+    ))
 }
 
 fn not_converged<D: Dim>(world: &World<D>, iterations: usize, residual: f64) -> Unstable {

@@ -9,7 +9,7 @@ use super::dilatation::{Groups, isotropic, trace};
 use super::frame::Frame;
 use super::operator::{Law, apply};
 use super::unknowns::Unknowns;
-use super::vectors::dot;
+use super::vectors::Sums;
 use super::{each_entry, fields, rigid};
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
@@ -122,7 +122,8 @@ impl<D: Dim> Direct<D> {
             what,
         };
         let n = f.len();
-        let norm_f = dot::<D>(f, f).sqrt();
+        let sums = Sums::of(world);
+        let norm_f = sums.dot::<D>(f, f).sqrt();
         if norm_f == 0.0 {
             return Ok((vec![D::zero(); n], Solved::default()));
         }
@@ -166,13 +167,13 @@ impl<D: Dim> Direct<D> {
                 MemStack::new(&mut memory),
             );
             self.layout.extend(&rhs, &mut u);
-            rigid::deflate::<D>(&mut u, &frame.modes);
+            rigid::deflate::<D>(sums, &mut u, &frame.modes);
             apply(world, law, &u, dofs, Some(&frame.ghost), &mut q);
             r.iter_mut()
                 .zip(f.iter().zip(&q))
                 .for_each(|(r, (&f, &q))| *r = f - q);
-            rigid::deflate::<D>(&mut r, &frame.modes);
-            residual = dot::<D>(&r, &r).sqrt() / norm_f;
+            rigid::deflate::<D>(sums, &mut r, &frame.modes);
+            residual = sums.dot::<D>(&r, &r).sqrt() / norm_f;
             if residual <= tolerance || pass == REFINEMENTS {
                 break;
             }

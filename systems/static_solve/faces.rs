@@ -93,27 +93,29 @@ pub(super) struct Changes {
 /// and `ku_less_f`, K u - f_ext per entry without ties folded: a pair whose fields overlap
 /// along the normal by more than `gap_tol` closes; a closed pair whose above field the
 /// other pulls (the constraint's force on it, K u - f_ext, the rest of its equilibrium,
-/// against the normal beyond `force_tol`) opens.
+/// against the normal beyond `force_tol`) opens. Counts the changes of the pairs
+/// `counted` takes.
 pub(super) fn update<D: Dim>(
     pairs: &[Pair<D::Vec>],
     closed: &mut [bool],
     u: &[D::Vec],
     ku_less_f: &[D::Vec],
-    gap_tol: f64,
-    force_tol: f64,
+    (gap_tol, force_tol): (f64, f64),
+    counted: impl Fn(&Pair<D::Vec>) -> bool,
 ) -> Changes {
     let mut changes = Changes::default();
     for (p, c) in pairs.iter().zip(closed.iter_mut()) {
         let (a, b) = p.above_below();
+        let count = counted(p) as usize;
         if *c {
             let push = D::dot(ku_less_f[a], p.normal);
             if push < -force_tol {
                 *c = false;
-                changes.opened += 1;
+                changes.opened += count;
             }
         } else if D::dot(u[a] - u[b], p.normal) < -gap_tol {
             *c = true;
-            changes.closed += 1;
+            changes.closed += count;
         }
     }
     changes

@@ -5,6 +5,7 @@ use super::ghost_stiffness;
 use super::operator::diagonal;
 use super::rigid;
 use super::unknowns::Unknowns;
+use super::vectors::Sums;
 use crate::base::dim::Dim;
 use crate::store::world::World;
 
@@ -25,6 +26,7 @@ impl<D: Dim> Frame<D> {
         let largest = (diag.iter().zip(&dofs.free))
             .flat_map(|(d, k)| (0..D::D).filter(|&a| k[a] != 0.0).map(|a| d[a]))
             .fold(0.0, f64::max);
+        let largest = Sums::of(world).max(largest);
         let ghost = ghost_stiffness(world, &diag);
         let modes = rigid::free_motions(world, dofs, &ghost, largest);
         Frame { diag, ghost, modes }

@@ -11,7 +11,7 @@ use super::frame::Frame;
 use super::operator::{Law, mask, stiffness};
 use super::solver::Solver;
 use super::unknowns::Unknowns;
-use super::vectors::dot;
+use super::vectors::Sums;
 use super::{Linear, equilibrium, gradient, rigid};
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
@@ -165,14 +165,17 @@ impl<D: Dim> Load<D> {
     /// The loads now in the grid's force column, on `dofs`, with the supports' increment
     /// `held`.
     fn new(world: &World<D>, dofs: &Unknowns<D>, held: Option<&[D::Vec]>) -> Self {
+        let sums = Sums::of(world);
         let mut force = world.grid.force.clone();
         dofs.fold(&mut force);
         let drive2 = held.map_or(0.0, |u_c| {
             let mut k_c = vec![D::zero(); u_c.len()];
             stiffness(world, Law::Elastic, u_c, dofs, &mut k_c);
-            dot::<D>(&k_c, &k_c)
+            sums.dot::<D>(&k_c, &k_c)
         });
-        let norm2 = dot::<D>(&force, &force).max(DRIVE_FLOOR * DRIVE_FLOOR * drive2);
+        let norm2 = sums
+            .dot::<D>(&force, &force)
+            .max(DRIVE_FLOOR * DRIVE_FLOOR * drive2);
         Load { force, norm2 }
     }
 }
@@ -209,16 +212,17 @@ fn residual<D: Dim>(
     load: &Load<D>,
     du: &[D::Vec],
 ) -> Residual<D> {
+    let sums = Sums::of(world);
     let returned = return_map(world, dofs, du);
     let mut f_int = vec![D::zero(); du.len()];
     stiffness(world, Law::Given(&returned.stress), du, dofs, &mut f_int);
-    let scale = load.norm2.max(dot::<D>(&f_int, &f_int)).sqrt();
+    let scale = load.norm2.max(sums.dot::<D>(&f_int, &f_int)).sqrt();
     let mut r: Vec<D::Vec> = (load.force.iter().zip(&f_int).zip(&dofs.free))
         .map(|((&f, &q), &k)| mask::<D>(f - q, k))
         .collect();
     dofs.project(&mut r);
-    rigid::deflate::<D>(&mut r, &frame.modes);
-    let norm = dot::<D>(&r, &r).sqrt();
+    rigid::deflate::<D>(sums, &mut r, &frame.modes);
+    let norm = sums.dot::<D>(&r, &r).sqrt();
     Residual {
         r,
         norm,

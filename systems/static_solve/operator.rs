@@ -1,6 +1,7 @@
 //! Products with the stiffness K of a static scene, matrix-free: particle by particle, the
 //! stress a displacement gradient gives under a [`Law`], scattered as nodal forces.
 
+use super::scatter::{entry_sums, near_crack_sums};
 use super::unknowns::Unknowns;
 use super::{each_entry, fields, gradient};
 use crate::base::dim::Dim;
@@ -104,29 +105,31 @@ pub(super) fn stiffness<D: Dim>(
     let (shape, plane) = (world.settings.shape, world.settings.plane);
     let stride = &world.grid.geom.stride;
     let (p, materials, tiles) = (&world.particles, &world.materials, &world.tiles);
-    let fields = fields(world);
+    let (fields, domain) = (fields(world), &world.domain);
     let y_w = Disjoint::new(y);
-    tiles.for_each_coloured(|t| {
-        let mine = tiles.particles(t).iter().map(|&i| i as usize);
-        for_each_free_particle!(D, shape, &tiles.stencils, fields, mine, |i, st| {
-            let rows = st.rows::<D>(stride);
-            let l = velocity_gradient::<D, N>(&st, &rows, x);
-            let s = law.stress(&materials[p.material[i] as usize], plane, i, &l);
-            // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and each
-            // tile is handled by one thread. Given -V, the internal-force scatter adds
-            // +V sigma . grad S: the rows of K x.
-            unsafe { add_internal_force::<D, N>(&st, &rows, &s, -p.volume[i], &y_w) };
-        })
-    });
+    tiles.for_each_coloured_then(
+        |t| {
+            let mine = tiles.particles(t).iter().map(|&i| i as usize);
+            for_each_free_particle!(D, shape, &tiles.stencils, fields, mine, |i, st| {
+                let rows = st.rows::<D>(stride);
+                let l = velocity_gradient::<D, N>(&st, &rows, x);
+                let s = law.stress(&materials[p.material[i] as usize], plane, i, &l);
+                // SAFETY: tiles of one colour class touch disjoint nodes (tiles.rs), and
+                // each tile is handled by one thread. Given -V, the internal-force scatter
+                // adds +V sigma . grad S: the rows of K x.
+                unsafe { add_internal_force::<D, N>(&st, &rows, &s, -p.volume[i], &y_w) };
+            })
+        },
+        |c| domain.settle(c, &[&y_w]),
+    );
     // The particles near a crack, on their sides' entries, in particle order.
-    for &i in fields.map_or(&[][..], |f| &f.coded[..]) {
-        let i = i as usize;
+    near_crack_sums(world, y, |i, emit| {
         let l = gradient(world, i, x);
         let s = law.stress(&materials[p.material[i] as usize], plane, i, &l);
         each_entry(world, i, |n, _, g| {
-            y[n] += D::stress_dot(&s, g) * p.volume[i]
+            emit(n, D::stress_dot(&s, g) * p.volume[i])
         });
-    }
+    });
     dofs.fold(y);
 }
 
@@ -165,20 +168,19 @@ pub(super) fn apply<D: Dim>(
 /// one entry of a node, so the two share no particle and K has no term between them.
 pub(super) fn diagonal<D: Dim>(world: &World<D>, dofs: &Unknowns<D>) -> Vec<D::Vec> {
     let free = &dofs.free;
-    let mut d = vec![D::zero(); free.len()];
     let plane = world.settings.plane;
     let p = &world.particles;
-    for i in 0..p.len() {
+    let mut d = entry_sums(world, |i, _, grad| {
         let m = &world.materials[p.material[i] as usize];
-        each_entry(world, i, |n, _, grad| {
-            for a in 0..D::D {
-                let mut e = D::zero();
-                e[a] = 1.0;
-                let s = elastic::<D>(m, plane, &D::outer(e, grad));
-                d[n][a] += p.volume[i] * D::stress_dot(&s, grad)[a];
-            }
-        });
-    }
+        let mut d = D::zero();
+        for a in 0..D::D {
+            let mut e = D::zero();
+            e[a] = 1.0;
+            let s = elastic::<D>(m, plane, &D::outer(e, grad));
+            d[a] = p.volume[i] * D::stress_dot(&s, grad)[a];
+        }
+        d
+    });
     dofs.fold(&mut d);
     for (d, &k) in d.iter_mut().zip(free) {
         for a in 0..D::D {

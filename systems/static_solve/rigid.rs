@@ -8,7 +8,7 @@
 use super::entry_node;
 use super::operator::{Law, apply};
 use super::unknowns::Unknowns;
-use super::vectors::dot;
+use super::vectors::Sums;
 use crate::base::dim::Dim;
 use crate::store::world::{CHUNK, World};
 use rayon::prelude::*;
@@ -27,9 +27,10 @@ pub(super) fn free_motions<D: Dim>(
     largest_diagonal: f64,
 ) -> Vec<Vec<D::Vec>> {
     let free = &dofs.free;
+    let sums = Sums::of(world);
     let mut candidates = rigid_candidates(world, free);
     candidates.iter_mut().for_each(|c| dofs.project(c));
-    let basis = orthonormal::<D>(candidates);
+    let basis = orthonormal::<D>(sums, candidates);
     if basis.is_empty() {
         return basis;
     }
@@ -41,7 +42,7 @@ pub(super) fn free_motions<D: Dim>(
         apply(world, Law::Elastic, bj, dofs, Some(ghost), &mut q);
         // K is symmetric: the upper triangle, mirrored.
         for (i, bi) in basis.iter().enumerate().take(j + 1) {
-            let v = dot::<D>(bi, &q);
+            let v = sums.dot::<D>(bi, &q);
             g[i][j] = v;
             g[j][i] = v;
         }
@@ -54,9 +55,9 @@ pub(super) fn free_motions<D: Dim>(
 }
 
 /// v less its components along the orthonormal `modes`.
-pub(super) fn deflate<D: Dim>(v: &mut [D::Vec], modes: &[Vec<D::Vec>]) {
+pub(super) fn deflate<D: Dim>(sums: Sums, v: &mut [D::Vec], modes: &[Vec<D::Vec>]) {
     for m in modes {
-        let c = dot::<D>(v, m);
+        let c = sums.dot::<D>(v, m);
         v.par_chunks_mut(CHUNK)
             .zip(m.par_chunks(CHUNK))
             .for_each(|(v, m)| v.iter_mut().zip(m).for_each(|(v, &m)| *v -= m * c));
@@ -69,10 +70,11 @@ fn rigid_candidates<D: Dim>(world: &World<D>, free: &[D::Vec]) -> Vec<Vec<D::Vec
     let geom = &world.grid.geom;
     let at = |e: usize| geom.node_position(entry_node(world, e));
     let mass = &world.grid.mass;
-    let total: f64 = mass.iter().sum();
+    let sums = Sums::of(world);
+    let total = sums.total(mass.len(), |e| mass[e]).max(f64::MIN_POSITIVE);
     let mut centre = D::zero();
-    for (e, &m) in mass.iter().enumerate() {
-        centre += at(e) * (m / total.max(f64::MIN_POSITIVE));
+    for a in 0..D::D {
+        centre[a] = sums.total(mass.len(), |e| at(e)[a] * mass[e]) / total;
     }
     let field = |f: &dyn Fn(D::Vec) -> D::Vec| -> Vec<D::Vec> {
         (0..free.len())
@@ -113,17 +115,17 @@ fn rigid_candidates<D: Dim>(world: &World<D>, free: &[D::Vec]) -> Vec<Vec<D::Vec
 
 /// Modified Gram-Schmidt, twice for round-off; a vector that loses all but 1e-8 of its
 /// length to the others (a motion the supports hold entirely) is dropped.
-fn orthonormal<D: Dim>(vectors: Vec<Vec<D::Vec>>) -> Vec<Vec<D::Vec>> {
+fn orthonormal<D: Dim>(sums: Sums, vectors: Vec<Vec<D::Vec>>) -> Vec<Vec<D::Vec>> {
     let mut basis: Vec<Vec<D::Vec>> = Vec::new();
     for mut v in vectors {
-        let start = dot::<D>(&v, &v).sqrt();
+        let start = sums.dot::<D>(&v, &v).sqrt();
         if start == 0.0 {
             continue;
         }
         for _ in 0..2 {
-            deflate::<D>(&mut v, &basis);
+            deflate::<D>(sums, &mut v, &basis);
         }
-        let left = dot::<D>(&v, &v).sqrt();
+        let left = sums.dot::<D>(&v, &v).sqrt();
         if left > 1e-8 * start {
             v.iter_mut().for_each(|x| *x *= 1.0 / left);
             basis.push(v);

@@ -34,7 +34,7 @@ impl<D: Dim> Solver<D> {
         let frame = Frame::new(world, dofs);
         let (direct, too_large) = match world.settings.linear {
             LinearSolver::Cg => (None, false),
-            LinearSolver::Auto if D::D == 3 => (None, false),
+            LinearSolver::Auto if D::D == 3 || world.domain.is_split() => (None, false),
             LinearSolver::Auto => match Direct::new(world, dofs, &frame.modes, kept) {
                 Ok(d) => (Some(d), false),
                 Err(_) => (None, true),

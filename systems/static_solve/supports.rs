@@ -2,10 +2,13 @@
 //! displacement that velocity would give by each load step's time (the same motion an
 //! explicit run of the scene imposes), and does work on the body through its reaction.
 
-use super::{each_entry, entries, fields};
+use super::scatter::entry_sums;
+use super::{entries, fields};
 use crate::base::dim::Dim;
+use crate::base::exact_sum::ExactSum;
 use crate::physics::loads::VelocityBc;
 use crate::store::world::World;
+use crate::systems::p2g;
 
 /// Per grid entry, the displacement the moving supports prescribe at time `t` on their
 /// held components (zero elsewhere); None when no support moves.
@@ -54,36 +57,14 @@ pub(super) fn start_forces<D: Dim>(world: &World<D>, t_start: f64) -> Vec<Vec<D:
     if world.step == 0 || !world.bcs.iter().any(moves) {
         return zero().collect();
     }
-    // Only entries of support nodes are needed: mark them.
-    let mut wanted = vec![false; world.grid.mass.len()];
-    for bc in &world.bcs {
-        for &n in &bc.nodes {
-            entries(n, fields(world)).for_each(|e| wanted[e] = true);
-        }
-    }
     let p = &world.particles;
-    let mut r = vec![D::zero(); wanted.len()];
-    for i in 0..p.len() {
-        let s = p.stress[i];
-        each_entry(world, i, |n, _, g| {
-            if wanted[n] {
-                r[n] += D::stress_dot(&s, g) * p.volume[i];
-            }
-        });
-    }
-    for load in &world.loads {
-        let scale = load.time.at(t_start);
-        for (&i, &f) in load.particles.iter().zip(&load.forces) {
-            each_entry(world, i as usize, |n, w, _| {
-                if wanted[n] {
-                    r[n] -= f * (scale * w);
-                }
-            });
-        }
-    }
+    let mut r = entry_sums(world, |i, _, g| {
+        D::stress_dot(&p.stress[i], g) * p.volume[i]
+    });
+    let loads = p2g::load_forces(world, t_start);
     let g = world.settings.gravity;
-    for (e, r) in r.iter_mut().enumerate().filter(|(e, _)| wanted[*e]) {
-        *r -= g * world.grid.mass[e];
+    for (e, r) in r.iter_mut().enumerate() {
+        *r -= loads[e] + g * world.grid.mass[e];
     }
     (world.bcs.iter())
         .map(|bc| {
@@ -103,12 +84,16 @@ pub(super) fn work<D: Dim>(
     t_start: f64,
     t_end: f64,
 ) -> f64 {
-    let mut work = 0.0;
+    let mut work = ExactSum::new();
     for (bc, start) in world.bcs.iter().zip(start) {
         let step = displacement(bc, t_end) - displacement(bc, t_start);
-        for (r0, r1) in start.iter().zip(&bc.reaction) {
-            work += D::dot((*r0 + *r1) * 0.5, step);
+        for ((r0, r1), &n) in start.iter().zip(&bc.reaction).zip(&bc.nodes) {
+            // Split across ranks, the node's owner books its work.
+            if world.domain.owns_node(n as usize) {
+                work.add(D::dot((*r0 + *r1) * 0.5, step));
+            }
         }
     }
-    work
+    world.domain.sum(std::slice::from_mut(&mut work));
+    work.value()
 }

@@ -128,7 +128,7 @@ fn slivers<D: Dim>(world: &World<D>) -> Vec<(usize, usize)> {
 }
 
 /// The vector of ones.
-fn ones<D: Dim>() -> D::Vec {
+pub(super) fn ones<D: Dim>() -> D::Vec {
     let mut k = D::zero();
     (0..D::D).for_each(|a| k[a] = 1.0);
     k
