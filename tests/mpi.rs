@@ -328,6 +328,17 @@ fn scene_file(scene: &str, name: &str) -> (std::path::PathBuf, std::path::PathBu
     (dir, file)
 }
 
+/// The earliest snapshot set (its manifest) a run wrote into `out`.
+#[cfg(feature = "mpi")]
+fn first_set(out: &Path) -> std::path::PathBuf {
+    let mut sets: Vec<_> = (std::fs::read_dir(out.join("snapshots")).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "fsnap"))
+        .collect();
+    sets.sort();
+    sets.swap_remove(0)
+}
+
 /// `file` (a scene with cracks) on 2 ranks of 2 threads, and 3 and 4 ranks of one, as on
 /// one process: `files` byte for byte, the frames' particles and the cracks' last frame (the advected, or grown, vertices
 /// and surfaces); and a snapshot set written mid-run on 2 ranks, resumed on 3, ends with
@@ -355,13 +366,8 @@ fn cracks_alike_on_ranks(file: &Path, dir: &Path, files: &[&str], every_steps: u
     let every = format!("checkpoint.every_steps={every_steps}");
     let split = dir.join("ranks2_snapshots");
     run(file, Some(2), &split, &["--set", &every, "--threads", "1"]);
-    let mut sets: Vec<_> = (std::fs::read_dir(split.join("snapshots")).unwrap())
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "fsnap"))
-        .collect();
-    sets.sort();
     let resumed = dir.join("resumed3");
-    succeeded(&resume(&sets[0], Some(3), &resumed));
+    succeeded(&resume(&first_set(&split), Some(3), &resumed));
     same_files(
         &serial,
         &resumed,
@@ -514,13 +520,8 @@ fn static_scenes_split_across_ranks_match_one_process() {
         &written,
         &[&every[..], &["--threads", "1"]].concat(),
     );
-    let mut sets: Vec<_> = (std::fs::read_dir(written.join("snapshots")).unwrap())
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "fsnap"))
-        .collect();
-    sets.sort();
     let resumed = bar.join("resumed3");
-    succeeded(&resume(&sets[0], Some(3), &resumed));
+    succeeded(&resume(&first_set(&written), Some(3), &resumed));
     same_files(&bar.join("serial"), &resumed, &solved, "resumed on 3 ranks");
     std::fs::remove_dir_all(&dir).ok();
 }
