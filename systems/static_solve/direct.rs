@@ -428,15 +428,16 @@ impl<D: Dim> Layout<D> {
                     .collect()
             })
             .collect();
+        // In the order of `Unknowns::expand`.
         let mut comb = own.clone();
-        for &(s, m) in &dofs.ties {
-            comb[s] = comb[m].clone();
-        }
         for &(s, m, n) in &dofs.normal_ties {
             let along: Vec<(u32, D::Vec)> = (comb[m].iter())
                 .map(|&(j, c)| (j, n * D::dot(n, c)))
                 .collect();
             comb[s].extend(along);
+        }
+        for &(s, m) in &dofs.ties {
+            comb[s] = comb[m].clone();
         }
         Layout {
             own,

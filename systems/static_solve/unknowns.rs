@@ -58,18 +58,20 @@ impl<D: Dim> Unknowns<D> {
     }
 
     /// Gives each tied entry the value of the entry it moves with (along the normal for a
-    /// frictionless pair).
+    /// frictionless pair): the faces' pairs first, so that a sliver whose heaviest entry is
+    /// a pair's tied one takes that entry's whole value.
     pub fn expand(&self, x: &mut [D::Vec]) {
-        for &(s, m) in &self.ties {
-            x[s] = x[m];
-        }
         for &(s, m, n) in &self.normal_ties {
             x[s] += n * D::dot(x[m] - x[s], n);
+        }
+        for &(s, m) in &self.ties {
+            x[s] = x[m];
         }
     }
 
     /// Adds each tied entry's value (a force) to the entry it moves with, and clears it
-    /// (its normal part, for a frictionless pair).
+    /// (its normal part, for a frictionless pair): the transpose of [`Self::expand`], in
+    /// the reverse order.
     pub fn fold(&self, y: &mut [D::Vec]) {
         for &(s, m) in &self.ties {
             y[m] += y[s];
@@ -132,4 +134,41 @@ pub(super) fn ones<D: Dim>() -> D::Vec {
     let mut k = D::zero();
     (0..D::D).for_each(|a| k[a] = 1.0);
     k
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::base::dim::D2;
+    use glam::DVec2;
+
+    /// A node with its own entry 0, a crack field 1 on a closed frictionless pair with it,
+    /// and a sliver 2 whose heaviest entry is the pair's tied field: folding is the
+    /// transpose of expanding on the unknowns (x . fold(y) = expand(x) . y), which keeps
+    /// K symmetric for conjugate gradients.
+    #[test]
+    fn folding_is_the_transpose_of_expanding() {
+        let n = DVec2::new(0.6, 0.8);
+        let dofs = Unknowns::<D2> {
+            free: vec![DVec2::ONE, DVec2::ONE, DVec2::ZERO],
+            ties: vec![(2, 1)],
+            normal_ties: vec![(1, 0, n)],
+            groups: None,
+        };
+        let mut x = vec![DVec2::new(1.0, -2.0), DVec2::new(3.0, 5.0), DVec2::ZERO];
+        dofs.project(&mut x);
+        let y = vec![
+            DVec2::new(0.7, 1.1),
+            DVec2::new(-1.3, 0.2),
+            DVec2::new(2.9, -0.4),
+        ];
+        let mut expanded = x.clone();
+        dofs.expand(&mut expanded);
+        let mut folded = y.clone();
+        dofs.fold(&mut folded);
+        let dot = |a: &[DVec2], b: &[DVec2]| a.iter().zip(b).map(|(a, b)| a.dot(*b)).sum::<f64>();
+        let (left, right) = (dot(&x, &folded), dot(&expanded, &y));
+        assert!((left - right).abs() < 1e-14, "{left} vs {right}");
+        assert!((expanded[2] - expanded[1]).length() == 0.0);
+    }
 }
