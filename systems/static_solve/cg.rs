@@ -6,7 +6,7 @@ use super::frame::Frame;
 use super::operator::{Law, apply};
 use super::rigid;
 use super::unknowns::Unknowns;
-use super::vectors::Sums;
+use super::vectors::{DotPair, Sums};
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::record::solve_log::Solved;
@@ -60,7 +60,15 @@ pub(super) fn conjugate_gradients<D: Dim>(
         }
         None => vec![D::zero(); n],
     };
-    let residual = sums.dot::<D>(&r, &r).sqrt() / norm_f;
+    // The residual's norm, and the preconditioned residual z with r . z, in one exchange.
+    let step = |r: &[D::Vec]| -> (f64, Vec<D::Vec>, f64) {
+        let mut z = precondition(r);
+        dofs.project(&mut z);
+        let (rr, along, rz) = residual_sums::<D>(sums, r, &z, modes);
+        rigid::remove::<D>(&mut z, modes, &along);
+        (rr.sqrt() / norm_f, z, rz)
+    };
+    let (residual, z, mut rz) = step(&r);
     if residual <= tolerance {
         let solved = Solved {
             residual,
@@ -68,11 +76,7 @@ pub(super) fn conjugate_gradients<D: Dim>(
         };
         return Ok((u, solved));
     }
-    let mut z = precondition(&r);
-    dofs.project(&mut z);
-    rigid::deflate::<D>(sums, &mut z, modes);
-    let mut dir = z.clone();
-    let mut rz = sums.dot::<D>(&r, &z);
+    let mut dir = z;
     let mut q = vec![D::zero(); n];
     let cells = world.grid.geom.cells;
     let most = ITERATIONS_PER_NODE * (cells[0].max(cells[1]).max(cells[2]) + 1);
@@ -95,7 +99,7 @@ pub(super) fn conjugate_gradients<D: Dim>(
                 *u += p * alpha;
                 *r -= q * alpha;
             });
-        let residual = sums.dot::<D>(&r, &r).sqrt() / norm_f;
+        let (residual, z, rz_next) = step(&r);
         if residual <= tolerance {
             return Ok((
                 u,
@@ -106,10 +110,6 @@ pub(super) fn conjugate_gradients<D: Dim>(
                 },
             ));
         }
-        z = precondition(&r);
-        dofs.project(&mut z);
-        rigid::deflate::<D>(sums, &mut z, modes);
-        let rz_next = sums.dot::<D>(&r, &z);
         let beta = rz_next / rz;
         rz = rz_next;
         dir.par_iter_mut()
@@ -121,6 +121,27 @@ pub(super) fn conjugate_gradients<D: Dim>(
         most,
         sums.dot::<D>(&r, &r).sqrt() / norm_f,
     ))
+}
+
+/// r . r, the projections of `z` on the orthonormal `modes`, and r . z' for z' the
+/// deflated z (r . z less each projection times r's own along that mode), from one
+/// exchange between ranks: a conjugate-gradient iteration's sums but one.
+fn residual_sums<D: Dim>(
+    sums: Sums,
+    r: &[D::Vec],
+    z: &[D::Vec],
+    modes: &[Vec<D::Vec>],
+) -> (f64, Vec<f64>, f64) {
+    let mut pairs: Vec<DotPair<D>> = vec![(r, r), (r, z)];
+    for m in modes {
+        pairs.push((z, m));
+        pairs.push((r, m));
+    }
+    let d = sums.dots::<D>(&pairs);
+    let per_mode = d[2..].chunks_exact(2);
+    let along: Vec<f64> = per_mode.clone().map(|m| m[0]).collect();
+    let rz = per_mode.fold(d[1], |rz, m| rz - m[0] * m[1]);
+    (d[0], along, rz)
 }
 
 fn not_converged<D: Dim>(world: &World<D>, iterations: usize, residual: f64) -> Unstable {

@@ -8,7 +8,7 @@
 use super::entry_node;
 use super::operator::{Law, apply};
 use super::unknowns::Unknowns;
-use super::vectors::Sums;
+use super::vectors::{DotPair, Sums};
 use crate::base::dim::Dim;
 use crate::store::world::{CHUNK, World};
 use rayon::prelude::*;
@@ -54,14 +54,30 @@ pub(super) fn free_motions<D: Dim>(
         .collect()
 }
 
-/// v less its components along the orthonormal `modes`.
+/// v less its components along the orthonormal `modes` (their projections in one
+/// exchange between ranks).
 pub(super) fn deflate<D: Dim>(sums: Sums, v: &mut [D::Vec], modes: &[Vec<D::Vec>]) {
-    for m in modes {
-        let c = sums.dot::<D>(v, m);
-        v.par_chunks_mut(CHUNK)
-            .zip(m.par_chunks(CHUNK))
-            .for_each(|(v, m)| v.iter_mut().zip(m).for_each(|(v, &m)| *v -= m * c));
+    if modes.is_empty() {
+        return;
     }
+    let pairs: Vec<DotPair<D>> = modes.iter().map(|m| (&v[..], &m[..])).collect();
+    let along = sums.dots::<D>(&pairs);
+    remove::<D>(v, modes, &along);
+}
+
+/// v less `along[m]` times each of the `modes`, in one pass.
+pub(super) fn remove<D: Dim>(v: &mut [D::Vec], modes: &[Vec<D::Vec>], along: &[f64]) {
+    if modes.is_empty() {
+        return;
+    }
+    v.par_chunks_mut(CHUNK).enumerate().for_each(|(k, v)| {
+        let start = k * CHUNK;
+        for (i, v) in v.iter_mut().enumerate() {
+            for (m, &c) in modes.iter().zip(along) {
+                *v -= m[start + i] * c;
+            }
+        }
+    });
 }
 
 /// The D translations and the rotations (1 in 2D, 3 in 3D) about the entries' mass centre,

@@ -8,6 +8,9 @@ use crate::store::crack::Fields;
 use crate::store::world::{CHUNK, World};
 use rayon::prelude::*;
 
+/// Two per-entry vectors whose dot product is wanted.
+pub(super) type DotPair<'v, D> = (&'v [<D as Dim>::Vec], &'v [<D as Dim>::Vec]);
+
 /// Sums of per-entry terms with the same bits for any thread count and any split across
 /// ranks: each term added exactly ([`ExactSum`]) by the rank owning the entry's node (a
 /// node shared between ranks holds the same value on each), the ranks' sums added.
@@ -61,6 +64,31 @@ impl<'a> Sums<'a> {
     /// The sum of a * b over all components.
     pub fn dot<D: Dim>(&self, a: &[D::Vec], b: &[D::Vec]) -> f64 {
         self.total(a.len(), |e| D::dot(a[e], b[e]))
+    }
+
+    /// The sums of a * b for each pair `(a, b)` of vectors (all of one length), in one pass
+    /// and one exchange between ranks: each the same bits as its own [`dot`](Self::dot).
+    pub fn dots<D: Dim>(&self, pairs: &[DotPair<D>]) -> Vec<f64> {
+        let len = pairs.first().map_or(0, |p| p.0.len());
+        let starts: Vec<usize> = (0..len).step_by(CHUNK).collect();
+        let parts: Vec<Vec<ExactSum>> = starts
+            .par_iter()
+            .map(|&s| {
+                let mut sums = vec![ExactSum::new(); pairs.len()];
+                for e in (s..(s + CHUNK).min(len)).filter(|&e| self.owns(e)) {
+                    for (sum, (a, b)) in sums.iter_mut().zip(pairs) {
+                        sum.add(D::dot(a[e], b[e]));
+                    }
+                }
+                sums
+            })
+            .collect();
+        let mut sums = vec![ExactSum::new(); pairs.len()];
+        for part in &parts {
+            sums.iter_mut().zip(part).for_each(|(s, p)| s.merge(p));
+        }
+        self.domain.sum(&mut sums);
+        sums.iter().map(ExactSum::value).collect()
     }
 
     /// The sum of every rank's count `n`.
