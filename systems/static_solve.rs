@@ -23,6 +23,7 @@ use crate::systems::{bin, classify, crack_advect, p2g};
 use crate::with_shape;
 
 mod cg;
+mod coarse;
 mod dilatation;
 mod direct;
 mod faces;

@@ -492,7 +492,7 @@ fn static_scenes_split_across_ranks_match_one_process() {
             [&static_cg[..], &["--set", "simulation.load_steps=1"]].concat(),
             &cracked,
         ),
-        ("scenarios/straight_front_3d.toml", Vec::new(), &cracked),
+        ("scenarios/straight_front_3d.toml", cg.to_vec(), &cracked),
     ];
     for (scene, args, files) in cases {
         let stem = Path::new(scene).file_stem().unwrap().to_string_lossy();
@@ -634,25 +634,30 @@ fn a_build_without_mpi_refuses_several_ranks() {
 }
 
 /// What a split run cannot do yet is refused by name, once (by the first rank): the sparse
-/// direct solver, and the commands that run on one process.
+/// direct solver and the coarse grid, and the commands that run on one process.
 #[cfg(feature = "mpi")]
 #[test]
 fn split_runs_refuse_what_they_cannot_do_yet() {
     let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_refuse", std::process::id()));
-    let direct = ["--set", "simulation.linear=\"direct\""];
-    let done = launch(
-        "scenarios/cantilever_static_2d.toml",
-        Some(2),
-        &dir,
-        &direct,
-    );
-    let said = String::from_utf8_lossy(&done.stderr);
-    assert!(!done.status.success());
-    assert!(
-        said.contains("the sparse direct solver runs on one process only"),
-        "{said}"
-    );
-    assert_eq!(said.matches("error:").count(), 1, "{said}");
+    for (key, what) in [
+        ("direct", "the sparse direct solver"),
+        ("two_level", "the coarse grid's direct solve"),
+    ] {
+        let set = format!("simulation.linear=\"{key}\"");
+        let done = launch(
+            "scenarios/cantilever_static_2d.toml",
+            Some(2),
+            &dir,
+            &["--set", &set],
+        );
+        let said = String::from_utf8_lossy(&done.stderr);
+        assert!(!done.status.success());
+        assert!(
+            said.contains(&format!("{what} runs on one process only")),
+            "{said}"
+        );
+        assert_eq!(said.matches("error:").count(), 1, "{said}");
+    }
 
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/dcb_2d.toml");
     let done = Command::new("mpirun")

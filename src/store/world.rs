@@ -56,15 +56,20 @@ pub enum Dilatation {
 #[serde(rename_all = "lowercase")]
 pub enum LinearSolver {
     /// The sparse direct factorization in 2D (when its factor fits in memory),
-    /// conjugate gradients in 3D, where a grid's factor fills in far faster (nested
-    /// dissection: n^(4/3) entries and n^2 operations against n log n and n^(3/2) in 2D)
-    /// and conjugate gradients won at every size measured (docs/static-solver.md).
+    /// conjugate gradients with the coarse grid in 3D, where a grid's factor fills in far
+    /// faster (nested dissection: n^(4/3) entries and n^2 operations against n log n and
+    /// n^(3/2) in 2D) and conjugate gradients won at every size measured
+    /// (docs/static-solver.md); conjugate gradients with Jacobi on several MPI ranks.
     #[default]
     Auto,
     /// Sparse Cholesky factorization of the assembled K.
     Direct,
     /// Matrix-free conjugate gradients with a Jacobi preconditioner.
     Cg,
+    /// Matrix-free conjugate gradients with Jacobi and a coarse grid of four times the
+    /// cell size (a two-level additive Schwarz preconditioner).
+    #[serde(rename = "two_level")]
+    TwoLevel,
 }
 
 /// The default residual, relative to the external force, at which a static load step has

@@ -30,7 +30,10 @@ pub(super) fn conjugate_gradients<D: Dim>(
     tolerance: f64,
 ) -> Result<(Vec<D::Vec>, Solved), Unstable> {
     let Frame {
-        diag, ghost, modes, ..
+        diag,
+        ghost,
+        modes,
+        coarse,
     } = frame;
     let n = f.len();
     let sums = Sums::of(world);
@@ -39,7 +42,8 @@ pub(super) fn conjugate_gradients<D: Dim>(
         return Ok((vec![D::zero(); n], Solved::default()));
     }
     let precondition = |r: &[D::Vec]| -> Vec<D::Vec> {
-        r.par_iter()
+        let mut z: Vec<D::Vec> = r
+            .par_iter()
             .zip(diag.par_iter())
             .map(|(&r, &d)| {
                 let mut z = r;
@@ -48,7 +52,11 @@ pub(super) fn conjugate_gradients<D: Dim>(
                 }
                 z
             })
-            .collect()
+            .collect();
+        if let Some(c) = coarse {
+            c.correct(r, &mut z);
+        }
+        z
     };
     let mut r = f.to_vec();
     let mut u = match start {

@@ -20,7 +20,7 @@ use crate::store::world::World;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
-    SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+    LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
@@ -73,13 +73,7 @@ impl<D: Dim> Direct<D> {
         let analysis = match kept.as_mut().filter(same) {
             Some(a) => a.clone(),
             None => {
-                let symbolic = factorize_symbolic_cholesky(
-                    pattern.as_ref(),
-                    Side::Lower,
-                    SymmetricOrdering::Amd,
-                    Default::default(),
-                )
-                .map_err(|e| format!("the direct solver's symbolic analysis failed: {e:?}"))?;
+                let symbolic = analyse(&pattern, "the direct solver")?;
                 let a = Analysis {
                     pattern,
                     symbolic: Arc::new(symbolic),
@@ -129,30 +123,19 @@ impl<D: Dim> Direct<D> {
         }
         let values = self.assemble(world, law, &frame.ghost, dofs.groups.as_ref());
         let Analysis { pattern, symbolic } = &self.analysis;
-        let matrix = SparseColMatRef::new(pattern.as_ref(), &values);
-        let mut factor = vec![0.0; symbolic.len_val()];
         let scratch = symbolic
             .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
             .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
         let mut memory = MemBuffer::try_new(scratch)
             .map_err(|_| failed("out of memory for the direct solver's workspace".into()))?;
-        let llt = symbolic
-            .factorize_numeric_llt(
-                &mut factor,
-                matrix,
-                Side::Lower,
-                LltRegularization::default(),
-                Par::Seq,
-                MemStack::new(&mut memory),
-                Default::default(),
+        let factor = factorize(symbolic, pattern, &values, &mut memory).ok_or_else(|| {
+            failed(
+                "the static solve's stiffness is not positive definite (is the body held \
+                 against every rigid motion the loads would start?)"
+                    .into(),
             )
-            .map_err(|_| {
-                failed(
-                    "the static solve's stiffness is not positive definite (is the body held \
-                     against every rigid motion the loads would start?)"
-                        .into(),
-                )
-            })?;
+        })?;
+        let llt = LltRef::<usize, f64>::new(symbolic, &factor);
         let mut u = vec![D::zero(); n];
         let mut r = f.to_vec();
         let mut q = vec![D::zero(); n];
@@ -621,6 +604,45 @@ fn pattern<D: Dim>(
     }
     let n = layout.count;
     SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx)
+}
+
+/// The symbolic Cholesky factorization of the lower triangle `pattern` after an
+/// approximate minimum degree ordering; `whose` names the solver in the error.
+pub(super) fn analyse(
+    pattern: &SymbolicSparseColMat<usize>,
+    whose: &str,
+) -> Result<SymbolicCholesky<usize>, String> {
+    factorize_symbolic_cholesky(
+        pattern.as_ref(),
+        Side::Lower,
+        SymmetricOrdering::Amd,
+        Default::default(),
+    )
+    .map_err(|e| format!("{whose}'s symbolic analysis failed: {e:?}"))
+}
+
+/// The numeric Cholesky factor of K's lower triangle `values` on `pattern`, on one thread
+/// (the same bits for any thread count), in `memory`; None where K is not positive
+/// definite.
+pub(super) fn factorize(
+    symbolic: &SymbolicCholesky<usize>,
+    pattern: &SymbolicSparseColMat<usize>,
+    values: &[f64],
+    memory: &mut MemBuffer,
+) -> Option<Vec<f64>> {
+    let mut factor = vec![0.0; symbolic.len_val()];
+    symbolic
+        .factorize_numeric_llt(
+            &mut factor,
+            SparseColMatRef::new(pattern.as_ref(), values),
+            Side::Lower,
+            LltRegularization::default(),
+            Par::Seq,
+            MemStack::new(memory),
+            Default::default(),
+        )
+        .ok()?;
+    Some(factor)
 }
 
 /// Bytes in a GiB.

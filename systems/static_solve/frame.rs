@@ -1,6 +1,8 @@
 //! What every linear solve on one set of unknowns shares: K's diagonal (the Jacobi
-//! preconditioner, from the elastic K), the ghost stiffness and the free rigid motions.
+//! preconditioner, from the elastic K), the coarse grid where there is one, the ghost
+//! stiffness and the free rigid motions.
 
+use super::coarse::Coarse;
 use super::ghost_stiffness;
 use super::operator::diagonal;
 use super::rigid;
@@ -17,11 +19,13 @@ pub(super) struct Frame<D: Dim> {
     pub ghost: Vec<D::Vec>,
     /// An orthonormal basis of the rigid motions K leaves free.
     pub modes: Vec<Vec<D::Vec>>,
+    /// The coarse grid under the Jacobi preconditioner, where the solver has one.
+    pub coarse: Option<Coarse<D>>,
 }
 
 impl<D: Dim> Frame<D> {
-    /// The frame of the unknowns `dofs`.
-    pub fn new(world: &World<D>, dofs: &Unknowns<D>) -> Self {
+    /// The frame of the unknowns `dofs`, with the `coarse` grid given.
+    pub fn new(world: &World<D>, dofs: &Unknowns<D>, coarse: Option<Coarse<D>>) -> Self {
         let diag = diagonal(world, dofs);
         let largest = (diag.iter().zip(&dofs.free))
             .flat_map(|(d, k)| (0..D::D).filter(|&a| k[a] != 0.0).map(|a| d[a]))
@@ -29,6 +33,11 @@ impl<D: Dim> Frame<D> {
         let largest = Sums::of(world).max(largest);
         let ghost = ghost_stiffness(world, &diag);
         let modes = rigid::free_motions(world, dofs, &ghost, largest);
-        Frame { diag, ghost, modes }
+        Frame {
+            diag,
+            ghost,
+            modes,
+            coarse,
+        }
     }
 }

@@ -1,8 +1,10 @@
 //! The linear solver of one set of unknowns: the sparse direct factorization or conjugate
-//! gradients, as `[simulation] linear` and the scene's dimension choose, on the unknowns'
-//! [`Frame`] (with the direct solver's pattern and symbolic analysis, made once here).
+//! gradients (with Jacobi, or Jacobi and the coarse grid), as `[simulation] linear`, the
+//! scene's dimension and the ranks choose, on the unknowns' [`Frame`] (with the direct
+//! solver's pattern and symbolic analysis, or the coarse grid's factor, made once here).
 
 use super::cg::conjugate_gradients;
+use super::coarse::Coarse;
 use super::direct::{Analysis, Direct};
 use super::frame::Frame;
 use super::operator::Law;
@@ -31,21 +33,31 @@ impl<D: Dim> Solver<D> {
         dofs: &Unknowns<D>,
         kept: &mut Option<Analysis>,
     ) -> Result<Self, Unstable> {
-        let frame = Frame::new(world, dofs);
+        let failed = |what: String| Unstable {
+            step: world.step + 1,
+            time: (world.step + 1) as f64 * world.settings.dt,
+            what,
+        };
+        let split = world.domain.is_split();
+        let coarse = match world.settings.linear {
+            LinearSolver::TwoLevel => true,
+            LinearSolver::Auto => D::D == 3 && !split,
+            _ => false,
+        };
+        let coarse = match coarse {
+            true => Some(Coarse::new(world, dofs).map_err(failed)?),
+            false => None,
+        };
+        let frame = Frame::new(world, dofs, coarse);
         let (direct, too_large) = match world.settings.linear {
-            LinearSolver::Cg => (None, false),
-            LinearSolver::Auto if D::D == 3 || world.domain.is_split() => (None, false),
+            LinearSolver::Cg | LinearSolver::TwoLevel => (None, false),
+            LinearSolver::Auto if D::D == 3 || split => (None, false),
             LinearSolver::Auto => match Direct::new(world, dofs, &frame.modes, kept) {
                 Ok(d) => (Some(d), false),
                 Err(_) => (None, true),
             },
             LinearSolver::Direct => {
-                let direct = Direct::new(world, dofs, &frame.modes, kept);
-                let direct = direct.map_err(|what| Unstable {
-                    step: world.step + 1,
-                    time: (world.step + 1) as f64 * world.settings.dt,
-                    what,
-                })?;
+                let direct = Direct::new(world, dofs, &frame.modes, kept).map_err(failed)?;
                 (Some(direct), false)
             }
         };

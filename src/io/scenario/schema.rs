@@ -86,7 +86,7 @@ pub struct Simulation {
     /// A static scene's residual, relative to the external force, at which a load step has
     /// converged (default 1e-8).
     pub tolerance: Option<f64>,
-    /// A static scene's linear solver: "auto" (default), "direct" or "cg".
+    /// A static scene's linear solver: "auto" (default), "direct", "cg" or "two_level".
     pub linear: Option<LinearSolver>,
     /// The volumetric strain a particle's stress sees: "particle" (its own, default) or
     /// "cell_mean" (its cell's mean: static scenes in plane strain and 3D).

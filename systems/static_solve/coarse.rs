@@ -1,0 +1,484 @@
+//! A coarse grid under the conjugate gradients' Jacobi preconditioner (`linear =
+//! "two_level"`, the 3D default): the two-level additive Schwarz method (Dryja & Widlund
+//! 1987; Smith, Bjørstad & Gropp 1996, ch. 2). The grid of [`RATIO`] times the cell size
+//! carries each fine entry's displacement by multilinear interpolation P; its stiffness is
+//! the Galerkin P^T K P, summed particle by particle and factorized once per set of
+//! unknowns (faer's sparse Cholesky). The preconditioner is z = D^-1 r + P (P^T K P)^-1 P^T
+//! r: Jacobi damps the short waves of the error, the coarse solve the long ones that take
+//! Jacobi-preconditioned conjugate gradients hundreds of iterations.
+//!
+//! The coarse field is one per node whatever the cracks (a crack's faces move together on
+//! it): the opening is left to Jacobi and the iteration. Held components are held on P
+//! (each fine entry's interpolated value is cleared where the entry is held), so P^T K P
+//! has the supports' stiffness; a body free of supports leaves P^T K P its rigid motions,
+//! on which the right-hand side vanishes: a relative [`SHIFT`] on the diagonal keeps the
+//! factorization defined there, and the solve's deflation takes the motions out.
+
+use super::direct::{analyse, factorize};
+use super::operator::elastic;
+use super::unknowns::Unknowns;
+use super::{each_entry, entry_node};
+use crate::base::dim::Dim;
+use crate::store::disjoint::Disjoint;
+use crate::store::world::World;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::SymbolicSparseColMat;
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
+use faer::{Conj, MatMut, Par};
+use rayon::prelude::*;
+
+/// The coarse nodes a fine node interpolates from, their weights, and how many (2^D at
+/// most).
+#[derive(Clone, Copy)]
+struct Parents {
+    node: [u32; 8],
+    weight: [f64; 8],
+    /// Per parent, the axes along which it is the upper of two (bit a for axis a).
+    upper: [u8; 8],
+    count: u8,
+    /// The lowest parent's index per axis.
+    low: [u32; 3],
+}
+
+/// Coupled coarse nodes lie at most this many coarse cells apart on an axis: a particle's
+/// stencil spans at most two fine cells, whose nodes take coarse nodes at most two coarse
+/// cells apart.
+const REACH: usize = 2;
+
+/// Coupling offsets per axis (-REACH..=REACH).
+const SPAN: usize = 2 * REACH + 1;
+
+/// Fine cells per coarse cell along each axis. On the penny cube of 10^6 particles (55^3
+/// nodes) a ratio of 2 took 38 iterations against Jacobi's 308, but its coarse factor
+/// held 64 million entries (11 s to factorize, a third of an iteration's time to apply);
+/// 4 takes 55 iterations with a factor of 4.3 million entries (0.2 s).
+const RATIO: usize = 4;
+
+/// The relative stiffness added to the coarse diagonal (see the module's doc).
+const SHIFT: f64 = 1e-8;
+
+/// The coarse grid, its stiffness's Cholesky factor and the interpolation to the fine
+/// entries.
+pub(super) struct Coarse<D: Dim> {
+    /// Per fine entry, the coarse nodes it interpolates from.
+    parents: Vec<Parents>,
+    /// Per coarse node, `children[start[c]..start[c + 1]]`: the fine entries that take it
+    /// and their weights, in entry order.
+    start: Vec<usize>,
+    children: Vec<(u32, f64)>,
+    /// Per coarse node and axis, its unknown (u32::MAX: none: no particle moves it).
+    unknown: Vec<u32>,
+    /// How many unknowns.
+    count: usize,
+    symbolic: SymbolicCholesky<usize>,
+    factor: Vec<f64>,
+    /// Per fine entry, 1 on the components the interpolation moves (the unknowns' free
+    /// ones; a sliver's, its partner's), else 0.
+    keep: Vec<D::Vec>,
+}
+
+/// The coarse grid's shape: nodes per axis and linear strides.
+#[derive(Clone, Copy)]
+struct Shape {
+    nodes: [usize; 3],
+    stride: [usize; 3],
+}
+
+impl Shape {
+    /// Coarse node `c`'s index per axis.
+    fn ijk(&self, mut c: usize) -> [usize; 3] {
+        let mut out = [0; 3];
+        for a in (0..3).rev() {
+            out[a] = c / self.stride[a];
+            c %= self.stride[a];
+        }
+        out
+    }
+}
+
+impl<D: Dim> Coarse<D> {
+    /// The coarse grid of `world`'s grid with its stiffness on the unknowns `dofs`: the
+    /// elastic P^T K P (without the ghost's, whose share is 1e-11). Says why when the
+    /// factorization fails.
+    pub fn new(world: &World<D>, dofs: &Unknowns<D>) -> Result<Self, String> {
+        let geom = &world.grid.geom;
+        let mut nodes = [1usize; 3];
+        for (n, &cells) in nodes.iter_mut().zip(&geom.cells).take(D::D) {
+            *n = cells.div_ceil(RATIO) + 1;
+        }
+        let shape = Shape {
+            nodes,
+            stride: [1, nodes[0], nodes[0] * nodes[1]],
+        };
+        let parents: Vec<Parents> = (0..dofs.free.len())
+            .into_par_iter()
+            .map(|e| parents_of::<D>(geom.stride, shape, entry_node(world, e)))
+            .collect();
+        let (start, children) = invert(&parents, nodes.iter().product());
+        let mut keep = dofs.free.clone();
+        for &(s, m) in &dofs.ties {
+            keep[s] = dofs.free[m];
+        }
+        let blocks = assemble(world, shape, &parents, &keep);
+        let (unknown, count, pattern, values) = lower_triangle::<D>(shape, &blocks);
+        let symbolic = analyse(&pattern, "the coarse grid")?;
+        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
+        let mut memory = MemBuffer::try_new(scratch)
+            .map_err(|_| "out of memory for the coarse grid's factorization".to_string())?;
+        let factor = factorize(&symbolic, &pattern, &values, &mut memory).ok_or_else(|| {
+            "the coarse grid's stiffness is not positive definite: set [simulation] linear = \
+             \"cg\""
+                .to_string()
+        })?;
+        Ok(Coarse {
+            parents,
+            start,
+            children,
+            unknown,
+            count,
+            symbolic,
+            factor,
+            keep,
+        })
+    }
+
+    /// Adds the coarse correction P (P^T K P)^-1 P^T r to `z`.
+    pub fn correct(&self, r: &[D::Vec], z: &mut [D::Vec]) {
+        let d = D::D;
+        let restricted: Vec<D::Vec> = (0..self.start.len() - 1)
+            .into_par_iter()
+            .map(|c| {
+                let mut sum = D::zero();
+                for &(e, w) in &self.children[self.start[c]..self.start[c + 1]] {
+                    let (e, k) = (e as usize, self.keep[e as usize]);
+                    for a in 0..d {
+                        sum[a] += w * k[a] * r[e][a];
+                    }
+                }
+                sum
+            })
+            .collect();
+        let mut x = vec![0.0; self.count];
+        for (c, v) in restricted.iter().enumerate() {
+            for a in 0..d {
+                let u = self.unknown[c * d + a];
+                if u != u32::MAX {
+                    x[u as usize] = v[a];
+                }
+            }
+        }
+        let llt = LltRef::<usize, f64>::new(&self.symbolic, &self.factor);
+        let scratch = self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
+        let mut memory = MemBuffer::new(scratch);
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut x, self.count, 1),
+            Par::Seq,
+            MemStack::new(&mut memory),
+        );
+        z.par_iter_mut().enumerate().for_each(|(e, z)| {
+            let p = &self.parents[e];
+            let k = self.keep[e];
+            for j in 0..p.count as usize {
+                let c = p.node[j] as usize;
+                for a in 0..d {
+                    let u = self.unknown[c * d + a];
+                    if u != u32::MAX {
+                        z[a] += p.weight[j] * k[a] * x[u as usize];
+                    }
+                }
+            }
+        });
+    }
+}
+
+/// The coarse nodes fine node `n` interpolates from: per axis the coarse node at an even
+/// index, or the two around an odd one, at half weight each.
+fn parents_of<D: Dim>(fine_stride: [usize; 3], shape: Shape, mut n: usize) -> Parents {
+    let mut ijk = [0usize; 3];
+    for a in (0..3).rev() {
+        ijk[a] = n / fine_stride[a];
+        n %= fine_stride[a];
+    }
+    let mut p = Parents {
+        node: [0; 8],
+        weight: [0.0; 8],
+        upper: [0; 8],
+        count: 1,
+        low: [0; 3],
+    };
+    p.weight[0] = 1.0;
+    for (a, &i) in ijk.iter().enumerate().take(D::D) {
+        let (c0, t) = (i / RATIO, i % RATIO);
+        let odd = t != 0;
+        let upper = t as f64 / RATIO as f64;
+        p.low[a] = c0 as u32;
+        let count = p.count as usize;
+        for k in 0..count {
+            let (c, w) = (p.node[k] as usize, p.weight[k]);
+            p.node[k] = (c + c0 * shape.stride[a]) as u32;
+            if odd {
+                p.weight[k] = (1.0 - upper) * w;
+                p.node[k + count] = (c + (c0 + 1) * shape.stride[a]) as u32;
+                p.weight[k + count] = upper * w;
+                p.upper[k + count] = p.upper[k] | (1 << a);
+            }
+        }
+        if odd {
+            p.count *= 2;
+        }
+    }
+    p
+}
+
+/// The fine entries (with weights) that take each of `nodes` coarse nodes, in entry order.
+fn invert(parents: &[Parents], nodes: usize) -> (Vec<usize>, Vec<(u32, f64)>) {
+    let mut start = vec![0usize; nodes + 1];
+    for p in parents {
+        p.node[..p.count as usize]
+            .iter()
+            .for_each(|&c| start[c as usize + 1] += 1);
+    }
+    for c in 0..nodes {
+        start[c + 1] += start[c];
+    }
+    let mut fill = start.clone();
+    let mut children = vec![(0u32, 0.0); start[nodes]];
+    for (e, p) in parents.iter().enumerate() {
+        for j in 0..p.count as usize {
+            let c = p.node[j] as usize;
+            children[fill[c]] = (e as u32, p.weight[j]);
+            fill[c] += 1;
+        }
+    }
+    (start, children)
+}
+
+/// Offsets of coupled coarse nodes in a row's blocks (SPAN^D).
+fn span<D: Dim>() -> usize {
+    SPAN.pow(D::D as u32)
+}
+
+/// The index among a row's blocks of the coupling from coarse node `row` to `col`
+/// (indices per axis, at most REACH apart).
+#[inline(always)]
+fn offset<D: Dim>(row: [usize; 3], col: [usize; 3]) -> usize {
+    let mut o = 0;
+    for a in (0..D::D).rev() {
+        o = o * SPAN + (col[a] + REACH - row[a]);
+    }
+    o
+}
+
+/// P^T K P under the elastic law, as D x D blocks per coarse node and coupling offset
+/// ([`offset`]), on and below the diagonal (a row's couplings to nodes of no larger
+/// index). A particle's stencil reaches three planes of coarse nodes along the last axis
+/// from its lowest: the particles are binned by that plane and the bins taken in three
+/// passes (bins 0, 3, 6, ..., then 1, 4, ..., then 2, 5, ...), the bins of a pass in
+/// parallel on disjoint rows: each row sums its terms in the same order for any thread
+/// count.
+fn assemble<D: Dim>(
+    world: &World<D>,
+    shape: Shape,
+    parents: &[Parents],
+    keep: &[D::Vec],
+) -> Vec<f64> {
+    let last = D::D - 1;
+    let planes = shape.nodes[last];
+    let p = &world.particles;
+    let lowest: Vec<[u32; 3]> = (0..p.len())
+        .into_par_iter()
+        .map(|i| {
+            let mut low = [u32::MAX; 3];
+            each_entry(world, i, |e, _, _| {
+                let q = &parents[e].low;
+                (0..3).for_each(|a| low[a] = low[a].min(q[a]));
+            });
+            low
+        })
+        .collect();
+    let plane_of = |i: usize| lowest[i][last] as usize;
+    let mut bin_start = vec![0usize; planes + 1];
+    let reached = || (0..p.len()).filter(|&i| plane_of(i) < planes);
+    reached().for_each(|i| bin_start[plane_of(i) + 1] += 1);
+    for z in 0..planes {
+        bin_start[z + 1] += bin_start[z];
+    }
+    let mut fill = bin_start.clone();
+    let mut binned = vec![0u32; bin_start[planes]];
+    for i in reached() {
+        binned[fill[plane_of(i)]] = i as u32;
+        fill[plane_of(i)] += 1;
+    }
+    let (dd, span) = (D::D * D::D, span::<D>());
+    let mut blocks = vec![0.0; shape.nodes.iter().product::<usize>() * span * dd];
+    let writer = Disjoint::new(&mut blocks);
+    for pass in 0..=REACH {
+        (pass..planes)
+            .step_by(REACH + 1)
+            .par_bridge()
+            .for_each(|z| {
+                for &i in &binned[bin_start[z]..bin_start[z + 1]] {
+                    let i = i as usize;
+                    // SAFETY: a particle of bin z writes the rows of planes z to z + REACH
+                    // only; the bins of one pass are REACH + 1 planes apart, so no two
+                    // threads write one row.
+                    unsafe { add_particle(world, shape, parents, keep, i, lowest[i], &writer) };
+                }
+            });
+    }
+    blocks
+}
+
+/// Slots of a particle's coarse support: 3 per axis from its lowest node.
+const SLOTS: usize = 27;
+
+/// Adds particle `i`'s V B^T C B on the coarse nodes (B made of the interpolated fine
+/// gradients, held components cleared) to the rows of its coarse support (lowest node
+/// `low`).
+///
+/// # Safety
+/// No other thread may write the rows of the particle's coarse support.
+unsafe fn add_particle<D: Dim>(
+    world: &World<D>,
+    shape: Shape,
+    parents: &[Parents],
+    keep: &[D::Vec],
+    i: usize,
+    low: [u32; 3],
+    rows: &Disjoint<f64>,
+) {
+    // Per slot, the gradient its unit motion along each axis gives.
+    let mut grads = [[D::zero(); 3]; SLOTS];
+    let mut used = 0u32;
+    // Whether every entry moves on every axis (so each slot's gradients are one).
+    let mut whole = true;
+    each_entry(world, i, |e, _, g| {
+        let q = &parents[e];
+        let k = keep[e];
+        whole &= (0..D::D).all(|a| k[a] == 1.0);
+        for j in 0..q.count as usize {
+            let slot = (0..D::D).rev().fold(0, |s, a| {
+                let x = q.low[a] - low[a] + u32::from(q.upper[j] >> a & 1);
+                s * 3 + x as usize
+            });
+            used |= 1 << slot;
+            for a in 0..D::D {
+                grads[slot][a] += g * (q.weight[j] * k[a]);
+            }
+        }
+    });
+    let p = &world.particles;
+    let m = &world.materials[p.material[i] as usize];
+    let (v, plane) = (p.volume[i], world.settings.plane);
+    let (dd, span) = (D::D * D::D, span::<D>());
+    let slots: Vec<usize> = (0..SLOTS).filter(|s| used >> s & 1 == 1).collect();
+    let ijk = |slot: usize| {
+        let mut out = [0usize; 3];
+        let mut rest = slot;
+        for a in 0..D::D {
+            out[a] = low[a] as usize + rest % 3;
+            rest /= 3;
+        }
+        out
+    };
+    let node = |x: [usize; 3]| (0..D::D).map(|a| x[a] * shape.stride[a]).sum::<usize>();
+    // stress[k][b]: the stress of a unit motion of slot k along b.
+    let mut stress = [[D::Sym::default(); 3]; SLOTS];
+    for &k in &slots {
+        for b in 0..D::D {
+            let mut eb = D::zero();
+            eb[b] = 1.0;
+            stress[k][b] = elastic::<D>(m, plane, &D::outer(eb, grads[k][b]));
+        }
+    }
+    for &l in &slots {
+        let (il, gl) = (ijk(l), &grads[l]);
+        let cl = node(il);
+        for &k in &slots {
+            let ik = ijk(k);
+            if node(ik) > cl {
+                continue;
+            }
+            let base = (cl * span + offset::<D>(il, ik)) * dd;
+            for (b, s) in stress[k].iter().enumerate().take(D::D) {
+                let all = whole.then(|| D::stress_dot(s, gl[0]));
+                for a in 0..D::D {
+                    let at = base + a * D::D + b;
+                    let f = match all {
+                        Some(f) => f[a],
+                        None => D::stress_dot(s, gl[a])[a],
+                    };
+                    // SAFETY: passed on from the caller.
+                    unsafe { rows.set(at, rows.get(at) + v * f) };
+                }
+            }
+        }
+    }
+}
+
+/// The coarse unknowns (each node's components with stiffness) and P^T K P's lower
+/// triangle on them (column by column, rows sorted), the diagonal raised by [`SHIFT`].
+fn lower_triangle<D: Dim>(
+    shape: Shape,
+    blocks: &[f64],
+) -> (Vec<u32>, usize, SymbolicSparseColMat<usize>, Vec<f64>) {
+    let (d, dd, span) = (D::D, D::D * D::D, span::<D>());
+    let total = shape.nodes.iter().product::<usize>();
+    let centre = offset::<D>([REACH; 3], [REACH; 3]);
+    let mut unknown = vec![u32::MAX; total * d];
+    let mut count = 0usize;
+    for c in 0..total {
+        for a in 0..d {
+            if blocks[(c * span + centre) * dd + a * d + a] > 0.0 {
+                unknown[c * d + a] = count as u32;
+                count += 1;
+            }
+        }
+    }
+    let mut col_ptr = vec![0usize];
+    let (mut row_idx, mut values) = (Vec::new(), Vec::new());
+    for c in 0..total {
+        let at = shape.ijk(c);
+        for b in 0..d {
+            let j = unknown[c * d + b];
+            if j == u32::MAX {
+                continue;
+            }
+            // Rows r >= c, nearest first along the last axis: increasing index.
+            for o in 0..span {
+                let mut rest = o;
+                let mut r = [0usize; 3];
+                let mut inside = true;
+                for a in 0..d {
+                    let x = at[a] + rest % SPAN;
+                    rest /= SPAN;
+                    inside &= x >= REACH && x - REACH < shape.nodes[a];
+                    r[a] = x.wrapping_sub(REACH);
+                }
+                let rc: usize = (0..d).map(|a| r[a] * shape.stride[a]).sum();
+                if !inside || rc < c {
+                    continue;
+                }
+                let base = (rc * span + offset::<D>(r, at)) * dd;
+                for a in 0..d {
+                    let i = unknown[rc * d + a];
+                    if i == u32::MAX || i < j {
+                        continue;
+                    }
+                    let value = blocks[base + a * d + b];
+                    if i == j {
+                        row_idx.push(i as usize);
+                        values.push(value * (1.0 + SHIFT));
+                    } else if value != 0.0 {
+                        row_idx.push(i as usize);
+                        values.push(value);
+                    }
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+    }
+    let pattern = SymbolicSparseColMat::new_checked(count, count, col_ptr, None, row_idx);
+    (unknown, count, pattern, values)
+}
