@@ -34,7 +34,8 @@ fn source(name: &str, linear: &str) -> Source {
 
 fn bench<D: DimSystems>(c: &mut Criterion, label: &str, src: &Source) {
     let world = build::<D>(src).expect("the scenario builds").world;
-    let solved = static_solve::run(&mut world.clone(), &mut None).expect("the load step solves");
+    let solved = static_solve::run(&mut world.clone(), &mut Default::default())
+        .expect("the load step solves");
     let iterations = solved.iterations.max(1);
     println!(
         "{label}: {} particles, {} iterations and {} factorizations in {} solves",
@@ -64,7 +65,8 @@ fn bench<D: DimSystems>(c: &mut Criterion, label: &str, src: &Source) {
                 let mut fresh = world.clone();
                 spent += pool.install(|| {
                     let t0 = Instant::now();
-                    static_solve::run(&mut fresh, &mut None).expect("the load step solves");
+                    static_solve::run(&mut fresh, &mut Default::default())
+                        .expect("the load step solves");
                     t0.elapsed()
                 });
             }

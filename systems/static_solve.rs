@@ -21,6 +21,7 @@ use crate::store::crack::Fields;
 use crate::store::world::World;
 use crate::systems::{bin, classify, crack_advect, p2g};
 use crate::with_shape;
+use std::sync::Arc;
 
 mod cg;
 mod coarse;
@@ -37,7 +38,8 @@ mod supports;
 mod unknowns;
 mod vectors;
 
-pub use direct::Analysis;
+use coarse::Coarse;
+use direct::Analysis;
 use operator::{Law, elastic, mask, stiffness};
 use scatter::entry_sums;
 use solver::Solver;
@@ -65,11 +67,20 @@ const GHOST: f64 = 1e-11;
 /// nodes (a half and a quarter) above. At 3 % the turned DCB's K moved in the fourth digit.
 const LIGHT: f64 = 0.1;
 
+/// What a static scene keeps from one load step to the next: the direct solver's symbolic
+/// analysis, reused while K's pattern holds, and the coarse grid of `"two_level"`, reused
+/// while the supports and the crack fields under the particles hold.
+#[derive(Clone, Debug, Default)]
+pub struct Kept {
+    analysis: Option<Analysis>,
+    coarse: Option<Arc<Coarse>>,
+}
+
 /// Solves the load step ending at the next step's time and sets the particles to it: x =
 /// x0 + u, v = 0, grad u and the stress it gives; adds the work of the loads and the moving
 /// supports over the step (trapezoidal, exact for a linear response). Refuses a solve that
-/// does not converge. `kept` carries the direct solver's analysis from step to step.
-pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Option<Analysis>) -> Result<Solved, Unstable> {
+/// does not converge. `kept` carries the solvers' set-up from step to step ([`Kept`]).
+pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Kept) -> Result<Solved, Unstable> {
     let t_end = end_time(world);
     let before: Vec<D::Vec> = (world.particles.x.iter())
         .zip(&world.particles.x0)
@@ -116,7 +127,7 @@ pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Option<Analysis>) -> Result<
 /// over the step, from `held` (their displacement at the step's end).
 fn plastic_step<D: Dim>(
     world: &mut World<D>,
-    kept: &mut Option<Analysis>,
+    kept: &mut Kept,
     held: Option<Vec<D::Vec>>,
     start_forces: &[Vec<D::Vec>],
     before: &[D::Vec],
@@ -216,7 +227,7 @@ struct Solution<D: Dim> {
 /// first conjugate-gradient solve starts from `guess` (every entry's displacement).
 fn with_contact<D: Dim>(
     world: &World<D>,
-    kept: &mut Option<Analysis>,
+    kept: &mut Kept,
     held: Option<&[D::Vec]>,
     guess: Option<Vec<D::Vec>>,
     t_end: f64,

@@ -96,9 +96,8 @@ pub struct Schedule {
     grows: bool,
     /// What the last load step's solves took (static scenes), until taken.
     solved: Option<Solved>,
-    /// The direct solver's last symbolic analysis (static scenes), reused while K's
-    /// pattern holds.
-    analysis: Option<static_solve::Analysis>,
+    /// What the static solver keeps from one load step to the next.
+    kept: static_solve::Kept,
 }
 
 impl Schedule {
@@ -127,7 +126,7 @@ impl Schedule {
                 fracture,
                 grows,
                 solved: None,
-                analysis: None,
+                kept: Default::default(),
             };
         }
         let bc = !world.bcs.is_empty();
@@ -188,7 +187,7 @@ impl Schedule {
             fracture,
             grows,
             solved: None,
-            analysis: None,
+            kept: Default::default(),
         }
     }
 
@@ -322,7 +321,7 @@ impl Schedule {
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),
                 System::StaticSolve => {
-                    self.solved = Some(static_solve::run(world, &mut self.analysis)?);
+                    self.solved = Some(static_solve::run(world, &mut self.kept)?);
                 }
                 System::Fracture | System::Grow => continue,
             }

@@ -17,7 +17,7 @@
 use super::direct::{analyse, factorize};
 use super::operator::elastic;
 use super::unknowns::Unknowns;
-use super::{each_entry, entry_node};
+use super::{each_entry, entry_node, fields};
 use crate::base::dim::Dim;
 use crate::store::disjoint::Disjoint;
 use crate::store::world::World;
@@ -29,7 +29,7 @@ use rayon::prelude::*;
 
 /// The coarse nodes a fine node interpolates from, their weights, and how many (2^D at
 /// most).
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 struct Parents {
     node: [u32; 8],
     weight: [f64; 8],
@@ -59,7 +59,8 @@ const SHIFT: f64 = 1e-8;
 
 /// The coarse grid, its stiffness's Cholesky factor and the interpolation to the fine
 /// entries.
-pub(super) struct Coarse<D: Dim> {
+#[derive(Debug)]
+pub struct Coarse {
     /// Per fine entry, the coarse nodes it interpolates from.
     parents: Vec<Parents>,
     /// Per coarse node, `children[start[c]..start[c + 1]]`: the fine entries that take it
@@ -72,9 +73,12 @@ pub(super) struct Coarse<D: Dim> {
     count: usize,
     symbolic: SymbolicCholesky<usize>,
     factor: Vec<f64>,
-    /// Per fine entry, 1 on the components the interpolation moves (the unknowns' free
-    /// ones; a sliver's, its partner's), else 0.
-    keep: Vec<D::Vec>,
+    /// Per fine entry, bit a set where the interpolation moves component a (the unknowns'
+    /// free ones; a sliver's, its partner's).
+    keep: Vec<u8>,
+    /// The particles near a crack and their stencils' entries when it was made: with
+    /// `keep`, what decides P^T K P on a static scene's fixed particles.
+    targets: (Vec<u32>, Vec<u32>),
 }
 
 /// The coarse grid's shape: nodes per axis and linear strides.
@@ -96,11 +100,11 @@ impl Shape {
     }
 }
 
-impl<D: Dim> Coarse<D> {
+impl Coarse {
     /// The coarse grid of `world`'s grid with its stiffness on the unknowns `dofs`: the
     /// elastic P^T K P (without the ghost's, whose share is 1e-11). Says why when the
     /// factorization fails.
-    pub fn new(world: &World<D>, dofs: &Unknowns<D>) -> Result<Self, String> {
+    pub(super) fn new<D: Dim>(world: &World<D>, dofs: &Unknowns<D>) -> Result<Self, String> {
         let geom = &world.grid.geom;
         let mut nodes = [1usize; 3];
         for (n, &cells) in nodes.iter_mut().zip(&geom.cells).take(D::D) {
@@ -115,10 +119,7 @@ impl<D: Dim> Coarse<D> {
             .map(|e| parents_of::<D>(geom.stride, shape, entry_node(world, e)))
             .collect();
         let (start, children) = invert(&parents, nodes.iter().product());
-        let mut keep = dofs.free.clone();
-        for &(s, m) in &dofs.ties {
-            keep[s] = dofs.free[m];
-        }
+        let keep = keep_bits(dofs);
         let blocks = assemble(world, shape, &parents, &keep);
         let (unknown, count, pattern, values) = lower_triangle::<D>(shape, &blocks);
         let symbolic = analyse(&pattern, "the coarse grid")?;
@@ -139,18 +140,27 @@ impl<D: Dim> Coarse<D> {
             symbolic,
             factor,
             keep,
+            targets: targets(world),
         })
     }
 
+    /// Whether this is the coarse grid of the unknowns `dofs` of `world`: the same held
+    /// components and the same crack fields under the particles (a static scene's
+    /// particles, volumes and materials do not change), so that a load step whose cracks
+    /// and supports are the last one's reuses it.
+    pub(super) fn fits<D: Dim>(&self, world: &World<D>, dofs: &Unknowns<D>) -> bool {
+        self.keep == keep_bits(dofs) && self.targets == targets(world)
+    }
+
     /// Adds the coarse correction P (P^T K P)^-1 P^T r to `z`.
-    pub fn correct(&self, r: &[D::Vec], z: &mut [D::Vec]) {
+    pub(super) fn correct<D: Dim>(&self, r: &[D::Vec], z: &mut [D::Vec]) {
         let d = D::D;
         let restricted: Vec<D::Vec> = (0..self.start.len() - 1)
             .into_par_iter()
             .map(|c| {
                 let mut sum = D::zero();
                 for &(e, w) in &self.children[self.start[c]..self.start[c + 1]] {
-                    let (e, k) = (e as usize, self.keep[e as usize]);
+                    let (e, k) = (e as usize, mask::<D>(self.keep[e as usize]));
                     for a in 0..d {
                         sum[a] += w * k[a] * r[e][a];
                     }
@@ -178,7 +188,7 @@ impl<D: Dim> Coarse<D> {
         );
         z.par_iter_mut().enumerate().for_each(|(e, z)| {
             let p = &self.parents[e];
-            let k = self.keep[e];
+            let k = mask::<D>(self.keep[e]);
             for j in 0..p.count as usize {
                 let c = p.node[j] as usize;
                 for a in 0..d {
@@ -190,6 +200,30 @@ impl<D: Dim> Coarse<D> {
             }
         });
     }
+}
+
+/// Per entry, the bits of the components the interpolation moves: the free ones, a
+/// sliver's its partner's.
+fn keep_bits<D: Dim>(dofs: &Unknowns<D>) -> Vec<u8> {
+    let bits = |k: D::Vec| (0..D::D).fold(0u8, |b, a| b | (u8::from(k[a] != 0.0) << a));
+    let mut keep: Vec<u8> = dofs.free.iter().map(|&k| bits(k)).collect();
+    for &(s, m) in &dofs.ties {
+        keep[s] = keep[m];
+    }
+    keep
+}
+
+/// The vector with 1 on the components of `bits`, 0 elsewhere.
+#[inline(always)]
+fn mask<D: Dim>(bits: u8) -> D::Vec {
+    let mut k = D::zero();
+    (0..D::D).for_each(|a| k[a] = f64::from(bits >> a & 1));
+    k
+}
+
+/// The particles near a crack and their stencils' entries (none without cracks).
+fn targets<D: Dim>(world: &World<D>) -> (Vec<u32>, Vec<u32>) {
+    fields(world).map_or_else(Default::default, |f| (f.coded.clone(), f.targets.clone()))
 }
 
 /// The coarse nodes fine node `n` interpolates from: per axis the coarse node at an even
@@ -277,12 +311,7 @@ fn offset<D: Dim>(row: [usize; 3], col: [usize; 3]) -> usize {
 /// passes (bins 0, 3, 6, ..., then 1, 4, ..., then 2, 5, ...), the bins of a pass in
 /// parallel on disjoint rows: each row sums its terms in the same order for any thread
 /// count.
-fn assemble<D: Dim>(
-    world: &World<D>,
-    shape: Shape,
-    parents: &[Parents],
-    keep: &[D::Vec],
-) -> Vec<f64> {
+fn assemble<D: Dim>(world: &World<D>, shape: Shape, parents: &[Parents], keep: &[u8]) -> Vec<f64> {
     let last = D::D - 1;
     let planes = shape.nodes[last];
     let p = &world.particles;
@@ -343,7 +372,7 @@ unsafe fn add_particle<D: Dim>(
     world: &World<D>,
     shape: Shape,
     parents: &[Parents],
-    keep: &[D::Vec],
+    keep: &[u8],
     i: usize,
     low: [u32; 3],
     rows: &Disjoint<f64>,
@@ -355,7 +384,7 @@ unsafe fn add_particle<D: Dim>(
     let mut whole = true;
     each_entry(world, i, |e, _, g| {
         let q = &parents[e];
-        let k = keep[e];
+        let k = mask::<D>(keep[e]);
         whole &= (0..D::D).all(|a| k[a] == 1.0);
         for j in 0..q.count as usize {
             let slot = (0..D::D).rev().fold(0, |s, a| {

@@ -10,6 +10,7 @@ use super::unknowns::Unknowns;
 use super::vectors::Sums;
 use crate::base::dim::Dim;
 use crate::store::world::World;
+use std::sync::Arc;
 
 /// The shared state of the solves on one set of unknowns.
 pub(super) struct Frame<D: Dim> {
@@ -20,12 +21,12 @@ pub(super) struct Frame<D: Dim> {
     /// An orthonormal basis of the rigid motions K leaves free.
     pub modes: Vec<Vec<D::Vec>>,
     /// The coarse grid under the Jacobi preconditioner, where the solver has one.
-    pub coarse: Option<Coarse<D>>,
+    pub coarse: Option<Arc<Coarse>>,
 }
 
 impl<D: Dim> Frame<D> {
     /// The frame of the unknowns `dofs`, with the `coarse` grid given.
-    pub fn new(world: &World<D>, dofs: &Unknowns<D>, coarse: Option<Coarse<D>>) -> Self {
+    pub fn new(world: &World<D>, dofs: &Unknowns<D>, coarse: Option<Arc<Coarse>>) -> Self {
         let diag = diagonal(world, dofs);
         let largest = (diag.iter().zip(&dofs.free))
             .flat_map(|(d, k)| (0..D::D).filter(|&a| k[a] != 0.0).map(|a| d[a]))

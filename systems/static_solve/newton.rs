@@ -6,7 +6,7 @@
 //! projected return, Miehe 1996), which keeps the iteration quadratic. The
 //! particles' state changes only when the step converges.
 
-use super::Analysis;
+use super::Kept;
 use super::frame::Frame;
 use super::operator::{Law, mask, stiffness};
 use super::solver::Solver;
@@ -66,7 +66,7 @@ pub(super) struct Step<D: Dim> {
 /// the moving supports' displacement increment `held` over the step.
 pub(super) fn solve<D: Dim>(
     world: &World<D>,
-    kept: &mut Option<Analysis>,
+    kept: &mut Kept,
     dofs: &Unknowns<D>,
     held: Option<&[D::Vec]>,
     t_end: f64,

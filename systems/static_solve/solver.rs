@@ -3,9 +3,10 @@
 //! scene's dimension and the ranks choose, on the unknowns' [`Frame`] (with the direct
 //! solver's pattern and symbolic analysis, or the coarse grid's factor, made once here).
 
+use super::Kept;
 use super::cg::conjugate_gradients;
 use super::coarse::Coarse;
-use super::direct::{Analysis, Direct};
+use super::direct::Direct;
 use super::frame::Frame;
 use super::operator::Law;
 use super::unknowns::Unknowns;
@@ -13,6 +14,7 @@ use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::record::solve_log::Solved;
 use crate::store::world::{LinearSolver, World};
+use std::sync::Arc;
 
 /// The solves on one set of unknowns.
 pub(super) struct Solver<D: Dim> {
@@ -28,11 +30,7 @@ impl<D: Dim> Solver<D> {
     /// The solver of the unknowns `dofs` (`kept`: the direct solver's last analysis, which
     /// takes this one's). Refuses a direct solve (`linear = "direct"`) whose factor would
     /// not fit in memory; under "auto" such a scene goes to conjugate gradients.
-    pub fn new(
-        world: &World<D>,
-        dofs: &Unknowns<D>,
-        kept: &mut Option<Analysis>,
-    ) -> Result<Self, Unstable> {
+    pub fn new(world: &World<D>, dofs: &Unknowns<D>, kept: &mut Kept) -> Result<Self, Unstable> {
         let failed = |what: String| Unstable {
             step: world.step + 1,
             time: (world.step + 1) as f64 * world.settings.dt,
@@ -44,20 +42,28 @@ impl<D: Dim> Solver<D> {
             LinearSolver::Auto => D::D == 3 && !split,
             _ => false,
         };
-        let coarse = match coarse {
-            true => Some(Coarse::new(world, dofs).map_err(failed)?),
-            false => None,
+        let coarse = match (coarse, &kept.coarse) {
+            (false, _) => None,
+            (true, Some(c)) if c.fits(world, dofs) => Some(c.clone()),
+            (true, _) => {
+                let c = Arc::new(Coarse::new(world, dofs).map_err(failed)?);
+                kept.coarse = Some(c.clone());
+                Some(c)
+            }
         };
         let frame = Frame::new(world, dofs, coarse);
         let (direct, too_large) = match world.settings.linear {
             LinearSolver::Cg | LinearSolver::TwoLevel => (None, false),
             LinearSolver::Auto if D::D == 3 || split => (None, false),
-            LinearSolver::Auto => match Direct::new(world, dofs, &frame.modes, kept) {
-                Ok(d) => (Some(d), false),
-                Err(_) => (None, true),
-            },
+            LinearSolver::Auto => {
+                match Direct::new(world, dofs, &frame.modes, &mut kept.analysis) {
+                    Ok(d) => (Some(d), false),
+                    Err(_) => (None, true),
+                }
+            }
             LinearSolver::Direct => {
-                let direct = Direct::new(world, dofs, &frame.modes, kept).map_err(failed)?;
+                let direct =
+                    Direct::new(world, dofs, &frame.modes, &mut kept.analysis).map_err(failed)?;
                 (Some(direct), false)
             }
         };
