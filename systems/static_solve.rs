@@ -24,6 +24,7 @@ use crate::with_shape;
 use std::sync::Arc;
 
 mod cg;
+mod cholesky;
 mod coarse;
 mod dilatation;
 mod direct;

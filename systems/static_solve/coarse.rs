@@ -14,7 +14,7 @@
 //! on which the right-hand side vanishes: a relative [`SHIFT`] on the diagonal keeps the
 //! factorization defined there, and the solve's deflation takes the motions out.
 
-use super::direct::{analyse, factorize};
+use super::cholesky::{analyse, factorize};
 use super::operator::elastic;
 use super::unknowns::Unknowns;
 use super::{each_entry, entry_node, fields};

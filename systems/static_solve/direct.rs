@@ -5,6 +5,7 @@
 //! serve every factorization on it: each Newton iteration, and the next load steps while
 //! the pattern holds.
 
+use super::cholesky::{analyse, factorize};
 use super::dilatation::{Groups, isotropic, trace};
 use super::frame::Frame;
 use super::operator::{Law, apply};
@@ -18,12 +19,9 @@ use crate::record::solve_log::Solved;
 use crate::store::disjoint::Disjoint;
 use crate::store::world::World;
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{
-    LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
-};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{Conj, MatMut, Par, Side};
+use faer::sparse::SymbolicSparseColMat;
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
+use faer::{Conj, MatMut, Par};
 use std::collections::HashSet;
 use std::sync::Arc;
 
@@ -604,45 +602,6 @@ fn pattern<D: Dim>(
     }
     let n = layout.count;
     SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx)
-}
-
-/// The symbolic Cholesky factorization of the lower triangle `pattern` after an
-/// approximate minimum degree ordering; `whose` names the solver in the error.
-pub(super) fn analyse(
-    pattern: &SymbolicSparseColMat<usize>,
-    whose: &str,
-) -> Result<SymbolicCholesky<usize>, String> {
-    factorize_symbolic_cholesky(
-        pattern.as_ref(),
-        Side::Lower,
-        SymmetricOrdering::Amd,
-        Default::default(),
-    )
-    .map_err(|e| format!("{whose}'s symbolic analysis failed: {e:?}"))
-}
-
-/// The numeric Cholesky factor of K's lower triangle `values` on `pattern`, on one thread
-/// (the same bits for any thread count), in `memory`; None where K is not positive
-/// definite.
-pub(super) fn factorize(
-    symbolic: &SymbolicCholesky<usize>,
-    pattern: &SymbolicSparseColMat<usize>,
-    values: &[f64],
-    memory: &mut MemBuffer,
-) -> Option<Vec<f64>> {
-    let mut factor = vec![0.0; symbolic.len_val()];
-    symbolic
-        .factorize_numeric_llt(
-            &mut factor,
-            SparseColMatRef::new(pattern.as_ref(), values),
-            Side::Lower,
-            LltRegularization::default(),
-            Par::Seq,
-            MemStack::new(memory),
-            Default::default(),
-        )
-        .ok()?;
-    Some(factor)
 }
 
 /// Bytes in a GiB.
