@@ -27,9 +27,10 @@ pub(super) struct Solver<D: Dim> {
 }
 
 impl<D: Dim> Solver<D> {
-    /// The solver of the unknowns `dofs` (`kept`: the direct solver's last analysis, which
-    /// takes this one's). Refuses a direct solve (`linear = "direct"`) whose factor would
-    /// not fit in memory; under "auto" such a scene goes to conjugate gradients.
+    /// The solver of the unknowns `dofs` (`kept`: the last load step's direct analysis and
+    /// coarse grid, reused when they fit these unknowns, else replaced by this one's).
+    /// Refuses a direct solve (`linear = "direct"`) whose factor would not fit in memory;
+    /// under "auto" such a scene goes to conjugate gradients.
     pub fn new(world: &World<D>, dofs: &Unknowns<D>, kept: &mut Kept) -> Result<Self, Unstable> {
         let failed = |what: String| Unstable {
             step: world.step + 1,
