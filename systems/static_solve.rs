@@ -75,6 +75,16 @@ const LIGHT: f64 = 0.1;
 pub struct Kept {
     analysis: Option<Analysis>,
     coarse: Option<Arc<Coarse>>,
+    /// The coarse grid's stiffnesses factorized so far.
+    coarse_factorizations: u64,
+}
+
+impl Kept {
+    /// The coarse grid's stiffnesses factorized since this was made (a run resumed from a
+    /// snapshot makes its first afresh).
+    pub fn coarse_factorizations(&self) -> u64 {
+        self.coarse_factorizations
+    }
 }
 
 /// Solves the load step ending at the next step's time and sets the particles to it: x =

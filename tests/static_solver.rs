@@ -831,6 +831,38 @@ fn quasi_static_growth_reads_the_k_of_the_cut_plate() {
     }
 }
 
+/// A crack that grows gives particles new entries of the same nodes, whose values the
+/// coarse grid interpolates alike: the coarse stiffness stays what it was and its factor is
+/// kept. The edge plate growing five extensions under `linear = "two_level"` factorizes the
+/// coarse grid once, and every check reads the K_I of the direct solver's run to 1e-6
+/// (both stop at 1e-8 of the load).
+#[test]
+fn a_growing_crack_keeps_the_coarse_factor() {
+    let plate = |linear: &str| {
+        let text = common::edge_plate(common::PARIS_GROWTH, 2.8e-5).replace(
+            "[simulation]",
+            &format!("[simulation]\nsolver = \"static\"\nload_steps = 7\nlinear = \"{linear}\""),
+        );
+        fissure::app::run::run(&source(&text), &Default::default())
+            .unwrap_or_else(|e| panic!("{e:#}"))
+    };
+    let (coarse, direct) = (plate("two_level"), plate("direct"));
+    let log = coarse.summary.static_solve.as_ref().unwrap();
+    assert_eq!(log.coarse_factorizations, 1, "{log:?}");
+    let (a, b) = (&coarse.history.growth, &direct.history.growth);
+    assert_eq!((a.len(), b.len()), (5, 5));
+    for (a, b) in a.iter().zip(b) {
+        assert_eq!(a.grown, b.grown);
+        assert!(
+            (a.k[0] - b.k[0]).abs() <= 1e-6 * b.k[0],
+            "grown {}: {} against {}",
+            a.grown,
+            a.k[0],
+            b.k[0]
+        );
+    }
+}
+
 /// solver.csv: one row per load step (numbered 1 to n), each under the scene's tolerance,
 /// their Newton iterations adding up to summary.json's total; the file holds the rows the
 /// history keeps (and a resumed run rewrites them: `tests/snapshot.rs`).

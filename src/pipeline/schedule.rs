@@ -191,6 +191,12 @@ impl Schedule {
         }
     }
 
+    /// The static solve's coarse-grid factorizations so far (see
+    /// [`static_solve::Kept::coarse_factorizations`]).
+    pub fn coarse_factorizations(&self) -> u64 {
+        self.kept.coarse_factorizations()
+    }
+
     /// What the last load step's solves took (a static scene; None once taken, and in an
     /// explicit scene).
     pub fn take_solved(&mut self) -> Option<Solved> {

@@ -59,6 +59,10 @@ pub struct SolveLog {
     /// Load steps whose direct solve (under "auto") was too large for the memory available
     /// and went to conjugate gradients.
     pub too_large: u64,
+    /// The coarse grid's stiffnesses factorized by this invocation (`linear =
+    /// "two_level"`): one, and another only when the supports the particles see change (a
+    /// grown crack keeps it); a resumed run makes its first afresh.
+    pub coarse_factorizations: u64,
 }
 
 /// One load step's solve, as solver.csv and the snapshot keep it.

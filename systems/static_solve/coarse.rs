@@ -26,6 +26,7 @@ use faer::sparse::SymbolicSparseColMat;
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::{Conj, MatMut, Par};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// The coarse nodes a fine node interpolates from, their weights, and how many (2^D at
 /// most).
@@ -57,8 +58,9 @@ const RATIO: usize = 4;
 /// The relative stiffness added to the coarse diagonal (see the module's doc).
 const SHIFT: f64 = 1e-8;
 
-/// The coarse grid, its stiffness's Cholesky factor and the interpolation to the fine
-/// entries.
+/// The coarse grid: the interpolation to the fine entries and its stiffness's factor,
+/// which a set of unknowns whose particles see the same held components shares with the
+/// last one (a crack that grows changes the entries, not P^T K P: [`Coarse::new`]).
 #[derive(Debug)]
 pub struct Coarse {
     /// Per fine entry, the coarse nodes it interpolates from.
@@ -67,18 +69,103 @@ pub struct Coarse {
     /// and their weights, in entry order.
     start: Vec<usize>,
     children: Vec<(u32, f64)>,
+    /// Per fine entry, bit a set where the interpolation moves component a (the unknowns'
+    /// free ones; a sliver's, its partner's).
+    keep: Vec<u8>,
+    /// The entries the particles near a crack took when it was made: with `keep`, what
+    /// decides P^T K P on a static scene's fixed particles.
+    layout: Layout,
+    /// P^T K P's factor.
+    stiffness: Arc<Stiffness>,
+}
+
+/// The coarse stiffness P^T K P on its unknowns, factorized.
+#[derive(Debug)]
+struct Stiffness {
     /// Per coarse node and axis, its unknown (u32::MAX: none: no particle moves it).
     unknown: Vec<u32>,
     /// How many unknowns.
     count: usize,
     symbolic: SymbolicCholesky<usize>,
     factor: Vec<f64>,
-    /// Per fine entry, bit a set where the interpolation moves component a (the unknowns'
-    /// free ones; a sliver's, its partner's).
-    keep: Vec<u8>,
-    /// The particles near a crack and their stencils' entries when it was made: with
-    /// `keep`, what decides P^T K P on a static scene's fixed particles.
-    targets: (Vec<u32>, Vec<u32>),
+}
+
+/// Which grid entry each particle near a crack takes at each node of its stencil (the
+/// others take their nodes' own entries).
+#[derive(Debug, Default, PartialEq)]
+struct Layout {
+    /// Grid nodes (the crack fields' rows are the entries from here on).
+    nodes: usize,
+    /// Stencil nodes per particle.
+    per: usize,
+    /// The particles near a crack, in increasing order, and their entries (`per` each).
+    coded: Vec<u32>,
+    targets: Vec<u32>,
+    /// The node of each crack field's row.
+    rows: Vec<u32>,
+}
+
+impl Layout {
+    /// The entries of `world`'s particles after `classify`.
+    fn of<D: Dim>(world: &World<D>) -> Self {
+        let nodes = world.grid.geom.node_count();
+        fields(world).map_or_else(
+            || Layout {
+                nodes,
+                ..Layout::default()
+            },
+            |f| Layout {
+                nodes,
+                per: f.per,
+                coded: f.coded.clone(),
+                targets: f.targets.clone(),
+                rows: f.node.clone(),
+            },
+        )
+    }
+
+    /// The node of entry `e`.
+    fn node_of(&self, e: u32) -> u32 {
+        match (e as usize).checked_sub(self.nodes) {
+            Some(r) => self.rows[r],
+            None => e,
+        }
+    }
+
+    /// Whether every particle, at every node of its stencil, takes an entry with the same
+    /// `keep` bits here as in `last` with `last_keep`: then P^T K P is the same, bit for
+    /// bit (each particle's interpolated gradients are).
+    fn sees_as(&self, keep: &[u8], last: &Layout, last_keep: &[u8]) -> bool {
+        let n = self.nodes;
+        if n != last.nodes || keep.get(..n) != last_keep.get(..n) || self.per != last.per {
+            return false;
+        }
+        let per = self.per;
+        let (mut i, mut j) = (0, 0);
+        while i < self.coded.len() || j < last.coded.len() {
+            // A particle of one list only takes its nodes' own entries in the other.
+            let (mine, theirs) = match (self.coded.get(i), last.coded.get(j)) {
+                (Some(a), Some(b)) => (a <= b, b <= a),
+                (a, b) => (a.is_some(), b.is_some()),
+            };
+            for k in 0..per {
+                let here = || self.targets[i * per + k];
+                let there = || last.targets[j * per + k];
+                let e = if mine { here() } else { last.node_of(there()) };
+                let f = if theirs {
+                    there()
+                } else {
+                    self.node_of(here())
+                };
+                if keep[e as usize] != last_keep[f as usize] {
+                    return false;
+                }
+            }
+            i += usize::from(mine);
+            j += usize::from(theirs);
+        }
+        true
+    }
 }
 
 /// The coarse grid's shape: nodes per axis and linear strides.
@@ -102,9 +189,16 @@ impl Shape {
 
 impl Coarse {
     /// The coarse grid of `world`'s grid with its stiffness on the unknowns `dofs`: the
-    /// elastic P^T K P (without the ghost's, whose share is 1e-11). Says why when the
+    /// elastic P^T K P (without the ghost's, whose share is 1e-11), taken from `last` (the
+    /// last load step's) where every particle sees the same held components through its
+    /// entries (a grown crack gives particles new entries of the same nodes, whose values
+    /// P interpolates alike), else assembled and factorized. Says why when the
     /// factorization fails.
-    pub(super) fn new<D: Dim>(world: &World<D>, dofs: &Unknowns<D>) -> Result<Self, String> {
+    pub(super) fn new<D: Dim>(
+        world: &World<D>,
+        dofs: &Unknowns<D>,
+        last: Option<&Coarse>,
+    ) -> Result<Self, String> {
         let geom = &world.grid.geom;
         let mut nodes = [1usize; 3];
         for (n, &cells) in nodes.iter_mut().zip(&geom.cells).take(D::D) {
@@ -120,27 +214,18 @@ impl Coarse {
             .collect();
         let (start, children) = invert(&parents, nodes.iter().product());
         let keep = keep_bits(dofs);
-        let blocks = assemble(world, shape, &parents, &keep);
-        let (unknown, count, pattern, values) = lower_triangle::<D>(shape, &blocks);
-        let symbolic = analyse(&pattern, "the coarse grid")?;
-        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
-        let mut memory = MemBuffer::try_new(scratch)
-            .map_err(|_| "out of memory for the coarse grid's factorization".to_string())?;
-        let factor = factorize(&symbolic, &pattern, &values, &mut memory).ok_or_else(|| {
-            "the coarse grid's stiffness is not positive definite: set [simulation] linear = \
-             \"cg\""
-                .to_string()
-        })?;
+        let layout = Layout::of(world);
+        let stiffness = match last {
+            Some(c) if layout.sees_as(&keep, &c.layout, &c.keep) => c.stiffness.clone(),
+            _ => Arc::new(Stiffness::new::<D>(world, shape, &parents, &keep)?),
+        };
         Ok(Coarse {
             parents,
             start,
             children,
-            unknown,
-            count,
-            symbolic,
-            factor,
             keep,
-            targets: targets(world),
+            layout,
+            stiffness,
         })
     }
 
@@ -149,12 +234,18 @@ impl Coarse {
     /// particles, volumes and materials do not change), so that a load step whose cracks
     /// and supports are the last one's reuses it.
     pub(super) fn fits<D: Dim>(&self, world: &World<D>, dofs: &Unknowns<D>) -> bool {
-        self.keep == keep_bits(dofs) && self.targets == targets(world)
+        self.keep == keep_bits(dofs) && self.layout == Layout::of(world)
+    }
+
+    /// Whether this coarse grid shares its factor with `other` (made by [`Coarse::new`]
+    /// from it).
+    pub(super) fn shares_factor(&self, other: &Coarse) -> bool {
+        Arc::ptr_eq(&self.stiffness, &other.stiffness)
     }
 
     /// Adds the coarse correction P (P^T K P)^-1 P^T r to `z`.
     pub(super) fn correct<D: Dim>(&self, r: &[D::Vec], z: &mut [D::Vec]) {
-        let d = D::D;
+        let (d, s) = (D::D, &*self.stiffness);
         let restricted: Vec<D::Vec> = (0..self.start.len() - 1)
             .into_par_iter()
             .map(|c| {
@@ -168,21 +259,21 @@ impl Coarse {
                 sum
             })
             .collect();
-        let mut x = vec![0.0; self.count];
+        let mut x = vec![0.0; s.count];
         for (c, v) in restricted.iter().enumerate() {
             for a in 0..d {
-                let u = self.unknown[c * d + a];
+                let u = s.unknown[c * d + a];
                 if u != u32::MAX {
                     x[u as usize] = v[a];
                 }
             }
         }
-        let llt = LltRef::<usize, f64>::new(&self.symbolic, &self.factor);
-        let scratch = self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
+        let llt = LltRef::<usize, f64>::new(&s.symbolic, &s.factor);
+        let scratch = s.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
         let mut memory = MemBuffer::new(scratch);
         llt.solve_in_place_with_conj(
             Conj::No,
-            MatMut::from_column_major_slice_mut(&mut x, self.count, 1),
+            MatMut::from_column_major_slice_mut(&mut x, s.count, 1),
             Par::Seq,
             MemStack::new(&mut memory),
         );
@@ -192,13 +283,41 @@ impl Coarse {
             for j in 0..p.count as usize {
                 let c = p.node[j] as usize;
                 for a in 0..d {
-                    let u = self.unknown[c * d + a];
+                    let u = s.unknown[c * d + a];
                     if u != u32::MAX {
                         z[a] += p.weight[j] * k[a] * x[u as usize];
                     }
                 }
             }
         });
+    }
+}
+
+impl Stiffness {
+    /// P^T K P assembled on the interpolation `parents` with the `keep` bits, factorized.
+    fn new<D: Dim>(
+        world: &World<D>,
+        shape: Shape,
+        parents: &[Parents],
+        keep: &[u8],
+    ) -> Result<Self, String> {
+        let blocks = assemble(world, shape, parents, keep);
+        let (unknown, count, pattern, values) = lower_triangle::<D>(shape, &blocks);
+        let symbolic = analyse(&pattern, "the coarse grid")?;
+        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
+        let mut memory = MemBuffer::try_new(scratch)
+            .map_err(|_| "out of memory for the coarse grid's factorization".to_string())?;
+        let factor = factorize(&symbolic, &pattern, &values, &mut memory).ok_or_else(|| {
+            "the coarse grid's stiffness is not positive definite: set [simulation] linear = \
+             \"cg\""
+                .to_string()
+        })?;
+        Ok(Stiffness {
+            unknown,
+            count,
+            symbolic,
+            factor,
+        })
     }
 }
 
@@ -219,11 +338,6 @@ fn mask<D: Dim>(bits: u8) -> D::Vec {
     let mut k = D::zero();
     (0..D::D).for_each(|a| k[a] = f64::from(bits >> a & 1));
     k
-}
-
-/// The particles near a crack and their stencils' entries (none without cracks).
-fn targets<D: Dim>(world: &World<D>) -> (Vec<u32>, Vec<u32>) {
-    fields(world).map_or_else(Default::default, |f| (f.coded.clone(), f.targets.clone()))
 }
 
 /// The coarse nodes fine node `n` interpolates from: per axis the coarse node at an even

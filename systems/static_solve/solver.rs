@@ -46,8 +46,13 @@ impl<D: Dim> Solver<D> {
         let coarse = match (coarse, &kept.coarse) {
             (false, _) => None,
             (true, Some(c)) if c.fits(world, dofs) => Some(c.clone()),
-            (true, _) => {
-                let c = Arc::new(Coarse::new(world, dofs).map_err(failed)?);
+            (true, last) => {
+                let last = last.as_deref();
+                let c = Coarse::new(world, dofs, last).map_err(failed)?;
+                if last.is_none_or(|l| !c.shares_factor(l)) {
+                    kept.coarse_factorizations += 1;
+                }
+                let c = Arc::new(c);
                 kept.coarse = Some(c.clone());
                 Some(c)
             }

@@ -401,8 +401,12 @@ impl<'a, D: DimSystems> Run<'a, D> {
             tips_on_lines: self.tips_on_lines.clone(),
             split_boundaries: reports::split_boundaries(world),
             energies: world.energies(),
-            static_solve: (world.settings.solver == crate::store::world::Solver::Static)
-                .then(|| SolveLog::from_rows(&history.solves)),
+            static_solve: (world.settings.solver == crate::store::world::Solver::Static).then(
+                || SolveLog {
+                    coarse_factorizations: self.schedule.coarse_factorizations(),
+                    ..SolveLog::from_rows(&history.solves)
+                },
+            ),
             ranks: reports::ranks(world, steps_run),
             ignored_keys: crate::io::scenario::ignored(self.src),
             probes: reports::probes(&self.probes, history),
