@@ -30,6 +30,7 @@ mod dilatation;
 mod direct;
 mod faces;
 mod frame;
+mod hold;
 mod newton;
 mod operator;
 mod rigid;
@@ -99,7 +100,7 @@ pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Kept) -> Result<Solved, Unst
         .collect();
     // The stiffness lives on the initial positions.
     let p = &mut world.particles;
-    p.x.copy_from_slice(&p.x0);
+    let x = std::mem::replace(&mut p.x, p.x0.clone());
     world.tiles.fresh = false;
     bin::run(world)?;
     classify::run(world)?;
@@ -112,6 +113,14 @@ pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Kept) -> Result<Solved, Unst
     let grid = &mut world.grid;
     for (f, &m) in grid.force.iter_mut().zip(&grid.mass) {
         *f += g * m;
+    }
+    if hold::unchanged(world, t_start, t_end) {
+        world.particles.x.copy_from_slice(&x);
+        supports::reactions_at_rest(world, t_end);
+        return Ok(Solved::KEPT);
+    }
+    if let Some(c) = &mut world.cracks {
+        c.solved = Some(c.topology.version());
     }
     let held = supports::prescribed(world, t_end);
     let start_forces = supports::start_forces(world, t_start);

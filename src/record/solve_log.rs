@@ -16,7 +16,8 @@ pub struct Solved {
     pub imbalance: f64,
     /// Crack-face pairs closed at the solution.
     pub closed_faces: usize,
-    /// Solves the contact active set took (1 without contact).
+    /// Solves the contact active set took (1 without contact; 0 for a load step that
+    /// changed nothing and kept the last answer).
     pub contact_rounds: usize,
     /// Newton iterations (plastic scenes; 0 for a linear step, which solves once).
     pub newton: usize,
@@ -27,6 +28,41 @@ pub struct Solved {
     /// Whether "auto" chose the direct solve and went to conjugate gradients instead, its
     /// factor being too large for the memory available.
     pub too_large: bool,
+}
+
+impl Solved {
+    /// A load step that changed nothing (the same loads and supports at both ends, the
+    /// cracks as the last solve left them): no solve.
+    pub const KEPT: Solved = Solved {
+        iterations: 0,
+        residual: 0.0,
+        free_motions: 0,
+        imbalance: 0.0,
+        closed_faces: 0,
+        contact_rounds: 0,
+        newton: 0,
+        factorizations: 0,
+        factor_entries: 0,
+        too_large: false,
+    };
+
+    /// Whether this step kept the last answer ([`Solved::KEPT`]): every solve takes at
+    /// least one contact round.
+    pub fn kept(&self) -> bool {
+        self.contact_rounds == 0
+    }
+
+    /// The row of a step that kept the answer of the step whose row is `last`: its
+    /// residual, rigid motions, imbalance and closed faces, no work.
+    pub fn keeping(last: &Solved) -> Solved {
+        Solved {
+            residual: last.residual,
+            free_motions: last.free_motions,
+            imbalance: last.imbalance,
+            closed_faces: last.closed_faces,
+            ..Solved::KEPT
+        }
+    }
 }
 
 /// What a static scene's load steps took: counts, iterations and the worst residual.

@@ -2,10 +2,11 @@
 //! "two_level"`, the 3D default): the two-level additive Schwarz method (Dryja & Widlund
 //! 1987; Smith, Bjørstad & Gropp 1996, ch. 2). The grid of [`RATIO`] times the cell size
 //! carries each fine entry's displacement by multilinear interpolation P; its stiffness is
-//! the Galerkin P^T K P, summed particle by particle and factorized once per set of
-//! unknowns (faer's sparse Cholesky). The preconditioner is z = D^-1 r + P (P^T K P)^-1 P^T
-//! r: Jacobi damps the short waves of the error, the coarse solve the long ones that take
-//! Jacobi-preconditioned conjugate gradients hundreds of iterations.
+//! the Galerkin P^T K P, summed particle by particle and factorized (faer's sparse
+//! Cholesky) once per set of held components the particles see: a grown crack keeps it.
+//! The preconditioner is z = D^-1 r + P (P^T K P)^-1 P^T r: Jacobi damps the short waves
+//! of the error, the coarse solve the long ones that take Jacobi-preconditioned conjugate
+//! gradients hundreds of iterations.
 //!
 //! The coarse field is one per node whatever the cracks (a crack's faces move together on
 //! it): the opening is left to Jacobi and the iteration. Held components are held on P

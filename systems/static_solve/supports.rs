@@ -31,7 +31,7 @@ pub(super) fn prescribed<D: Dim>(world: &World<D>, t: f64) -> Option<Vec<D::Vec>
 }
 
 /// Whether support `bc` prescribes a non-zero velocity on a component it holds.
-fn moves<D: Dim>(bc: &VelocityBc<D>) -> bool {
+pub(super) fn moves<D: Dim>(bc: &VelocityBc<D>) -> bool {
     (0..D::D).any(|a| bc.axes[a] && bc.velocity[a] != 0.0)
 }
 
@@ -47,21 +47,43 @@ fn displacement<D: Dim>(bc: &VelocityBc<D>, t: f64) -> D::Vec {
 }
 
 /// Each support's force on the body per node at the start of the step, from the state the
-/// last step left: K u_old (the particles' stresses, C : sym(grad u_old), scattered as
-/// the internal force) less the loads and gravity at `t_start`, summed over the node's
-/// entries. The particles' stresses are in every snapshot, so a resumed run finds the
-/// same forces. Zero on the first step, which starts from the unloaded body, and where no
-/// support moves (a still support does no work): no pass over the particles then.
+/// last step left ([`node_forces`] at `t_start`). The particles' stresses are in every
+/// snapshot, so a resumed run finds the same forces. Zero on the first step, which starts
+/// from the unloaded body, and where no support moves (a still support does no work): no
+/// pass over the particles then.
 pub(super) fn start_forces<D: Dim>(world: &World<D>, t_start: f64) -> Vec<Vec<D::Vec>> {
-    let zero = || (world.bcs.iter()).map(|bc| vec![D::zero(); bc.nodes.len()]);
     if world.step == 0 || !world.bcs.iter().any(moves) {
-        return zero().collect();
+        return (world.bcs.iter())
+            .map(|bc| vec![D::zero(); bc.nodes.len()])
+            .collect();
+    }
+    node_forces(world, t_start)
+}
+
+/// Sets each support's reaction from the state the particles hold, at time `t`: its
+/// [`node_forces`] on the components it holds (a load step that solved nothing).
+pub(super) fn reactions_at_rest<D: Dim>(world: &mut World<D>, t: f64) {
+    let forces = node_forces(world, t);
+    for (bc, f) in world.bcs.iter_mut().zip(forces) {
+        for (r, f) in bc.reaction.iter_mut().zip(f) {
+            *r = D::zero();
+            (0..D::D).filter(|&a| bc.axes[a]).for_each(|a| r[a] = f[a]);
+        }
+    }
+}
+
+/// Each support's force on the body per node from the particles' state: K u (their
+/// stresses, scattered as the internal force) less the loads and gravity at `t`, summed
+/// over the node's entries.
+fn node_forces<D: Dim>(world: &World<D>, t: f64) -> Vec<Vec<D::Vec>> {
+    if world.bcs.is_empty() {
+        return Vec::new();
     }
     let p = &world.particles;
     let mut r = entry_sums(world, |i, _, g| {
         D::stress_dot(&p.stress[i], g) * p.volume[i]
     });
-    let loads = p2g::load_forces(world, t_start);
+    let loads = p2g::load_forces(world, t);
     let g = world.settings.gravity;
     for (e, r) in r.iter_mut().enumerate() {
         *r -= loads[e] + g * world.grid.mass[e];

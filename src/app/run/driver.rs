@@ -17,7 +17,7 @@ use crate::pipeline::distribute;
 use crate::pipeline::schedule::Schedule;
 use crate::record::expect::Expect;
 use crate::record::probe::Probe;
-use crate::record::solve_log::{SolveLog, SolveRow};
+use crate::record::solve_log::{SolveLog, SolveRow, Solved};
 use crate::record::state::RunState;
 use crate::store::world::World;
 use crate::systems::DimSystems;
@@ -245,7 +245,11 @@ impl<'a, D: DimSystems> Run<'a, D> {
             .map_err(Stop::Unstable)?;
         self.state.sample(&self.world, &self.probes);
         self.report(measured).map_err(Stop::Output)?;
-        if let Some(solved) = self.schedule.take_solved() {
+        if let Some(mut solved) = self.schedule.take_solved() {
+            let last = self.state.history.solves.last();
+            if let (true, Some(last)) = (solved.kept(), last) {
+                solved = Solved::keeping(&last.solved);
+            }
             let row = SolveRow {
                 step: self.world.step,
                 time: self.world.time,

@@ -147,6 +147,7 @@ fn write_with<D: Dim>(
     let tips: Vec<f64> = (world.cracks.iter())
         .flat_map(|cr| cr.tips.iter().flat_map(|t| t.values()))
         .collect();
+    let solved: Vec<u64> = (world.cracks.iter()).flat_map(|cr| cr.solved).collect();
     let mut c = ColumnSet::default();
     c.add("scenario.toml", src.text.as_bytes());
     c.add("scenario.file", src.file.as_bytes());
@@ -171,6 +172,7 @@ fn write_with<D: Dim>(
         c.add("cracks.top", &cr.geometry.top);
         c.add("cracks.bottom", &cr.geometry.bottom);
         c.add("cracks.tips", &tips);
+        c.add("cracks.solved", &solved);
     }
     c.add("history.fracture.step", &tip_steps);
     c.add("history.fracture.tip", &tip_ids);
@@ -330,6 +332,12 @@ fn read_cracks<D: Dim>(r: &mut Reader, cr: &mut Cracks<D>) -> Result<(), Snapsho
             .ok_or_else(|| r.invalid("cracks.tips: a tip's growth state is not one"))?
     } else {
         vec![TipState::default(); fronts]
+    };
+    // None: no static solve yet, or a snapshot from a build that did not keep it (the
+    // next load step solves).
+    cr.solved = match r.offset_of("cracks.solved") {
+        Some(_) => r.column_any::<u64>("cracks.solved")?.first().copied(),
+        None => None,
     };
     Ok(())
 }

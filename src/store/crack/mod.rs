@@ -76,6 +76,9 @@ pub struct Cracks<D: Dim> {
     pub geometry: Positions<D>,
     /// What each front's tip has grown (one per front, in the topology's order).
     pub tips: Vec<TipState>,
+    /// The topology's version at the last static solve (None before one): a static load
+    /// step after growth solves again.
+    pub solved: Option<u64>,
     /// Rebuilt or kept by the systems; not part of a snapshot.
     pub scratch: Scratch<D>,
 }
