@@ -355,6 +355,12 @@ fn switched(name: &str) -> fissure::io::scenario::Source {
     switched_with(name, &[])
 }
 
+/// The text of the shipped scenario `scenarios/{name}.toml`.
+fn shipped(name: &str) -> String {
+    let path = format!("{}/scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(&path).unwrap()
+}
+
 /// As [`switched`], with more `--set` overrides.
 fn switched_with(name: &str, more: &[&str]) -> fissure::io::scenario::Source {
     let path = format!("{}/scenarios/{name}.toml", env!("CARGO_MANIFEST_DIR"));
@@ -870,11 +876,7 @@ fn a_growing_crack_keeps_the_coarse_factor() {
 /// from the particles' stresses on the kept steps, balances the 100 N load to 1e-9.
 #[test]
 fn a_step_that_changes_nothing_keeps_the_last_answer() {
-    let path = format!(
-        "{}/scenarios/cantilever_static_2d.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let text = std::fs::read_to_string(&path).unwrap();
+    let text = shipped("cantilever_static_2d");
     let ramped = text.replace("load_steps = 1", "load_steps = 8").replace(
         "force = [0.0, -100.0]     # N",
         "force = [0.0, -100.0]\ntime = { kind = \"ramp\", rise = 0.5 }",
@@ -949,16 +951,12 @@ fn each_load_step_writes_its_solve_row() {
 /// iterations (a tangent that were not the return's derivative would take dozens).
 #[test]
 fn a_plane_stress_plastic_bar_solves_static() {
-    let path = format!(
-        "{}/scenarios/bar_plastic_2d.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let text = std::fs::read_to_string(&path).unwrap();
+    let text = shipped("bar_plastic_2d");
     let set = [
         "simulation.solver=\"static\"".to_string(),
         "simulation.load_steps=40".to_string(),
     ];
-    let src = fissure::io::scenario::Source::parse(&path, &text, &set).unwrap();
+    let src = fissure::io::scenario::Source::parse("bar_plastic_2d.toml", &text, &set).unwrap();
     let out = fissure::app::run::run(&src, &Default::default()).unwrap_or_else(|e| panic!("{e:#}"));
     let expect = |reference: f64| {
         let e = (out.summary.expects.iter())
