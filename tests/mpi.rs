@@ -472,7 +472,8 @@ fn alike_on_ranks(scene: &str, args: &[&str], dir: &Path, files: &[&str]) {
 }
 
 /// Static scenes (`solver = "static"`, conjugate gradients) split across ranks give one
-/// process's files byte for byte: a cantilever on its clamp (the reaction probe), the ENF
+/// process's files byte for byte: a cantilever on its clamp (the reaction probe; and with
+/// its load held over the last two of 4 load steps, which keep the answer), the ENF
 /// specimen whose crack faces close (the active set across the ranks' boundary, K_II), a
 /// straight 3D front (J and K along it), and a bar pulled past yield by a moving grip in 40
 /// load steps (Newton iterations with the return map), whose snapshot set written on 2
@@ -498,6 +499,25 @@ fn static_scenes_split_across_ranks_match_one_process() {
         let stem = Path::new(scene).file_stem().unwrap().to_string_lossy();
         alike_on_ranks(scene, &args, &dir.join(&*stem), files);
     }
+    // The cantilever's load ramped over half of 4 load steps: the last two keep the
+    // answer, their reactions taken from the particles' stresses on every rank.
+    let held = dir.join("cantilever_held");
+    let ramp = [
+        "--set",
+        "simulation.load_steps=4",
+        "--set",
+        "load[0].time={kind=\"ramp\",rise=0.5}",
+    ];
+    alike_on_ranks(
+        "scenarios/cantilever_static_2d.toml",
+        &[&cg[..], &ramp].concat(),
+        &held,
+        &solved,
+    );
+    let log = std::fs::read_to_string(held.join("serial/solver.csv")).unwrap();
+    let rounds = |l: &str| l.split(',').nth(6).unwrap().parse::<u32>().unwrap();
+    let kept: Vec<bool> = log.lines().skip(1).map(|l| rounds(l) == 0).collect();
+    assert_eq!(kept, [false, false, true, true], "{log}");
     let enf = std::fs::read_to_string(dir.join("enf_2d/serial/solver.csv")).unwrap();
     let row: Vec<&str> = enf.lines().nth(1).unwrap().split(',').collect();
     assert!(row[7].parse::<usize>().unwrap() > 0, "faces closed: {enf}");
