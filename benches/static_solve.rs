@@ -8,7 +8,9 @@
 //! (`scenarios/cantilever_static_2d.toml`, 16,000 particles, no crack), the DCB
 //! (`scenarios/dcb_2d.toml`, 9,600 particles, a crack: its fields are unknowns) and the
 //! ENF (`scenarios/enf_2d.toml`, frictionless faces: an active set of solves) switched to
-//! static, and the penny crack in a 30 mm cube (216,000 particles, 3D).
+//! static, and the penny crack in a 30 mm cube (216,000 particles, 3D), by conjugate
+//! gradients with Jacobi (`/cg`) and with the coarse grid (`/two_level`, the 3D default:
+//! its set-up is in the load step's time).
 //!
 //! `cargo bench --bench static_solve`.
 
@@ -87,12 +89,15 @@ fn static_solve(c: &mut Criterion) {
         bench::<D2>(c, &format!("dcb/{linear}"), &source("dcb_2d", linear));
         bench::<D2>(c, &format!("enf/{linear}"), &source("enf_2d", linear));
     }
-    let set = [
-        "simulation.solver=\"static\"".to_string(),
-        "simulation.load_steps=1".to_string(),
-    ];
-    let penny = Source::parse("penny.toml", PENNY, &set).expect("the penny scene parses");
-    bench::<D3>(c, "penny-216k", &penny);
+    for linear in ["cg", "two_level"] {
+        let set = [
+            "simulation.solver=\"static\"".to_string(),
+            "simulation.load_steps=1".to_string(),
+            format!("simulation.linear=\"{linear}\""),
+        ];
+        let penny = Source::parse("penny.toml", PENNY, &set).expect("the penny scene parses");
+        bench::<D3>(c, &format!("penny-216k/{linear}"), &penny);
+    }
 }
 
 criterion_group!(benches, static_solve);
