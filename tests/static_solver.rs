@@ -906,6 +906,32 @@ fn a_step_that_changes_nothing_keeps_the_last_answer() {
     );
     let reaction = *held.history.probes[1].last().unwrap();
     assert!((reaction - 100.0).abs() < 1e-7, "{reaction}");
+    // A ramp of 0.1 s over 7 load steps of 0.7 s: the first step ends at
+    // 0.09999999999999999 s, a rounding short of the ramp's top; the six after it keep
+    // the answer all the same.
+    let rounded = text
+        .replace("load_steps = 1", "load_steps = 7")
+        .replace("duration = 1.0", "duration = 0.7")
+        .replace(
+            "force = [0.0, -100.0]     # N",
+            "force = [0.0, -100.0]\ntime = { kind = \"ramp\", rise = 0.1 }",
+        );
+    assert!(rounded.contains("duration = 0.7") && rounded.contains("rise = 0.1"));
+    let out = run(&rounded);
+    assert!(
+        out.history.solves[0].time < 0.1,
+        "{}",
+        out.history.solves[0].time
+    );
+    let kept: Vec<bool> = (out.history.solves.iter())
+        .map(|r| r.solved.kept())
+        .collect();
+    assert_eq!(kept, [false, true, true, true, true, true, true]);
+    let tip = *out.history.probes[0].last().unwrap();
+    assert!(
+        (tip - want).abs() <= 1e-12 * want.abs(),
+        "{tip} against {want}"
+    );
 }
 
 /// solver.csv: one row per load step (numbered 1 to n), each under the scene's tolerance,
