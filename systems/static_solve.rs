@@ -117,7 +117,8 @@ pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Kept) -> Result<Solved, Unst
     if hold::unchanged(world, t_start, t_end) {
         world.particles.x.copy_from_slice(&x);
         supports::reactions_at_rest(world, t_end);
-        return Ok(Solved::KEPT);
+        // No solve: a row with no contact round (`Solved::kept`).
+        return Ok(Solved::default());
     }
     if let Some(c) = &mut world.cracks {
         c.solved = Some(c.topology.version());
@@ -435,18 +436,9 @@ fn reactions<D: Dim>(world: &mut World<D>, dofs: &Unknowns<D>, law: Law<D>, u: &
     stiffness(world, law, u, dofs, &mut ku);
     let force = &world.grid.force;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
-    for bc in &mut world.bcs {
-        for (k, &n) in bc.nodes.iter().enumerate() {
-            let r = (entries(n, fields)).fold(D::zero(), |r, e| r + ku[e] - force[e]);
-            let mut held = D::zero();
-            for a in 0..D::D {
-                if bc.axes[a] {
-                    held[a] = r[a];
-                }
-            }
-            bc.reaction[k] = held;
-        }
-    }
+    supports::set_reactions(&mut world.bcs, |n| {
+        (entries(n, fields)).fold(D::zero(), |r, e| r + ku[e] - force[e])
+    });
 }
 
 /// The work of the particle loads and gravity over the step (particle displacements

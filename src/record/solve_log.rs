@@ -31,23 +31,9 @@ pub struct Solved {
 }
 
 impl Solved {
-    /// A load step that changed nothing (the same loads and supports at both ends, the
-    /// cracks as the last solve left them): no solve.
-    pub const KEPT: Solved = Solved {
-        iterations: 0,
-        residual: 0.0,
-        free_motions: 0,
-        imbalance: 0.0,
-        closed_faces: 0,
-        contact_rounds: 0,
-        newton: 0,
-        factorizations: 0,
-        factor_entries: 0,
-        too_large: false,
-    };
-
-    /// Whether this step kept the last answer ([`Solved::KEPT`]): every solve takes at
-    /// least one contact round.
+    /// Whether this step kept the last answer (the same loads and supports at both ends,
+    /// the cracks as the last solve left them): every solve takes at least one contact
+    /// round, such a step none.
     pub fn kept(&self) -> bool {
         self.contact_rounds == 0
     }
@@ -60,7 +46,7 @@ impl Solved {
             free_motions: last.free_motions,
             imbalance: last.imbalance,
             closed_faces: last.closed_faces,
-            ..Solved::KEPT
+            ..Solved::default()
         }
     }
 }

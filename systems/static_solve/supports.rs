@@ -7,6 +7,7 @@ use super::{entries, fields};
 use crate::base::dim::Dim;
 use crate::base::exact_sum::ExactSum;
 use crate::physics::loads::VelocityBc;
+use crate::store::crack::Fields;
 use crate::store::world::World;
 use crate::systems::p2g;
 
@@ -47,38 +48,52 @@ fn displacement<D: Dim>(bc: &VelocityBc<D>, t: f64) -> D::Vec {
 }
 
 /// Each support's force on the body per node at the start of the step, from the state the
-/// last step left ([`node_forces`] at `t_start`). The particles' stresses are in every
-/// snapshot, so a resumed run finds the same forces. Zero on the first step, which starts
-/// from the unloaded body, and where no support moves (a still support does no work): no
-/// pass over the particles then.
+/// last step left ([`entry_forces`] at `t_start`, summed over each node's entries). The
+/// particles' stresses are in every snapshot, so a resumed run finds the same forces. Zero
+/// on the first step, which starts from the unloaded body, and where no support moves (a
+/// still support does no work): no pass over the particles then.
 pub(super) fn start_forces<D: Dim>(world: &World<D>, t_start: f64) -> Vec<Vec<D::Vec>> {
     if world.step == 0 || !world.bcs.iter().any(moves) {
         return (world.bcs.iter())
             .map(|bc| vec![D::zero(); bc.nodes.len()])
             .collect();
     }
-    node_forces(world, t_start)
+    let r = entry_forces(world, t_start);
+    let fields = fields(world);
+    (world.bcs.iter())
+        .map(|bc| {
+            (bc.nodes.iter())
+                .map(|&n| node_sum::<D>(&r, n, fields))
+                .collect()
+        })
+        .collect()
 }
 
-/// Sets each support's reaction from the state the particles hold, at time `t`: its
-/// [`node_forces`] on the components it holds (a load step that solved nothing).
+/// Sets each support's reaction from the state the particles hold, at time `t` (a load
+/// step that solved nothing): [`entry_forces`], summed over each node's entries.
 pub(super) fn reactions_at_rest<D: Dim>(world: &mut World<D>, t: f64) {
-    let forces = node_forces(world, t);
-    for (bc, f) in world.bcs.iter_mut().zip(forces) {
-        for (r, f) in bc.reaction.iter_mut().zip(f) {
+    if world.bcs.is_empty() {
+        return;
+    }
+    let r = entry_forces(world, t);
+    let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
+    set_reactions(&mut world.bcs, |n| node_sum::<D>(&r, n, fields));
+}
+
+/// Sets each support's reaction at its nodes to `force(node)` on the components it holds.
+pub(super) fn set_reactions<D: Dim>(bcs: &mut [VelocityBc<D>], force: impl Fn(u32) -> D::Vec) {
+    for bc in bcs {
+        for (r, &n) in bc.reaction.iter_mut().zip(&bc.nodes) {
+            let f = force(n);
             *r = D::zero();
             (0..D::D).filter(|&a| bc.axes[a]).for_each(|a| r[a] = f[a]);
         }
     }
 }
 
-/// Each support's force on the body per node from the particles' state: K u (their
-/// stresses, scattered as the internal force) less the loads and gravity at `t`, summed
-/// over the node's entries.
-fn node_forces<D: Dim>(world: &World<D>, t: f64) -> Vec<Vec<D::Vec>> {
-    if world.bcs.is_empty() {
-        return Vec::new();
-    }
+/// Each grid entry's force on the body from the particles' state: K u (their stresses,
+/// scattered as the internal force) less the loads and gravity at `t`.
+fn entry_forces<D: Dim>(world: &World<D>, t: f64) -> Vec<D::Vec> {
     let p = &world.particles;
     let mut r = entry_sums(world, |i, _, g| {
         D::stress_dot(&p.stress[i], g) * p.volume[i]
@@ -88,13 +103,12 @@ fn node_forces<D: Dim>(world: &World<D>, t: f64) -> Vec<Vec<D::Vec>> {
     for (e, r) in r.iter_mut().enumerate() {
         *r -= loads[e] + g * world.grid.mass[e];
     }
-    (world.bcs.iter())
-        .map(|bc| {
-            (bc.nodes.iter())
-                .map(|&n| entries(n, fields(world)).fold(D::zero(), |s, e| s + r[e]))
-                .collect()
-        })
-        .collect()
+    r
+}
+
+/// The sum of `r` over node `n`'s entries.
+fn node_sum<D: Dim>(r: &[D::Vec], n: u32, fields: Option<&Fields>) -> D::Vec {
+    entries(n, fields).fold(D::zero(), |s, e| s + r[e])
 }
 
 /// The work the moving supports did on the body over the step: each node's force, the
