@@ -475,7 +475,9 @@ fn alike_on_ranks(scene: &str, args: &[&str], dir: &Path, files: &[&str]) {
 /// process's files byte for byte: a cantilever on its clamp (the reaction probe; and with
 /// its load held over the last two of 4 load steps, which keep the answer), the ENF
 /// specimen whose crack faces close (the active set across the ranks' boundary, K_II), a
-/// straight 3D front (J and K along it), and a bar pulled past yield by a moving grip in 40
+/// straight 3D front (J and K along it; with Jacobi, and with the coarse grid of
+/// `linear = "two_level"`, whose factor the second step of its ramp keeps), and a bar pulled past
+/// yield by a moving grip in 40
 /// load steps (Newton iterations with the return map), whose snapshot set written on 2
 /// ranks resumes on 3 to the same files.
 #[cfg(feature = "mpi")]
@@ -486,19 +488,62 @@ fn static_scenes_split_across_ranks_match_one_process() {
     let solved = ["energy.csv", "probes.csv", "solver.csv"];
     let cracked = ["energy.csv", "solver.csv", "fracture.csv"];
     let static_cg = [&["--set", "simulation.solver=\"static\""][..], &cg].concat();
-    let cases: [(&str, Vec<&str>, &[&str]); 3] = [
-        ("scenarios/cantilever_static_2d.toml", cg.to_vec(), &solved),
+    let two_level = [
+        "--set",
+        "simulation.linear=\"two_level\"",
+        "--set",
+        "simulation.load_steps=2",
+        "--set",
+        "load[0].time={kind=\"ramp\",rise=1.0}",
+    ];
+    let cases: [(&str, &str, Vec<&str>, &[&str]); 4] = [
+        (
+            "scenarios/cantilever_static_2d.toml",
+            "",
+            cg.to_vec(),
+            &solved,
+        ),
         (
             "scenarios/enf_2d.toml",
+            "",
             [&static_cg[..], &["--set", "simulation.load_steps=1"]].concat(),
             &cracked,
         ),
-        ("scenarios/straight_front_3d.toml", cg.to_vec(), &cracked),
+        (
+            "scenarios/straight_front_3d.toml",
+            "",
+            cg.to_vec(),
+            &cracked,
+        ),
+        (
+            "scenarios/straight_front_3d.toml",
+            "_two_level",
+            two_level.to_vec(),
+            &cracked,
+        ),
     ];
-    for (scene, args, files) in cases {
+    for (scene, tag, args, files) in cases {
         let stem = Path::new(scene).file_stem().unwrap().to_string_lossy();
-        alike_on_ranks(scene, &args, &dir.join(&*stem), files);
+        alike_on_ranks(scene, &args, &dir.join(format!("{stem}{tag}")), files);
     }
+    // The coarse grid took fewer iterations than Jacobi, and its second load step (the
+    // same cracks and supports) kept its factor on every rank.
+    let log = |tag: &str| {
+        let f = dir.join(format!("straight_front_3d{tag}/ranks2/solver.csv"));
+        std::fs::read_to_string(f).unwrap()
+    };
+    let first = |l: String| -> u32 {
+        let row = l.lines().nth(1).unwrap().to_string();
+        row.split(',').nth(3).unwrap().parse().unwrap()
+    };
+    let (jacobi, coarse) = (first(log("")), first(log("_two_level")));
+    assert!(coarse < jacobi / 2, "{coarse} against {jacobi}");
+    let summary = dir.join("straight_front_3d_two_level/ranks2/summary.json");
+    let summary = std::fs::read_to_string(summary).unwrap();
+    assert!(
+        summary.contains("\"coarse_factorizations\": 1"),
+        "{summary}"
+    );
     // The cantilever's load ramped over half of 4 load steps: the last two keep the
     // answer, their reactions taken from the particles' stresses on every rank.
     let held = dir.join("cantilever_held");
@@ -654,30 +699,24 @@ fn a_build_without_mpi_refuses_several_ranks() {
 }
 
 /// What a split run cannot do yet is refused by name, once (by the first rank): the sparse
-/// direct solver and the coarse grid, and the commands that run on one process.
+/// direct solver, and the commands that run on one process.
 #[cfg(feature = "mpi")]
 #[test]
 fn split_runs_refuse_what_they_cannot_do_yet() {
     let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_refuse", std::process::id()));
-    for (key, what) in [
-        ("direct", "the sparse direct solver"),
-        ("two_level", "the coarse grid's direct solve"),
-    ] {
-        let set = format!("simulation.linear=\"{key}\"");
-        let done = launch(
-            "scenarios/cantilever_static_2d.toml",
-            Some(2),
-            &dir,
-            &["--set", &set],
-        );
-        let said = String::from_utf8_lossy(&done.stderr);
-        assert!(!done.status.success());
-        assert!(
-            said.contains(&format!("{what} runs on one process only")),
-            "{said}"
-        );
-        assert_eq!(said.matches("error:").count(), 1, "{said}");
-    }
+    let done = launch(
+        "scenarios/cantilever_static_2d.toml",
+        Some(2),
+        &dir,
+        &["--set", "simulation.linear=\"direct\""],
+    );
+    let said = String::from_utf8_lossy(&done.stderr);
+    assert!(!done.status.success());
+    assert!(
+        said.contains("the sparse direct solver runs on one process only"),
+        "{said}"
+    );
+    assert_eq!(said.matches("error:").count(), 1, "{said}");
 
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/dcb_2d.toml");
     let done = Command::new("mpirun")

@@ -79,16 +79,11 @@ fn refuse_unsupported<D: Dim>(world: &World<D>) -> anyhow::Result<()> {
     if world.settings.solver != Solver::Static {
         return Ok(());
     }
-    let one_process = match world.settings.linear {
-        LinearSolver::Direct => Some(("direct", "the sparse direct solver")),
-        LinearSolver::TwoLevel => Some(("two_level", "the coarse grid's direct solve")),
-        _ => None,
-    };
-    if let Some((key, what)) = one_process {
+    if world.settings.linear == LinearSolver::Direct {
         anyhow::bail!(
-            "simulation.linear = \"{key}\": {what} runs on one process only; give linear = \
-             \"cg\" (or \"auto\", which takes conjugate gradients with Jacobi on several \
-             ranks)"
+            "simulation.linear = \"direct\": the sparse direct solver runs on one process \
+             only; give linear = \"two_level\" or \"cg\" (or \"auto\", which takes \
+             conjugate gradients on several ranks)"
         );
     }
     Ok(())

@@ -215,6 +215,35 @@ impl Domain {
         all
     }
 
+    /// Every rank's `values` (rows of `width`, the same length on each) added row by row
+    /// in rank order, on every rank (`values` on one rank). Only rows holding a nonzero
+    /// value travel. The bits are those of one rank only where the terms add exactly
+    /// (multiples of a quantum whose sums stay well inside the doubles' precision).
+    pub fn add_rows(&self, values: &mut [f64], width: usize) {
+        if !self.is_split() {
+            return;
+        }
+        // Each rank's message: per nonzero row its index, then the row.
+        let mut mine = Vec::new();
+        for (r, row) in values.chunks_exact(width).enumerate() {
+            if row.iter().any(|&v| v != 0.0) {
+                mine.extend_from_slice(&(r as u64).to_le_bytes());
+                mine.extend_from_slice(bytemuck::cast_slice(row));
+            }
+        }
+        values.fill(0.0);
+        for bytes in self.comm.all_gather(mine) {
+            for chunk in bytes.chunks_exact(8 * (width + 1)) {
+                let (head, row) = chunk.split_at(8);
+                let r = u64::from_le_bytes(head.try_into().expect("8 bytes")) as usize;
+                let row: Vec<f64> = bytemuck::pod_collect_to_vec(row);
+                (values[r * width..(r + 1) * width].iter_mut())
+                    .zip(row)
+                    .for_each(|(v, x)| *v += x);
+            }
+        }
+    }
+
     /// Adds the other ranks' terms into `sums` (nothing on one rank).
     pub fn sum(&self, sums: &mut [ExactSum]) {
         if self.is_split() {

@@ -54,7 +54,7 @@ pub(super) fn conjugate_gradients<D: Dim>(
             })
             .collect();
         if let Some(c) = coarse {
-            c.correct::<D>(r, &mut z);
+            c.correct::<D>(sums, r, &mut z);
         }
         z
     };

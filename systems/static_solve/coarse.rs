@@ -4,6 +4,9 @@
 //! carries each fine entry's displacement by multilinear interpolation P; its stiffness is
 //! the Galerkin P^T K P, summed particle by particle and factorized (faer's sparse
 //! Cholesky) once per set of held components the particles see: a grown crack keeps it.
+//! Its sums (P^T K P, and P^T r in each iteration) round their terms to a power of two
+//! per row and so add exactly: split across ranks, each adds its own particles and
+//! entries, the ranks' rows are added, and every rank solves the coarse system of one.
 //! The preconditioner is z = D^-1 r + P (P^T K P)^-1 P^T r: Jacobi damps the short waves
 //! of the error, the coarse solve the long ones that take Jacobi-preconditioned conjugate
 //! gradients hundreds of iterations.
@@ -18,8 +21,10 @@
 use super::cholesky::{analyse, factorize};
 use super::operator::elastic;
 use super::unknowns::Unknowns;
+use super::vectors::Sums;
 use super::{each_entry, entry_node, fields};
 use crate::base::dim::Dim;
+use crate::physics::material::Material;
 use crate::store::disjoint::Disjoint;
 use crate::store::world::World;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -228,8 +233,10 @@ impl Coarse {
         let (start, children) = invert(&parents, nodes.iter().product());
         let keep = keep_bits(dofs);
         let layout = Layout::of(world);
+        // Split across ranks, each sees its own particles: all keep the factor or none.
+        let sees = |c: &Coarse| !world.domain.any(!layout.sees_as(&keep, &c.layout, &c.keep));
         let stiffness = match last {
-            Some(c) if layout.sees_as(&keep, &c.layout, &c.keep) => c.stiffness.clone(),
+            Some(c) if sees(c) => c.stiffness.clone(),
             _ => Arc::new(Stiffness::new::<D>(world, shape, &parents, &keep)?),
         };
         Ok(Coarse {
@@ -245,9 +252,11 @@ impl Coarse {
     /// Whether this is the coarse grid of the unknowns `dofs` of `world`: the same held
     /// components and the same crack fields under the particles (a static scene's
     /// particles, volumes and materials do not change), so that a load step whose cracks
-    /// and supports are the last one's reuses it.
+    /// and supports are the last one's reuses it. Split across ranks, it fits where it
+    /// fits every rank's particles.
     pub(super) fn fits<D: Dim>(&self, world: &World<D>, dofs: &Unknowns<D>) -> bool {
-        self.keep == keep_bits(dofs) && self.layout.is_of(world)
+        let mine = self.keep == keep_bits(dofs) && self.layout.is_of(world);
+        !world.domain.any(!mine)
     }
 
     /// Whether this coarse grid shares its factor with `other` (made by [`Coarse::new`]
@@ -256,29 +265,45 @@ impl Coarse {
         Arc::ptr_eq(&self.stiffness, &other.stiffness)
     }
 
-    /// Adds the coarse correction P (P^T K P)^-1 P^T r to `z`.
-    pub(super) fn correct<D: Dim>(&self, r: &[D::Vec], z: &mut [D::Vec]) {
+    /// Adds the coarse correction P (P^T K P)^-1 P^T r to `z`. P^T r sums its terms
+    /// rounded to a quantum per coarse node ([`quantum`]) over the entries each rank owns
+    /// ([`Sums`]): exact sums, so that every rank, and one rank alone, solves the same
+    /// coarse system.
+    pub(super) fn correct<D: Dim>(&self, sums: Sums, r: &[D::Vec], z: &mut [D::Vec]) {
         let (d, s) = (D::D, &*self.stiffness);
-        let restricted: Vec<D::Vec> = (0..self.start.len() - 1)
-            .into_par_iter()
-            .map(|c| {
-                let mut sum = D::zero();
-                for &(e, w) in &self.children[self.start[c]..self.start[c + 1]] {
-                    let (e, k) = (e as usize, mask::<D>(self.keep[e as usize]));
-                    for a in 0..d {
-                        sum[a] += w * k[a] * r[e][a];
+        let largest = (r.par_iter().enumerate())
+            .filter(|&(e, _)| sums.owns(e))
+            .map(|(e, r)| {
+                (0..d)
+                    .filter(|&a| self.keep[e] >> a & 1 == 1)
+                    .fold(0.0, |m, a| r[a].abs().max(m))
+            })
+            .reduce(|| 0.0, f64::max);
+        let largest = sums.max(largest);
+        let mut restricted = vec![0.0; (self.start.len() - 1) * d];
+        restricted
+            .par_chunks_mut(d)
+            .enumerate()
+            .for_each(|(c, sum)| {
+                let terms = &self.children[self.start[c]..self.start[c + 1]];
+                let (q, inv) = quantum(terms.len() as f64 * largest);
+                for &(e, w) in terms {
+                    let (e, k) = (e as usize, self.keep[e as usize]);
+                    if k == 0 || !sums.owns(e) {
+                        continue;
+                    }
+                    for (a, sum) in sum.iter_mut().enumerate() {
+                        if k >> a & 1 == 1 {
+                            *sum += quantized(w * r[e][a], q, inv);
+                        }
                     }
                 }
-                sum
-            })
-            .collect();
+            });
+        sums.add_rows(&mut restricted, d);
         let mut x = vec![0.0; s.count];
-        for (c, v) in restricted.iter().enumerate() {
-            for a in 0..d {
-                let u = s.unknown[c * d + a];
-                if u != u32::MAX {
-                    x[u as usize] = v[a];
-                }
+        for (u, &v) in s.unknown.iter().zip(&restricted) {
+            if *u != u32::MAX {
+                x[*u as usize] = v;
             }
         }
         let llt = LltRef::<usize, f64>::new(&s.symbolic, &s.factor);
@@ -436,23 +461,28 @@ fn offset<D: Dim>(row: [usize; 3], col: [usize; 3]) -> usize {
 /// index). A particle's stencil reaches three planes of coarse nodes along the last axis
 /// from its lowest: the particles are binned by that plane and the bins taken in three
 /// passes (bins 0, 3, 6, ..., then 1, 4, ..., then 2, 5, ...), the bins of a pass in
-/// parallel on disjoint rows: each row sums its terms in the same order for any thread
-/// count.
+/// parallel on disjoint rows. Each term is rounded to its row's [`quanta`], so that the
+/// sums are exact: the same bits in any order, for any thread count and any split of the
+/// particles across ranks, whose rows are then added.
 fn assemble<D: Dim>(world: &World<D>, shape: Shape, parents: &[Parents], keep: &[u8]) -> Vec<f64> {
     let last = D::D - 1;
     let planes = shape.nodes[last];
     let p = &world.particles;
-    let lowest: Vec<[u32; 3]> = (0..p.len())
+    let (lowest, bound): (Vec<[u32; 3]>, Vec<f64>) = (0..p.len())
         .into_par_iter()
         .map(|i| {
             let mut low = [u32::MAX; 3];
-            each_entry(world, i, |e, _, _| {
+            // The sum of the stencil's gradients' 1-norms bounds every interpolated one.
+            let mut grads = 0.0;
+            each_entry(world, i, |e, _, g| {
                 let q = &parents[e].low;
                 (0..3).for_each(|a| low[a] = low[a].min(q[a]));
+                grads += (0..D::D).map(|a| g[a].abs()).sum::<f64>();
             });
-            low
+            let m = &world.materials[p.material[i] as usize];
+            (low, p.volume[i] * stiffest(m) * grads * grads)
         })
-        .collect();
+        .unzip();
     let plane_of = |i: usize| lowest[i][last] as usize;
     let mut bin_start = vec![0usize; planes + 1];
     let reached = || (0..p.len()).filter(|&i| plane_of(i) < planes);
@@ -466,9 +496,16 @@ fn assemble<D: Dim>(world: &World<D>, shape: Shape, parents: &[Parents], keep: &
         binned[fill[plane_of(i)]] = i as u32;
         fill[plane_of(i)] += 1;
     }
+    let quanta = quanta::<D>(world, shape, reached().map(|i| lowest[i]), &bound);
     let (dd, span) = (D::D * D::D, span::<D>());
     let mut blocks = vec![0.0; shape.nodes.iter().product::<usize>() * span * dd];
     let writer = Disjoint::new(&mut blocks);
+    let support = Support {
+        shape,
+        parents,
+        keep,
+        quanta: &quanta,
+    };
     for pass in 0..=REACH {
         (pass..planes)
             .step_by(REACH + 1)
@@ -479,11 +516,78 @@ fn assemble<D: Dim>(world: &World<D>, shape: Shape, parents: &[Parents], keep: &
                     // SAFETY: a particle of bin z writes the rows of planes z to z + REACH
                     // only; the bins of one pass are REACH + 1 planes apart, so no two
                     // threads write one row.
-                    unsafe { add_particle(world, shape, parents, keep, i, lowest[i], &writer) };
+                    unsafe { add_particle(world, &support, i, lowest[i], &writer) };
                 }
             });
     }
+    world.domain.add_rows(&mut blocks, span * dd);
     blocks
+}
+
+/// A bound on the elastic law's stiffness: |C : e| <= stiffest |e| (Frobenius norms) for
+/// any strain e, with room for the plane-stress zz strain (at most as large as e).
+fn stiffest(m: &Material) -> f64 {
+    2.0 * (3.0 * m.lambda.abs() + 2.0 * m.mu)
+}
+
+/// Per coarse row, the power of two its terms are rounded to: 2^-50 of a bound on the sum
+/// of their magnitudes (the particles reaching the row, on every rank, times the largest
+/// particle's `bound` on a term), so that every partial sum is a multiple of it well
+/// inside the doubles' 53 bits, and exact. A term keeps about 50 bits less the bound's
+/// slack (a few bits): far more than a preconditioner needs.
+fn quanta<D: Dim>(
+    world: &World<D>,
+    shape: Shape,
+    lowest: impl Iterator<Item = [u32; 3]>,
+    bound: &[f64],
+) -> Vec<(f64, f64)> {
+    let most = world.domain.max(bound.iter().copied().fold(0.0, f64::max));
+    let mut count = vec![0.0; shape.nodes.iter().product()];
+    for low in lowest {
+        for slot in 0..3usize.pow(D::D as u32) {
+            let (mut node, mut rest, mut inside) = (0, slot, true);
+            for (a, &l) in low.iter().enumerate().take(D::D) {
+                let x = l as usize + rest % 3;
+                rest /= 3;
+                inside &= x < shape.nodes[a];
+                node += x * shape.stride[a];
+            }
+            if inside {
+                count[node] += 1.0;
+            }
+        }
+    }
+    world.domain.add_rows(&mut count, 1);
+    count.iter().map(|&n| quantum(n * most)).collect()
+}
+
+/// The power of two 2^-50 of `bound` (a bound on the magnitudes of a sum's terms added
+/// up), with its inverse: the sum of terms [`quantized`] to it is exact (1 for a bound
+/// of 0: the terms are 0).
+fn quantum(bound: f64) -> (f64, f64) {
+    if bound > 0.0 {
+        let e = bound.log2().ceil() as i32 - 50;
+        (2f64.powi(e), 2f64.powi(-e))
+    } else {
+        (1.0, 1.0)
+    }
+}
+
+/// `t` rounded to a multiple of the power of two `q` (`inv` = 1 / q; |t| / q under 2^51:
+/// adding 1.5 2^52 rounds to an integer, to nearest, without a call to `round`).
+#[inline(always)]
+fn quantized(t: f64, q: f64, inv: f64) -> f64 {
+    const INTEGER: f64 = 6_755_399_441_055_744.0;
+    ((t * inv + INTEGER) - INTEGER) * q
+}
+
+/// What every particle's share of P^T K P reads: the coarse grid, the interpolation, the
+/// held components and the rows' quanta.
+struct Support<'a> {
+    shape: Shape,
+    parents: &'a [Parents],
+    keep: &'a [u8],
+    quanta: &'a [(f64, f64)],
 }
 
 /// Slots of a particle's coarse support: 3 per axis from its lowest node.
@@ -491,19 +595,23 @@ const SLOTS: usize = 27;
 
 /// Adds particle `i`'s V B^T C B on the coarse nodes (B made of the interpolated fine
 /// gradients, held components cleared) to the rows of its coarse support (lowest node
-/// `low`).
+/// `low`), each term rounded to its row's quantum.
 ///
 /// # Safety
 /// No other thread may write the rows of the particle's coarse support.
 unsafe fn add_particle<D: Dim>(
     world: &World<D>,
-    shape: Shape,
-    parents: &[Parents],
-    keep: &[u8],
+    support: &Support,
     i: usize,
     low: [u32; 3],
     rows: &Disjoint<f64>,
 ) {
+    let Support {
+        shape,
+        parents,
+        keep,
+        quanta,
+    } = *support;
     // Per slot, the gradient its unit motion along each axis gives.
     let mut grads = [[D::zero(); 3]; SLOTS];
     let mut used = 0u32;
@@ -551,6 +659,7 @@ unsafe fn add_particle<D: Dim>(
     for &l in &slots {
         let (il, gl) = (ijk(l), &grads[l]);
         let cl = node(il);
+        let (q, inv) = quanta[cl];
         for &k in &slots {
             let ik = ijk(k);
             if node(ik) > cl {
@@ -566,7 +675,7 @@ unsafe fn add_particle<D: Dim>(
                         None => D::stress_dot(s, gl[a])[a],
                     };
                     // SAFETY: passed on from the caller.
-                    unsafe { rows.set(at, rows.get(at) + v * f) };
+                    unsafe { rows.set(at, rows.get(at) + quantized(v * f, q, inv)) };
                 }
             }
         }
@@ -637,4 +746,37 @@ fn lower_triangle<D: Dim>(
     }
     let pattern = SymbolicSparseColMat::new_checked(count, count, col_ptr, None, row_idx);
     (unknown, count, pattern, values)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{quantized, quantum};
+
+    /// Terms rounded to the quantum of their bound add exactly: any order, and any split
+    /// into partial sums added afterwards, gives the same bits, within half a quantum per
+    /// term of the exact sum.
+    #[test]
+    fn quantized_sums_do_not_depend_on_the_order() {
+        // Terms over 12 orders of magnitude and both signs (a deterministic sequence).
+        let terms: Vec<f64> = (0..10_000)
+            .map(|i| {
+                let x = (i as f64 * 0.618_033_988_749_895).fract();
+                (x - 0.5) * 10f64.powi((i % 13) - 6)
+            })
+            .collect();
+        let bound = terms.iter().map(|t| t.abs()).sum::<f64>();
+        let (q, inv) = quantum(bound);
+        let sum =
+            |ts: &mut dyn Iterator<Item = &f64>| ts.map(|&t| quantized(t, q, inv)).sum::<f64>();
+        let forward = sum(&mut terms.iter());
+        let backward = sum(&mut terms.iter().rev());
+        let (odd, even): (Vec<f64>, Vec<f64>) = terms.iter().partition(|t| t.to_bits() % 2 == 1);
+        let split = sum(&mut even.iter()) + sum(&mut odd.iter());
+        assert_eq!(forward.to_bits(), backward.to_bits());
+        assert_eq!(forward.to_bits(), split.to_bits());
+        let exact = crate::base::exact_sum::ExactSum::of(terms.iter().copied());
+        assert!((forward - exact).abs() <= terms.len() as f64 * q / 2.0);
+        // The quantum is 2^-50 of the bound, up to a factor of 2.
+        assert!(q >= bound * 2f64.powi(-50) && q < bound * 2f64.powi(-49));
+    }
 }

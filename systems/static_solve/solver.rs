@@ -40,7 +40,7 @@ impl<D: Dim> Solver<D> {
         let split = world.domain.is_split();
         let coarse = match world.settings.linear {
             LinearSolver::TwoLevel => true,
-            LinearSolver::Auto => D::D == 3 && !split,
+            LinearSolver::Auto => D::D == 3,
             _ => false,
         };
         let coarse = match (coarse, &kept.coarse) {

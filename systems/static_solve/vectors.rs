@@ -91,6 +91,11 @@ impl<'a> Sums<'a> {
         sums.iter().map(ExactSum::value).collect()
     }
 
+    /// Every rank's rows of `width` added ([`Domain::add_rows`]; `values` on one rank).
+    pub fn add_rows(&self, values: &mut [f64], width: usize) {
+        self.domain.add_rows(values, width);
+    }
+
     /// The sum of every rank's count `n`.
     pub fn count(&self, n: usize) -> usize {
         let mut sum = ExactSum::new();
