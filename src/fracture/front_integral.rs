@@ -26,7 +26,7 @@
 use crate::base::dim::D3;
 use crate::base::sym::SymTensor;
 use crate::fracture::front::{FrontFrame, FrontLine, tensor_to_local, to_local};
-use crate::fracture::interaction::{accel, near};
+use crate::fracture::interaction::{accel, near_box};
 use crate::physics::near_tip;
 use crate::ranks::domain::Domain;
 use crate::store::crack::Cracks;
@@ -409,6 +409,104 @@ impl Stretch {
     }
 }
 
+/// The crack triangles near a tube, sorted by their centroids' position along an axis (the
+/// front's tangent at the vertex), for the nearest centroid to a particle without a look at
+/// every triangle.
+struct Sides<'a> {
+    facets: &'a [Facet],
+    axis: DVec3,
+    /// Each triangle's centroid along the axis, and its index, in increasing order.
+    along: Vec<(f64, u32)>,
+}
+
+impl<'a> Sides<'a> {
+    fn new(facets: &'a [Facet], axis: DVec3) -> Self {
+        let mut along: Vec<(f64, u32)> = (facets.iter().enumerate())
+            .map(|(k, f)| (f.centroid.dot(axis), k as u32))
+            .collect();
+        along.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        Sides {
+            facets,
+            axis,
+            along,
+        }
+    }
+
+    /// The triangle whose centroid is nearest `x` (the first in the given order of equals),
+    /// None without triangles: outward from `x`'s place along the axis, until the distance
+    /// along it alone exceeds the nearest found (with a margin for round-off).
+    fn nearest(&self, x: DVec3) -> Option<&'a Facet> {
+        let t = x.dot(self.axis);
+        let start = self.along.partition_point(|a| a.0 < t);
+        let mut best = (f64::INFINITY, u32::MAX);
+        let mut look = |&(key, k): &(f64, u32)| {
+            let gap = (key - t) * (key - t);
+            if gap > best.0 * (1.0 + 1e-9) {
+                return false;
+            }
+            let d = (x - self.facets[k as usize].centroid).length_squared();
+            if (d, k) < best {
+                best = (d, k);
+            }
+            true
+        };
+        for a in &self.along[start..] {
+            if !look(a) {
+                break;
+            }
+        }
+        for a in self.along[..start].iter().rev() {
+            if !look(a) {
+                break;
+            }
+        }
+        self.facets.get(best.1 as usize)
+    }
+}
+
+/// Where a tube's particles can lie: the box, in the vertex's front axes, of the stretch's
+/// vertices widened by the tube's radius (every point of the stretch's segments is within
+/// their bounds), and its bounds in global axes.
+struct Reach {
+    frame: FrontFrame,
+    /// The box in front axes, from the vertex (m).
+    local: [DVec3; 2],
+    /// Its bounding box in global axes (m).
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl Reach {
+    /// The reach of the stretch `st` of `line` around the vertex of `frame`, `widen` beyond
+    /// its segments.
+    fn new(line: &FrontLine, frame: &FrontFrame, st: &Stretch, widen: f64) -> Reach {
+        let (mut a, mut b) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for &i in &st.idx {
+            let l = frame.local(line.frames[i].x - frame.x);
+            (a, b) = (a.min(l), b.max(l));
+        }
+        let local = [a - DVec3::splat(widen), b + DVec3::splat(widen)];
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for corner in 0..8 {
+            let pick = |k: usize| local[corner >> k & 1][k];
+            let x = frame.x + (0..3).map(|k| frame.e[k] * pick(k)).sum::<DVec3>();
+            (lo, hi) = (lo.min(x), hi.max(x));
+        }
+        Reach {
+            frame: *frame,
+            local,
+            lo,
+            hi,
+        }
+    }
+
+    /// Whether `x` lies in the box.
+    fn holds(&self, x: DVec3) -> bool {
+        let l = self.frame.local(x - self.frame.x);
+        l.cmpge(self.local[0]).all() && l.cmple(self.local[1]).all()
+    }
+}
+
 /// The stretch of `line` around vertex `k` that the tube of half-length `len` can reach:
 /// vertex indices in order with their arc lengths from vertex `k` (negative before it),
 /// one vertex past `len` each way where the front goes on.
@@ -520,6 +618,7 @@ pub fn tube_samples(
     let (rad, len) = (tube.radius, tube.length);
     let st = Stretch::new(line, k, len);
     let h = (0..3).map(|a| world.grid.geom.h[a]).fold(0.0, f64::max);
+    let reach = Reach::new(line, frame, &st, rad + 1e-6 * h);
     // Only a particle within a cell of the band the facets span about the crack's plane at
     // the vertex can be on the other face from where the sign of x2 puts it.
     let band = facets
@@ -527,24 +626,22 @@ pub fn tube_samples(
         .map(|f| frame.local(f.centroid - frame.x).y.abs())
         .fold(0.0, f64::max)
         + h;
+    let sides = Sides::new(facets, frame.e[2]);
     let mut out = Vec::new();
-    for i in near(world, frame.x, rad.hypot(len)) {
+    for i in near_box(world, reach.lo, reach.hi) {
+        if !reach.holds(p.x[i]) {
+            continue;
+        }
         let Some(mut at) = place(line, &st, p.x[i], len) else {
             continue;
         };
         if at.x1.hypot(at.x2) >= rad {
             continue;
         }
-        if at.x1 < 0.0 && at.x2.abs() <= band {
-            let side = facets
-                .iter()
-                .map(|f| ((p.x[i] - f.centroid).length_squared(), f))
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .map(|(_, f)| f.normal.dot(p.x[i] - f.centroid));
-            if let Some(side) = side {
-                // Only the sign of x2 matters to theta behind the front.
-                at.x2 = at.x2.abs().copysign(side);
-            }
+        let behind = at.x1 < 0.0 && at.x2.abs() <= band;
+        if let Some(f) = behind.then(|| sides.nearest(p.x[i])).flatten() {
+            // Only the sign of x2 matters to theta behind the front.
+            at.x2 = at.x2.abs().copysign(f.normal.dot(p.x[i] - f.centroid));
         }
         let st = p.stress[i].to_sym3();
         let s = from_rows([
@@ -929,5 +1026,84 @@ mod tests {
             .collect();
         assert!(integrate(&samples, 1.0e-3, 0.5e-3).is_some());
         assert!(integrate(&samples, 1.0e-3, 1.0e-3).is_none());
+    }
+
+    /// A point of a deterministic scatter in the cube of half-side `half` about `c`.
+    fn scatter(k: usize, c: DVec3, half: f64) -> DVec3 {
+        let u = |m: f64| ((k as f64 + 0.5) * m).fract() * 2.0 - 1.0;
+        c + DVec3::new(u(0.754_877_666), u(0.569_840_291), u(0.438_846_856)) * half
+    }
+
+    /// A circular front of radius `rho` about the y axis, `n` vertices, with its frames.
+    fn circle(rho: f64, n: usize) -> FrontLine {
+        let frames = (0..n)
+            .map(|k| {
+                let phi = 2.0 * PI * k as f64 / n as f64;
+                let e1 = DVec3::new(phi.cos(), 0.0, phi.sin());
+                FrontFrame {
+                    vertex: k as u32,
+                    x: e1 * rho,
+                    e: [e1, DVec3::Y, e1.cross(DVec3::Y)],
+                }
+            })
+            .collect();
+        FrontLine {
+            frames,
+            closed: true,
+        }
+    }
+
+    /// The nearest crack triangle by the sorted search is the brute-force one, the first of
+    /// equals included (centroids repeated).
+    #[test]
+    fn the_nearest_facet_is_the_brute_force_one() {
+        let facets: Vec<Facet> = (0..300)
+            .map(|k| Facet {
+                centroid: scatter(k % 250, DVec3::ZERO, 1e-3),
+                normal: DVec3::new(0.0, 1.0, (k % 7) as f64 * 0.1).normalize(),
+            })
+            .collect();
+        let sides = Sides::new(&facets, DVec3::new(0.3, -0.2, 0.9).normalize());
+        for k in 0..2000 {
+            let x = scatter(k, DVec3::new(1e-4, 0.0, 0.0), 1.5e-3);
+            let brute = (facets.iter().enumerate())
+                .map(|(i, f)| ((x - f.centroid).length_squared(), i))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map(|(_, i)| i);
+            let found = sides.nearest(x).map(|f| {
+                (f as *const Facet as usize - facets.as_ptr() as usize) / size_of::<Facet>()
+            });
+            assert_eq!(found, brute, "point {k}");
+        }
+        assert!(Sides::new(&[], DVec3::Z).nearest(DVec3::ZERO).is_none());
+    }
+
+    /// Every point a tube on a curved front accepts lies in its reach, some of them farther
+    /// from the vertex than hypot(R, L) (the radius searched before, which only its padding
+    /// by a cell covered), and the reach holds under three times the points the tube
+    /// accepts.
+    #[test]
+    fn a_tube_lies_in_its_reach() {
+        let (rho, rad) = (5e-3, 4e-3);
+        let line = circle(rho, 60);
+        let st = Stretch::new(&line, 0, rad);
+        let frame = &line.frames[0];
+        let reach = Reach::new(&line, frame, &st, rad);
+        let half = 2.0 * rad;
+        let (mut inside, mut held, mut far) = (0, 0, 0);
+        for k in 0..200_000 {
+            let x = scatter(k, frame.x, half);
+            held += usize::from(reach.holds(x));
+            let Some(at) = place(&line, &st, x, rad) else {
+                continue;
+            };
+            if at.x1.hypot(at.x2) < rad {
+                inside += 1;
+                far += usize::from((x - frame.x).length() > rad.hypot(rad));
+                assert!(reach.holds(x), "point {k} at {x}");
+            }
+        }
+        assert!(inside > 10_000 && far > 0, "{inside} {far}");
+        assert!(held < 3 * inside, "{held} against {inside}");
     }
 }

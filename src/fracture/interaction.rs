@@ -306,11 +306,19 @@ fn gather(
 /// in the tiles around it (padded by a cell for the particles' moves since binning), or
 /// every particle before the first binning.
 pub(crate) fn near<D: Dim>(world: &World<D>, x: D::Vec, reach: f64) -> Vec<usize> {
+    let mut r = D::zero();
+    (0..D::D).for_each(|a| r[a] = reach);
+    near_box(world, x - r, x + r)
+}
+
+/// The particles that can lie in the box from `lo` to `hi`, in ascending index order: those
+/// binned in the tiles it reaches (padded by a cell for the particles' moves since
+/// binning), or every particle before the first binning.
+pub(crate) fn near_box<D: Dim>(world: &World<D>, lo: D::Vec, hi: D::Vec) -> Vec<usize> {
     let geom = &world.grid.geom;
-    let pad = reach + (0..D::D).map(|a| geom.h[a]).fold(0.0, f64::max);
-    let at =
-        |s: f64| D::from_slice(&[x[0] + s * pad, x[1] + s * pad, x[D::D - 1] + s * pad][..D::D]);
-    let (lo, hi) = geom.cell_range(at(-1.0), at(1.0));
+    let (mut pad, h) = (D::zero(), (0..D::D).map(|a| geom.h[a]).fold(0.0, f64::max));
+    (0..D::D).for_each(|a| pad[a] = h);
+    let (lo, hi) = geom.cell_range(lo - pad, hi + pad);
     let n = world.particles.len();
     match world.tiles.particles_in_cells(lo, hi, n) {
         Some(p) => p.into_iter().map(|i| i as usize).collect(),
