@@ -52,13 +52,13 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                     })
                 })
                 .collect();
-            // Split across ranks, one gather for the whole batch; then the integrals.
-            let mut merged = TubeSamples::merged(&world.domain, local).into_iter();
-            let sampled: Vec<(&Asks, Vec<TubeSamples>)> = (asks.iter())
-                .map(|a| (a, merged.by_ref().take(a.tubes().count()).collect()))
+            let integrals = scope.integrals(&asks, local);
+            let mut integrals = integrals.into_iter();
+            let measured: Vec<(&Asks, Vec<FrontIntegrals>)> = (asks.iter())
+                .map(|a| (a, integrals.by_ref().take(a.tubes().count()).collect()))
                 .collect();
-            let rows: Vec<(TipResult, Vec<PathResult>)> = (sampled.par_iter())
-                .map(|(a, samples)| scope.rows(&line, c, ordinal[c] + a.k as u32, a, samples))
+            let rows: Vec<(TipResult, Vec<PathResult>)> = (measured.par_iter())
+                .map(|(a, fis)| scope.rows(&line, c, ordinal[c] + a.k as u32, a, fis))
                 .collect();
             for (a, row) in asks.iter().zip(rows) {
                 slots[a.k] = Some(row);
@@ -172,26 +172,52 @@ impl<'a> Scope<'a> {
         }
     }
 
-    /// The rows of vertex `a.k` of `line` on crack `c`, numbered `tip`, from its tubes'
-    /// merged samples (the own first): its fracture.csv row and its paths.csv rows.
+    /// The integrals over every tube of the vertices `asks` (in their order, each
+    /// vertex's own tube first) from this rank's samples of them, `local`. Split across
+    /// ranks, the tubes are dealt out in turn: each tube's samples travel to its rank,
+    /// which integrates them in whole-scene particle order, and the integrals are then
+    /// shared (the same bits as one rank's).
+    fn integrals(&self, asks: &[Asks], local: Vec<TubeSamples>) -> Vec<FrontIntegrals> {
+        let domain = &self.world.domain;
+        let (me, size) = (domain.comm.rank(), domain.comm.size());
+        let tubes: Vec<Tube> = asks
+            .iter()
+            .flat_map(|a| a.tubes().map(|(t, _)| t))
+            .collect();
+        let routed = TubeSamples::routed(domain, local, |t| t % size);
+        let mine: Vec<[f64; 1 + FrontIntegrals::VALUES]> = (routed.par_iter().zip(&tubes))
+            .enumerate()
+            .filter(|(t, _)| t % size == me)
+            .map(|(t, (samples, tube))| {
+                let fi = front_integrals(samples, *tube, |m| self.elastic(m));
+                let mut row = [t as f64; 1 + FrontIntegrals::VALUES];
+                row[1..].copy_from_slice(&fi.values());
+                row
+            })
+            .collect();
+        (domain.in_order(mine, |row| row[0] as u64).iter())
+            .map(|row| FrontIntegrals::from_values(row[1..].try_into().expect("the values")))
+            .collect()
+    }
+
+    /// The rows of vertex `a.k` of `line` on crack `c`, numbered `tip`, from the integrals
+    /// over its tubes (the own first): its fracture.csv row and its paths.csv rows.
     fn rows(
         &self,
         line: &FrontLine,
         c: usize,
         tip: u32,
         a: &Asks,
-        samples: &[TubeSamples],
+        integrals: &[FrontIntegrals],
     ) -> (TipResult, Vec<PathResult>) {
         let (world, h) = (self.world, self.h);
         let elastic = |m| self.elastic(m);
-        let mut samples = samples.iter();
-        let fi = front_integrals(samples.next().expect("the own tube"), a.own, elastic);
+        let mut integrals = integrals.iter();
+        let fi = *integrals.next().expect("the own tube");
         let path_rows = (a.paths.iter().zip(&self.paths))
             .map(|(fits, t)| {
                 let p = match fits {
-                    Some(t) => {
-                        front_integrals(samples.next().expect("a compared tube"), *t, elastic)
-                    }
+                    Some(_) => *integrals.next().expect("a compared tube"),
                     None => FrontIntegrals::NONE,
                 };
                 PathResult {
@@ -227,8 +253,8 @@ impl<'a> Scope<'a> {
     }
 }
 
-/// Most front vertices measured together: split across ranks, one gather carries all
-/// their tubes' samples. Bounds the samples held at once (a tube of 3 cells holds some
+/// Most front vertices measured together: split across ranks, one exchange carries all
+/// their tubes' samples, each to the rank that integrates the tube. Bounds the samples held at once (a tube of 3 cells holds some
 /// 1,400 particles at 8 per cell, 144 bytes each).
 const BATCH: usize = 64;
 

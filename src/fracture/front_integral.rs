@@ -70,6 +70,30 @@ pub struct FrontIntegrals {
 }
 
 impl FrontIntegrals {
+    /// Number of [`FrontIntegrals::values`].
+    pub const VALUES: usize = 8;
+
+    /// The integrals as doubles, for the ranks to share: J, its volume part, K, the radius,
+    /// the material (-1 for none) and whether plastic (1) or not (0).
+    pub fn values(&self) -> [f64; Self::VALUES] {
+        let m = self.material.map_or(-1.0, f64::from);
+        let [k1, k2, k3] = self.k;
+        let plastic = f64::from(u8::from(self.plastic));
+        [self.j, self.j_volume, k1, k2, k3, self.radius, m, plastic]
+    }
+
+    /// The integrals whose [`values`](Self::values) are `v`.
+    pub fn from_values(v: &[f64; Self::VALUES]) -> Self {
+        FrontIntegrals {
+            j: v[0],
+            j_volume: v[1],
+            k: [v[2], v[3], v[4]],
+            radius: v[5],
+            material: (v[6] >= 0.0).then_some(v[6] as u16),
+            plastic: v[7] != 0.0,
+        }
+    }
+
     /// No tube fitted: J and K NaN, radius 0.
     pub const NONE: FrontIntegrals = FrontIntegrals {
         j: f64::NAN,
@@ -318,21 +342,26 @@ fn curved(place: &Place, s: &DMat3, gu: &DMat3, sa: &DMat3, ga: &DMat3, ua: DVec
 
 /// The particles' shares of the integrals over one tube around a front vertex, in
 /// particle order ([`tube_samples`]); split across ranks, every rank's, once
-/// [`merged`](TubeSamples::merged).
+/// [`routed`](TubeSamples::routed) to the rank that integrates them.
 pub struct TubeSamples(Vec<Sample>);
 
 impl TubeSamples {
-    /// Each tube's samples from every rank, in whole-scene particle order, in one
-    /// collective for all the tubes (as they are on one rank).
-    pub fn merged(domain: &Domain, tubes: Vec<TubeSamples>) -> Vec<TubeSamples> {
+    /// Each tube's samples from every rank, in whole-scene particle order (as they are on
+    /// one rank), on the rank `owner` names for the tube (empty on the others), in one
+    /// exchange for all the tubes.
+    pub fn routed(
+        domain: &Domain,
+        tubes: Vec<TubeSamples>,
+        owner: impl Fn(usize) -> usize,
+    ) -> Vec<TubeSamples> {
         let lists = tubes.into_iter().map(|t| t.0).collect();
-        (domain.in_order_each(lists, |s| s.id).into_iter())
+        (domain.to_owners(lists, owner, |s| s.id).into_iter())
             .map(TubeSamples)
             .collect()
     }
 }
 
-/// J and K at a front vertex from the samples of its tube ([`TubeSamples::merged`]),
+/// J and K at a front vertex from the samples of its tube ([`TubeSamples::routed`]),
 /// shrunk by `tube.step` while particles do not fill it or it holds a material other than
 /// that of the particle nearest the vertex; `elastic` gives the material of each material
 /// index.

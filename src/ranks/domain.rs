@@ -181,6 +181,68 @@ impl Domain {
         all
     }
 
+    /// Each of `mine`'s lists sent to the rank `owner` names (every rank passes as many):
+    /// the `j`-th list returned is, on its owner, every rank's `j`-th list as
+    /// [`in_order_each`](Self::in_order_each) gives it, and empty elsewhere (`mine` on one
+    /// rank). Each item travels once, to one rank.
+    pub fn to_owners<T: Pod, K: Ord>(
+        &self,
+        mine: Vec<Vec<T>>,
+        owner: impl Fn(usize) -> usize,
+        key: impl Fn(&T) -> K,
+    ) -> Vec<Vec<T>> {
+        if !self.is_split() {
+            return mine;
+        }
+        let me = self.comm.rank();
+        let everyone: Vec<usize> = (0..self.comm.size()).filter(|&r| r != me).collect();
+        // To each rank: the lengths of the lists it owns, then their items.
+        let out: Vec<Vec<u8>> = (everyone.iter())
+            .map(|&r| {
+                let theirs: Vec<&Vec<T>> = (mine.iter().enumerate())
+                    .filter(|&(j, _)| owner(j) == r)
+                    .map(|(_, l)| l)
+                    .collect();
+                let lens: Vec<u64> = theirs.iter().map(|l| l.len() as u64).collect();
+                let mut bytes = (theirs.len() as u64).to_le_bytes().to_vec();
+                bytes.extend_from_slice(bytemuck::cast_slice(&lens));
+                theirs
+                    .iter()
+                    .for_each(|l| bytes.extend_from_slice(bytemuck::cast_slice(l)));
+                bytes
+            })
+            .collect();
+        let got = self.comm.exchange(&everyone, &out);
+        let owned: Vec<usize> = (0..mine.len()).filter(|&j| owner(j) == me).collect();
+        // Per rank in rank order, its items of each list this rank owns.
+        let mut all: Vec<Vec<T>> = vec![Vec::new(); mine.len()];
+        let mut mine = mine;
+        let mut from_peer = got.iter();
+        for r in 0..self.comm.size() {
+            if r == me {
+                for &j in &owned {
+                    all[j].append(&mut mine[j]);
+                }
+                continue;
+            }
+            let bytes = from_peer.next().expect("one message per peer");
+            let (head, rest) = bytes.split_at(8);
+            let n = u64::from_le_bytes(head.try_into().expect("8 bytes")) as usize;
+            let (lens, mut rest) = rest.split_at(8 * n);
+            let lens: Vec<u64> = bytemuck::pod_collect_to_vec(lens);
+            for (&j, &len) in owned.iter().zip(&lens) {
+                let (items, tail) = rest.split_at(len as usize * std::mem::size_of::<T>());
+                all[j].extend(bytemuck::pod_collect_to_vec::<u8, T>(items));
+                rest = tail;
+            }
+        }
+        // Stable: equal keys keep rank order.
+        for &j in &owned {
+            all[j].sort_by_key(&key);
+        }
+        all
+    }
+
     /// `mine` and what the peers' lists hold on the nodes this rank shares with them, in
     /// `key` order (each list in `key` order, no key on two ranks): the terms one rank,
     /// holding every particle, would add on the nodes this rank reaches. `node` gives an
