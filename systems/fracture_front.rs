@@ -52,8 +52,7 @@ pub fn measure(world: &World<D3>, plan: &FracturePlan) -> Measured {
                     })
                 })
                 .collect();
-            let integrals = scope.integrals(&asks, local);
-            let mut integrals = integrals.into_iter();
+            let mut integrals = scope.integrals(&asks, local).into_iter();
             let measured: Vec<(&Asks, Vec<FrontIntegrals>)> = (asks.iter())
                 .map(|a| (a, integrals.by_ref().take(a.tubes().count()).collect()))
                 .collect();
@@ -254,8 +253,9 @@ impl<'a> Scope<'a> {
 }
 
 /// Most front vertices measured together: split across ranks, one exchange carries all
-/// their tubes' samples, each to the rank that integrates the tube. Bounds the samples held at once (a tube of 3 cells holds some
-/// 1,400 particles at 8 per cell, 144 bytes each).
+/// their tubes' samples, each to the rank that integrates the tube. Bounds the samples
+/// held at once (a tube of 3 cells holds some 1,400 particles at 8 per cell, 144 bytes
+/// each).
 const BATCH: usize = 64;
 
 /// What vertex `k` measures: its own tube (shrunk to stay clear of other cracks) over the

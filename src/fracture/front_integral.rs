@@ -453,7 +453,7 @@ impl<'a> Sides<'a> {
         let mut along: Vec<(f64, u32)> = (facets.iter().enumerate())
             .map(|(k, f)| (f.centroid.dot(axis), k as u32))
             .collect();
-        along.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        along.sort_by(|a, b| a.0.total_cmp(&b.0));
         Sides {
             facets,
             axis,

@@ -187,7 +187,7 @@ impl Domain {
     /// rank). Each item travels once, to one rank.
     pub fn to_owners<T: Pod, K: Ord>(
         &self,
-        mine: Vec<Vec<T>>,
+        mut mine: Vec<Vec<T>>,
         owner: impl Fn(usize) -> usize,
         key: impl Fn(&T) -> K,
     ) -> Vec<Vec<T>> {
@@ -216,7 +216,6 @@ impl Domain {
         let owned: Vec<usize> = (0..mine.len()).filter(|&j| owner(j) == me).collect();
         // Per rank in rank order, its items of each list this rank owns.
         let mut all: Vec<Vec<T>> = vec![Vec::new(); mine.len()];
-        let mut mine = mine;
         let mut from_peer = got.iter();
         for r in 0..self.comm.size() {
             if r == me {
