@@ -33,6 +33,7 @@ mod frame;
 mod hold;
 mod newton;
 mod operator;
+mod recover;
 mod rigid;
 mod scatter;
 mod solver;
@@ -42,6 +43,7 @@ mod vectors;
 
 use coarse::Coarse;
 use direct::Analysis;
+use faces::Face;
 use operator::{Law, elastic, mask, stiffness};
 use scatter::entry_sums;
 use solver::Solver;
@@ -132,13 +134,19 @@ pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Kept) -> Result<Solved, Unst
     // Conjugate gradients start from the last load step's answer, carried by the
     // particles: a step whose load and cracks changed little needs fewer iterations.
     let guess = (world.step > 0).then(|| entry_displacements(world, &before));
-    let Solution { u, dofs, solved } = with_contact(world, kept, held.as_deref(), guess, t_end)?;
+    let Solution {
+        u,
+        dofs,
+        solved,
+        friction,
+    } = with_contact(world, kept, held.as_deref(), guess, (&before, t_end))?;
     reactions(world, &dofs, Law::Elastic, &u);
     let after = gather(world, &u);
     move_cracks(world, &before, &after);
     let work = load_work(world, &before, &after, t_start, t_end)
         + supports::work(world, &start_forces, t_start, t_end);
     world.work.external += work;
+    world.work.friction += friction;
     set_particles(world, &dofs, &u, &after);
     Ok(solved)
 }
@@ -161,7 +169,7 @@ fn plastic_step<D: Dim>(
     });
     let pairs = faces::pairs(world);
     let any_pairs = world.domain.any(!pairs.is_empty());
-    let mut closed = vec![false; pairs.len()];
+    let mut faces = vec![Face::Open; pairs.len()];
     // The entries' displacement at the step's start, which the faces' overlap adds to.
     let start = if !any_pairs {
         Vec::new()
@@ -171,7 +179,7 @@ fn plastic_step<D: Dim>(
     let (mut iterations, mut factorizations, mut newton) = (0, 0, 0);
     let mut rounds = 0;
     let (dofs, mut step) = loop {
-        let dofs = Unknowns::new(world, &pairs, &closed);
+        let dofs = Unknowns::new(world, &pairs, &faces);
         let step = newton::solve(world, kept, &dofs, increment.as_deref(), t_end)?;
         iterations += step.solved.iterations;
         factorizations += step.solved.factorizations;
@@ -183,8 +191,8 @@ fn plastic_step<D: Dim>(
         let u: Vec<D::Vec> = (start.iter().zip(&step.du)).map(|(&a, &d)| a + d).collect();
         let zero = vec![D::zero(); u.len()];
         let law = Law::Given(&step.returned.stress);
-        let changes = faces_round(world, &pairs, &mut closed, &u, (law, &zero));
-        if changes.closed + changes.opened == 0 {
+        let changes = faces_round(world, &pairs, &mut faces, (&u, &start), (law, &zero));
+        if changes.none() {
             break (dofs, step);
         }
         if rounds >= CONTACT_ROUNDS {
@@ -195,7 +203,7 @@ fn plastic_step<D: Dim>(
     step.solved.factorizations = factorizations;
     step.solved.newton = newton;
     step.solved.contact_rounds = rounds;
-    step.solved.closed_faces = closed_count(world, &pairs, &closed);
+    step.solved.closed_faces = closed_count(world, &pairs, &faces);
     reactions(world, &dofs, Law::Given(&step.returned.stress), &step.du);
     let after: Vec<D::Vec> = (before.iter().zip(gather(world, &step.du)))
         .map(|(&b, d)| b + d)
@@ -241,6 +249,8 @@ struct Solution<D: Dim> {
     dofs: Unknowns<D>,
     /// What the solves took, all together.
     solved: Solved,
+    /// The energy the sliding faces dissipated over the step (J).
+    friction: f64,
 }
 
 /// The load step's equilibrium with its crack faces' contact settled: solves until the
@@ -251,28 +261,53 @@ fn with_contact<D: Dim>(
     kept: &mut Kept,
     held: Option<&[D::Vec]>,
     guess: Option<Vec<D::Vec>>,
-    t_end: f64,
+    (before, t_end): (&[D::Vec], f64),
 ) -> Result<Solution<D>, Unstable> {
     let pairs = faces::pairs(world);
     let any_pairs = world.domain.any(!pairs.is_empty());
-    let mut closed = vec![false; pairs.len()];
+    let rubbing = world.domain.any(pairs.iter().any(|p| p.friction.is_some()));
+    // A face's slip is over the step: from the entries' displacement at its start.
+    let start = if rubbing && world.step > 0 {
+        recover::recovered(world, before)
+    } else {
+        Vec::new()
+    };
+    let mut faces = vec![Face::Open; pairs.len()];
     let (mut iterations, mut factorizations) = (0, 0);
     let mut rounds = 0;
     let mut last = guess;
     let (u, dofs, mut solved) = loop {
-        let dofs = Unknowns::new(world, &pairs, &closed);
+        let dofs = Unknowns::new(world, &pairs, &faces);
         let solver = Solver::new(world, &dofs, kept)?;
-        let load = world.grid.force.clone();
+        let mut load = world.grid.force.clone();
+        faces::add_friction::<D>(&pairs, &faces, &mut load);
+        let tied = |s: usize, m: usize| dofs.ties.binary_search(&(s, m)).is_ok();
+        let kept_slip = faces::kept_slip::<D>(&pairs, &faces, &start, tied);
+        if let Some(d) = &kept_slip {
+            let mut kd = vec![D::zero(); d.len()];
+            stiffness(
+                world,
+                Law::Elastic,
+                d,
+                &Unknowns::new(world, &[], &[]),
+                &mut kd,
+            );
+            load.iter_mut().zip(&kd).for_each(|(f, &k)| *f -= k);
+        }
         let linear = Linear::elastic(world);
-        let (u, solved) = equilibrium(world, &dofs, &solver, linear, load, held, last.as_deref())?;
+        let (mut u, solved) =
+            equilibrium(world, &dofs, &solver, linear, load, held, last.as_deref())?;
+        if let Some(d) = &kept_slip {
+            u.iter_mut().zip(d).for_each(|(u, &d)| *u += d);
+        }
         iterations += solved.iterations;
         factorizations += solved.factorizations;
         rounds += 1;
         if !any_pairs {
             break (u, dofs, solved);
         }
-        let changes = faces_round(world, &pairs, &mut closed, &u, (Law::Elastic, &u));
-        if changes.closed + changes.opened == 0 {
+        let changes = faces_round(world, &pairs, &mut faces, (&u, &start), (Law::Elastic, &u));
+        if changes.none() {
             break (u, dofs, solved);
         }
         last = Some(u);
@@ -283,8 +318,18 @@ fn with_contact<D: Dim>(
     solved.iterations = iterations;
     solved.factorizations = factorizations;
     solved.contact_rounds = rounds;
-    solved.closed_faces = closed_count(world, &pairs, &closed);
-    Ok(Solution { u, dofs, solved })
+    solved.closed_faces = closed_count(world, &pairs, &faces);
+    let friction = if rubbing {
+        friction_work(world, &pairs, &faces, (&u, &start))
+    } else {
+        0.0
+    };
+    Ok(Solution {
+        u,
+        dofs,
+        solved,
+        friction,
+    })
 }
 
 /// How a linear solve is made: the stiffness, and the residual (relative to the load) at
@@ -390,8 +435,8 @@ fn equilibrium<D: Dim>(
 fn faces_round<D: Dim>(
     world: &World<D>,
     pairs: &[faces::Pair<D::Vec>],
-    closed: &mut [bool],
-    u: &[D::Vec],
+    faces: &mut [Face<D::Vec>],
+    (u, start): (&[D::Vec], &[D::Vec]),
     (law, at): (Law<D>, &[D::Vec]),
 ) -> faces::Changes {
     let loose = Unknowns::new(world, &[], &[]);
@@ -410,17 +455,22 @@ fn faces_round<D: Dim>(
     let gap_tol = 1e-9 * sums.max(largest(u));
     // Split across ranks, a pair on a shared node changes alike on each: its owner counts it.
     let counted = |p: &faces::Pair<D::Vec>| sums.owns(p.own);
-    let mine = faces::update::<D>(pairs, closed, u, &r, (gap_tol, force_tol), counted);
+    let mine = faces::update::<D>(pairs, faces, (u, start), &r, (gap_tol, force_tol), counted);
     faces::Changes {
         closed: sums.count(mine.closed),
         opened: sums.count(mine.opened),
+        slid: sums.count(mine.slid),
     }
 }
 
-/// How many of the face `pairs` are `closed`, over all ranks.
-fn closed_count<D: Dim>(world: &World<D>, pairs: &[faces::Pair<D::Vec>], closed: &[bool]) -> usize {
+/// How many of the face `pairs` are closed, over all ranks.
+fn closed_count<D: Dim>(
+    world: &World<D>,
+    pairs: &[faces::Pair<D::Vec>],
+    faces: &[Face<D::Vec>],
+) -> usize {
     let sums = Sums::of(world);
-    let mine = (pairs.iter().zip(closed)).filter(|(p, c)| **c && sums.owns(p.own));
+    let mine = (pairs.iter().zip(faces)).filter(|(p, f)| f.closed() && sums.owns(p.own));
     sums.count(mine.count())
 }
 
@@ -469,6 +519,52 @@ fn load_work<D: Dim>(
     (0..p.len()).for_each(|i| work.add(p.mass[i] * D::dot(g, step(i))));
     world.domain.sum(std::slice::from_mut(&mut work));
     work.value()
+}
+
+/// The energy the sliding face `pairs` dissipate over the step (J): each one's friction
+/// force against its slip, the force the mean of its values at the step's ends (exact for a
+/// response linear over the step, as `load_work`). At the start the force is the one the
+/// face then carried: the tangential part of f_int - f_ext on its field above, from the
+/// particles' stresses and the loads at that time (none before the first step). `u` and
+/// `start` are the entries' displacements at the step's end and start.
+fn friction_work<D: Dim>(
+    world: &World<D>,
+    pairs: &[faces::Pair<D::Vec>],
+    faces: &[Face<D::Vec>],
+    (u, start): (&[D::Vec], &[D::Vec]),
+) -> f64 {
+    let carried = if world.step == 0 {
+        Vec::new()
+    } else {
+        let loose = Unknowns::new(world, &[], &[]);
+        let mut r = vec![D::zero(); u.len()];
+        let zero = vec![D::zero(); u.len()];
+        stiffness(
+            world,
+            Law::Given(&world.particles.stress),
+            &zero,
+            &loose,
+            &mut r,
+        );
+        let loads = p2g::load_forces(world, world.time);
+        let g = world.settings.gravity;
+        for ((r, &f), &m) in r.iter_mut().zip(&loads).zip(&world.grid.mass) {
+            *r -= f + g * m;
+        }
+        r
+    };
+    let along = |v: D::Vec, n: D::Vec| v - n * D::dot(v, n);
+    let moved = |e: usize| u[e] - start.get(e).copied().unwrap_or(D::zero());
+    let mut dissipated = vec![0.0; u.len()];
+    for (p, face) in pairs.iter().zip(faces) {
+        if let Face::Sliding { force } = *face {
+            let (a, b) = p.above_below();
+            let slip = along(moved(a) - moved(b), p.normal);
+            let before = carried.get(a).map_or(D::zero(), |&r| along(r, p.normal));
+            dissipated[a] += -0.5 * D::dot(force + before, slip);
+        }
+    }
+    Sums::of(world).total(dissipated.len(), |e| dissipated[e])
 }
 
 /// Moves the cracks' vertices and surfaces over the step as the explicit solver would

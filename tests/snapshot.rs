@@ -926,6 +926,61 @@ fn restart_is_bit_exact_with_a_cracked_static_scene() {
     restart_is_bit_exact(&text, 7, 2, "static_crack");
 }
 
+/// A static crack pressed shut and sheared against Coulomb friction (a 60 mm plate on
+/// 2 mm cells, sigma = 100 MPa, tau = 50 MPa rising over 24 load steps, mu = 0.2): each
+/// step's faces slide from the entries the particles recover, so nothing of the active
+/// set travels in the snapshot; stopped after 7 and resumed, the same bits, the friction's
+/// work among them.
+#[test]
+fn restart_is_bit_exact_with_static_friction() {
+    let edge = |min: [f64; 2], max: [f64; 2], f: [f64; 2]| {
+        format!(
+            "[[load]]\nregion = {{ min = {min:?}, max = {max:?} }}\nforce = {f:?}\n\
+             time = {{ kind = \"table\", points = [[0.0, 0.0], [1.0, 1.0]] }}\n"
+        )
+    };
+    let loads = [
+        edge([-0.03, 0.029], [0.03, 0.03], [3.0e6, -6.0e6]),
+        edge([-0.03, -0.03], [0.03, -0.029], [-3.0e6, 6.0e6]),
+        edge([0.029, -0.03], [0.03, 0.03], [0.0, 3.0e6]),
+        edge([-0.03, -0.03], [-0.029, 0.03], [0.0, -3.0e6]),
+    ]
+    .concat();
+    let text = format!(
+        r#"
+[simulation]
+dimension = 2
+plane = "strain"
+solver = "static"
+duration = 1.0
+load_steps = 24
+[grid]
+min = [-0.034, -0.034]
+max = [0.034, 0.034]
+cell = [0.002, 0.002]
+anchor = {{ point = [0.0, 0.0], offset = [0.0, 0.5] }}
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 7800.0
+[[body]]
+material = "steel"
+box = {{ min = [-0.03, -0.03], max = [0.03, 0.03] }}
+{loads}
+[[crack]]
+name = "shut"
+line = {{ start = [-0.01, 0.0], end = [0.01, 0.0] }}
+contact = {{ law = "friction", friction = 0.2 }}
+[output]
+history_interval = 0.125
+[checkpoint]
+every_steps = 10
+"#
+    );
+    restart_is_bit_exact(&text, 7, 2, "static_friction");
+}
+
 /// A static scene whose grip moves (a bar pulled by a prescribed velocity's displacement
 /// over 24 load steps): the grip's work over each step takes its force at the step's start
 /// from the particles' stresses, so a resumed run books the same work; stopped after 7 and

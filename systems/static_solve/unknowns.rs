@@ -1,10 +1,11 @@
 //! The unknowns of a load step: the components of the grid entries that are free (a
 //! particle reaches the entry, no boundary holds it), the crack fields that hold a sliver
-//! of mass, tied to their node's heaviest entry, and the closed frictionless crack faces,
-//! tied along the crack's normal.
+//! of mass, tied to their node's heaviest entry, the closed crack faces that slide
+//! (frictionless or against friction), tied along the crack's normal, and the stuck ones,
+//! tied whole.
 
 use super::dilatation::Groups;
-use super::faces::Pair;
+use super::faces::{Face, Pair};
 use super::{entries, fields};
 use crate::base::dim::Dim;
 use crate::store::world::{Dilatation, World};
@@ -13,10 +14,11 @@ use crate::store::world::{Dilatation, World};
 pub(super) struct Unknowns<D: Dim> {
     /// Per entry, 1 on the free components, 0 on the held ones and on tied entries.
     pub free: Vec<D::Vec>,
-    /// (sliver field, the entry of the same node it moves with), in entry order.
+    /// (tied entry, the entry of the same node it moves with): slivers and the stuck
+    /// faces' fields; no partner is tied itself.
     pub ties: Vec<(usize, usize)>,
     /// (tied entry, its partner, the unit normal along which they move together): closed
-    /// frictionless pairs. The tied entry's normal component is not an unknown.
+    /// pairs that slide. The tied entry's normal component is not an unknown.
     pub normal_ties: Vec<(usize, usize, D::Vec)>,
     /// The particles' mean-dilatation groups (`dilatation = "cell_mean"`), else None.
     pub groups: Option<Groups>,
@@ -24,8 +26,8 @@ pub(super) struct Unknowns<D: Dim> {
 
 impl<D: Dim> Unknowns<D> {
     /// The free components and ties of the world's grid after `p2g`, with the face
-    /// `pairs` flagged in `closed` closed.
-    pub fn new(world: &World<D>, pairs: &[Pair<D::Vec>], closed: &[bool]) -> Self {
+    /// `pairs` in the states `faces`.
+    pub fn new(world: &World<D>, pairs: &[Pair<D::Vec>], faces: &[Face<D::Vec>]) -> Self {
         let tol = world.settings.mass_tol;
         let mut free: Vec<D::Vec> = (world.grid.mass.iter())
             .map(|&m| if m > tol { ones::<D>() } else { D::zero() })
@@ -38,12 +40,24 @@ impl<D: Dim> Unknowns<D> {
                 }
             }
         }
-        let ties = slivers(world);
+        let mut ties = slivers(world);
         let sliver = |e: usize| ties.binary_search_by_key(&e, |t| t.0).is_ok();
-        let normal_ties = (pairs.iter().zip(closed))
-            .filter(|(p, c)| **c && !sliver(p.row) && !sliver(p.own))
+        let acting = (pairs.iter().zip(faces)).filter(|(p, _)| !sliver(p.row) && !sliver(p.own));
+        let normal_ties = (acting.clone())
+            .filter(|(_, f)| matches!(f, Face::Closed | Face::Sliding { .. }))
             .map(|(p, _)| (p.row, p.own, p.normal))
             .collect();
+        let stuck: Vec<(usize, usize)> = (acting.filter(|(_, f)| **f == Face::Stuck))
+            .map(|(p, _)| (p.row, p.own))
+            .collect();
+        // A sliver that moved with a stuck row moves with the row's partner.
+        for t in ties.iter_mut() {
+            if let Ok(k) = stuck.binary_search_by_key(&t.1, |s| s.0) {
+                t.1 = stuck[k].1;
+            }
+        }
+        ties.extend(stuck);
+        ties.sort_unstable();
         for &(s, _) in &ties {
             free[s] = D::zero();
         }
