@@ -474,7 +474,8 @@ fn alike_on_ranks(scene: &str, args: &[&str], dir: &Path, files: &[&str]) {
 /// Static scenes (`solver = "static"`, conjugate gradients) split across ranks give one
 /// process's files byte for byte: a cantilever on its clamp (the reaction probe; and with
 /// its load held over the last two of 4 load steps, which keep the answer), the ENF
-/// specimen whose crack faces close (the active set across the ranks' boundary, K_II), a
+/// specimen whose crack faces close (the active set across the ranks' boundary, K_II;
+/// and with Coulomb friction, whose sliding pairs carry mu N and dissipate), a
 /// straight 3D front (J and K along it; with Jacobi, and with the coarse grid of
 /// `linear = "two_level"`, whose factor the second step of its ramp keeps), and a bar pulled past
 /// yield by a moving grip in 40
@@ -496,7 +497,9 @@ fn static_scenes_split_across_ranks_match_one_process() {
         "--set",
         "load[0].time={kind=\"ramp\",rise=1.0}",
     ];
-    let cases: [(&str, &str, Vec<&str>, &[&str]); 4] = [
+    let one_step = ["--set", "simulation.load_steps=1"];
+    let rubbing = ["--set", "crack[0].contact={law=\"friction\",friction=0.3}"];
+    let cases: [(&str, &str, Vec<&str>, &[&str]); 5] = [
         (
             "scenarios/cantilever_static_2d.toml",
             "",
@@ -506,7 +509,13 @@ fn static_scenes_split_across_ranks_match_one_process() {
         (
             "scenarios/enf_2d.toml",
             "",
-            [&static_cg[..], &["--set", "simulation.load_steps=1"]].concat(),
+            [&static_cg[..], &one_step].concat(),
+            &cracked,
+        ),
+        (
+            "scenarios/enf_2d.toml",
+            "_friction",
+            [&static_cg[..], &one_step, &rubbing].concat(),
             &cracked,
         ),
         (
