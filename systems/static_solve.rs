@@ -170,9 +170,13 @@ fn plastic_step<D: Dim>(
     let pairs = faces::pairs(world);
     let any_pairs = world.domain.any(!pairs.is_empty());
     let mut faces = vec![Face::Open; pairs.len()];
-    // The entries' displacement at the step's start, which the faces' overlap adds to.
+    let rubbing = world.domain.any(pairs.iter().any(|p| p.friction.is_some()));
+    // The entries' displacement at the step's start, which the faces' overlap adds to:
+    // where faces rub, the one the particles carry (their slip counts from there).
     let start = if !any_pairs {
         Vec::new()
+    } else if rubbing && world.step > 0 {
+        recover::recovered(world, before)
     } else {
         entry_displacements(world, before)
     };
@@ -180,7 +184,13 @@ fn plastic_step<D: Dim>(
     let mut rounds = 0;
     let (dofs, mut step) = loop {
         let dofs = Unknowns::new(world, &pairs, &faces);
-        let step = newton::solve(world, kept, &dofs, increment.as_deref(), t_end)?;
+        let friction = rubbing.then(|| {
+            let mut f = vec![D::zero(); world.grid.mass.len()];
+            faces::add_friction::<D>(&pairs, &faces, &mut f);
+            f
+        });
+        let ends = (increment.as_deref(), friction.as_deref());
+        let step = newton::solve(world, kept, &dofs, ends, t_end)?;
         iterations += step.solved.iterations;
         factorizations += step.solved.factorizations;
         newton += step.solved.newton;
@@ -204,6 +214,10 @@ fn plastic_step<D: Dim>(
     step.solved.newton = newton;
     step.solved.contact_rounds = rounds;
     step.solved.closed_faces = closed_count(world, &pairs, &faces);
+    if rubbing {
+        let u: Vec<D::Vec> = (start.iter().zip(&step.du)).map(|(&a, &d)| a + d).collect();
+        world.work.friction += friction_work(world, &pairs, &faces, (&u, &start));
+    }
     reactions(world, &dofs, Law::Given(&step.returned.stress), &step.du);
     let after: Vec<D::Vec> = (before.iter().zip(gather(world, &step.du)))
         .map(|(&b, d)| b + d)

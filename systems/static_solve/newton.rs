@@ -62,15 +62,23 @@ pub(super) struct Step<D: Dim> {
     pub solved: Solved,
 }
 
-/// Solves the load step on the unknowns `dofs`: the loads now in the grid's force column,
-/// the moving supports' displacement increment `held` over the step.
+/// Solves the load step on the unknowns `dofs`: the loads now in the grid's force column
+/// and the sliding crack faces' `friction` (per entry), the moving supports' displacement
+/// increment `held` over the step.
 pub(super) fn solve<D: Dim>(
     world: &World<D>,
     kept: &mut Kept,
     dofs: &Unknowns<D>,
-    held: Option<&[D::Vec]>,
+    (held, friction): (Option<&[D::Vec]>, Option<&[D::Vec]>),
     t_end: f64,
 ) -> Result<Step<D>, Unstable> {
+    let mut external = world.grid.force.clone();
+    if let Some(friction) = friction {
+        external
+            .iter_mut()
+            .zip(friction)
+            .for_each(|(f, &t)| *f += t);
+    }
     let solver = Solver::new(world, dofs, kept)?;
     let frame = &solver.frame;
     let entries = world.grid.mass.len();
@@ -81,7 +89,7 @@ pub(super) fn solve<D: Dim>(
     let none = vec![D::zero(); entries];
     let committed = Law::Given(&world.particles.stress);
     stiffness(world, committed, &none, dofs, &mut f_int);
-    let unbalanced = (world.grid.force.iter().zip(&f_int))
+    let unbalanced = (external.iter().zip(&f_int))
         .map(|(&f, &q)| f - q)
         .collect();
     let tolerance = world.settings.tolerance;
@@ -91,7 +99,7 @@ pub(super) fn solve<D: Dim>(
         tolerance: LINEAR_TOLERANCE.0,
     };
     let (mut du, mut solved) = equilibrium(world, dofs, &solver, first, unbalanced, held, None)?;
-    let load = Load::new(world, dofs, held);
+    let load = Load::new(world, dofs, &external, held);
     let mut now = residual(world, dofs, frame, &load, &du);
     let mut history = vec![now.relative()];
     for newton in 1..=NEWTON_ITERATIONS {
@@ -162,11 +170,15 @@ struct Load<D: Dim> {
 const DRIVE_FLOOR: f64 = 1e-3;
 
 impl<D: Dim> Load<D> {
-    /// The loads now in the grid's force column, on `dofs`, with the supports' increment
-    /// `held`.
-    fn new(world: &World<D>, dofs: &Unknowns<D>, held: Option<&[D::Vec]>) -> Self {
+    /// The `external` force per entry, on `dofs`, with the supports' increment `held`.
+    fn new(
+        world: &World<D>,
+        dofs: &Unknowns<D>,
+        external: &[D::Vec],
+        held: Option<&[D::Vec]>,
+    ) -> Self {
         let sums = Sums::of(world);
-        let mut force = world.grid.force.clone();
+        let mut force = external.to_vec();
         dofs.fold(&mut force);
         let drive2 = held.map_or(0.0, |u_c| {
             let mut k_c = vec![D::zero(); u_c.len()];

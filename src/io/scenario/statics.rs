@@ -1,12 +1,10 @@
 //! What a static scene (`solver = "static"`) may hold so far: linear elastic bodies held
 //! by their boundaries (still, or moved by a prescribed velocity's displacement), under
 //! loads and gravity, with open cracks or faces in frictionless contact, growing or not,
-//! elastic or J2 plastic, and faces under Coulomb friction on elastic bodies. The `stick`
-//! law, and friction on plastic bodies, are refused by name until the static solver takes
-//! them.
+//! elastic or J2 plastic, and faces under Coulomb friction. The `stick` law is refused by
+//! name until the static solver takes it.
 
 use super::check::R;
-use super::schema::ModelKind;
 use super::source::Source;
 use crate::store::world::Solver;
 
@@ -44,24 +42,13 @@ pub(super) fn check(src: &Source) -> R<()> {
         }
         return Ok(());
     }
-    let plastic = (sc.materials.iter()).position(|m| m.model == ModelKind::J2);
     for (c, crack) in sc.cracks.iter().enumerate() {
-        let law = crack.contact.as_ref().map_or("none", |k| k.law.as_str());
-        if law == "stick" {
+        if crack.contact.as_ref().is_some_and(|k| k.law == "stick") {
             return Err(src.error(
                 &format!("crack[{c}].contact.law"),
                 "the static solver takes frictionless faces and Coulomb friction (`friction`), \
                  not `stick` yet (faces that stick whatever the force: give a large friction \
                  coefficient, or run this scene with solver = \"explicit\")",
-            ));
-        }
-        if let (Some(m), "friction") = (plastic, law) {
-            return Err(src.error(
-                &format!("crack[{c}].contact.law"),
-                format!(
-                    "the static solver takes Coulomb friction on elastic bodies only, and \
-                     material[{m}] is J2 plastic: run this scene with solver = \"explicit\""
-                ),
             ));
         }
     }
