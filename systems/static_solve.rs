@@ -189,8 +189,8 @@ fn plastic_step<D: Dim>(
             faces::add_friction::<D>(&pairs, &faces, &mut f);
             f
         });
-        let ends = (increment.as_deref(), friction.as_deref());
-        let step = newton::solve(world, kept, &dofs, ends, t_end)?;
+        let (held, friction) = (increment.as_deref(), friction.as_deref());
+        let step = newton::solve(world, kept, &dofs, held, friction, t_end)?;
         iterations += step.solved.iterations;
         factorizations += step.solved.factorizations;
         newton += step.solved.newton;

@@ -69,7 +69,8 @@ pub(super) fn solve<D: Dim>(
     world: &World<D>,
     kept: &mut Kept,
     dofs: &Unknowns<D>,
-    (held, friction): (Option<&[D::Vec]>, Option<&[D::Vec]>),
+    held: Option<&[D::Vec]>,
+    friction: Option<&[D::Vec]>,
     t_end: f64,
 ) -> Result<Step<D>, Unstable> {
     let mut external = world.grid.force.clone();
