@@ -21,6 +21,7 @@ use crate::store::crack::Fields;
 use crate::store::world::World;
 use crate::systems::{bin, classify, crack_advect, p2g};
 use crate::with_shape;
+use std::mem::discriminant;
 use std::sync::Arc;
 
 mod cg;
@@ -290,9 +291,20 @@ fn with_contact<D: Dim>(
     let (mut iterations, mut factorizations) = (0, 0);
     let mut rounds = 0;
     let mut last = guess;
-    let (u, dofs, mut solved) = loop {
-        let dofs = Unknowns::new(world, &pairs, &faces);
-        let solver = Solver::new(world, &dofs, kept)?;
+    // The unknowns and their solver, kept over the rounds that move only friction forces
+    // (every rank alike: a new solver takes collectives).
+    let kinds = |faces: &[Face<D::Vec>]| -> Vec<_> { faces.iter().map(discriminant).collect() };
+    let mut built: Option<(Vec<_>, Unknowns<D>, Solver<D>)> = None;
+    let (u, mut solved) = loop {
+        let now = kinds(&faces);
+        if world.domain.any(built.as_ref().is_none_or(|b| b.0 != now)) {
+            let dofs = Unknowns::new(world, &pairs, &faces);
+            let solver = Solver::new(world, &dofs, kept)?;
+            built = Some((now, dofs, solver));
+        }
+        let Some((_, dofs, solver)) = built.as_ref() else {
+            unreachable!("the unknowns are built before the first round")
+        };
         let mut load = world.grid.force.clone();
         faces::add_friction::<D>(&pairs, &faces, &mut load);
         let tied = |s: usize, m: usize| dofs.ties.binary_search(&(s, m)).is_ok();
@@ -310,7 +322,7 @@ fn with_contact<D: Dim>(
         }
         let linear = Linear::elastic(world);
         let (mut u, solved) =
-            equilibrium(world, &dofs, &solver, linear, load, held, last.as_deref())?;
+            equilibrium(world, dofs, solver, linear, load, held, last.as_deref())?;
         if let Some(d) = &kept_slip {
             u.iter_mut().zip(d).for_each(|(u, &d)| *u += d);
         }
@@ -318,16 +330,19 @@ fn with_contact<D: Dim>(
         factorizations += solved.factorizations;
         rounds += 1;
         if !any_pairs {
-            break (u, dofs, solved);
+            break (u, solved);
         }
         let changes = faces_round(world, &pairs, &mut faces, (&u, &start), (Law::Elastic, &u));
         if changes.none() {
-            break (u, dofs, solved);
+            break (u, solved);
         }
         last = Some(u);
         if rounds >= CONTACT_ROUNDS {
             return Err(unsettled(world, t_end, rounds, changes));
         }
+    };
+    let Some((_, dofs, _)) = built else {
+        unreachable!("a round was solved")
     };
     solved.iterations = iterations;
     solved.factorizations = factorizations;

@@ -23,7 +23,7 @@ use faer::sparse::SymbolicSparseColMat;
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};
 use faer::{Conj, MatMut, Par};
 use std::collections::HashSet;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Most refinement passes (a solve of K d = r with the same factor) after the first solve:
 /// a well-posed scene needs none; a stiffness spread over many orders (the ghost on a
@@ -41,6 +41,9 @@ const MEMORY_SHARE: f64 = 0.5;
 pub(super) struct Direct<D: Dim> {
     layout: Layout<D>,
     analysis: Analysis,
+    /// The factor of the elastic K on these unknowns, once a solve has made it: the
+    /// contact rounds of a load step that move only friction forces solve with it again.
+    elastic: OnceLock<Vec<f64>>,
 }
 
 /// K's pattern and its symbolic factorization, kept from one load step to the next: a
@@ -92,7 +95,11 @@ impl<D: Dim> Direct<D> {
                 free / GIB
             ));
         }
-        Ok(Direct { layout, analysis })
+        Ok(Direct {
+            layout,
+            analysis,
+            elastic: OnceLock::new(),
+        })
     }
 
     /// Solves K u = f as [`Frame::solve`] does: assembles K under `law` (with the ghost),
@@ -119,21 +126,38 @@ impl<D: Dim> Direct<D> {
         if norm_f == 0.0 {
             return Ok((vec![D::zero(); n], Solved::default()));
         }
-        let values = self.assemble(world, law, &frame.ghost, dofs.groups.as_ref());
         let Analysis { pattern, symbolic } = &self.analysis;
         let scratch = symbolic
             .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
             .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
         let mut memory = MemBuffer::try_new(scratch)
             .map_err(|_| failed("out of memory for the direct solver's workspace".into()))?;
-        let factor = factorize(symbolic, pattern, &values, &mut memory).ok_or_else(|| {
-            failed(
-                "the static solve's stiffness is not positive definite (is the body held \
-                 against every rigid motion the loads would start?)"
-                    .into(),
-            )
-        })?;
-        let llt = LltRef::<usize, f64>::new(symbolic, &factor);
+        let kept = match law {
+            Law::Elastic => self.elastic.get(),
+            _ => None,
+        };
+        let owned: Vec<f64>;
+        let factorizations = usize::from(kept.is_none());
+        let factor: &[f64] = match kept {
+            Some(f) => f,
+            None => {
+                let values = self.assemble(world, law, &frame.ghost, dofs.groups.as_ref());
+                let f = factorize(symbolic, pattern, &values, &mut memory).ok_or_else(|| {
+                    failed(
+                        "the static solve's stiffness is not positive definite (is the body \
+                         held against every rigid motion the loads would start?)"
+                            .into(),
+                    )
+                })?;
+                if matches!(law, Law::Elastic) {
+                    self.elastic.get_or_init(|| f)
+                } else {
+                    owned = f;
+                    &owned
+                }
+            }
+        };
+        let llt = LltRef::<usize, f64>::new(symbolic, factor);
         let mut u = vec![D::zero(); n];
         let mut r = f.to_vec();
         let mut q = vec![D::zero(); n];
@@ -163,7 +187,7 @@ impl<D: Dim> Direct<D> {
             u,
             Solved {
                 residual,
-                factorizations: 1,
+                factorizations,
                 factor_entries: symbolic.len_val(),
                 ..Solved::default()
             },
