@@ -933,51 +933,9 @@ fn restart_is_bit_exact_with_a_cracked_static_scene() {
 /// work among them.
 #[test]
 fn restart_is_bit_exact_with_static_friction() {
-    let edge = |min: [f64; 2], max: [f64; 2], f: [f64; 2]| {
-        format!(
-            "[[load]]\nregion = {{ min = {min:?}, max = {max:?} }}\nforce = {f:?}\n\
-             time = {{ kind = \"table\", points = [[0.0, 0.0], [1.0, 1.0]] }}\n"
-        )
-    };
-    let loads = [
-        edge([-0.03, 0.029], [0.03, 0.03], [3.0e6, -6.0e6]),
-        edge([-0.03, -0.03], [0.03, -0.029], [-3.0e6, 6.0e6]),
-        edge([0.029, -0.03], [0.03, 0.03], [0.0, 3.0e6]),
-        edge([-0.03, -0.03], [-0.029, 0.03], [0.0, -3.0e6]),
-    ]
-    .concat();
-    let text = format!(
-        r#"
-[simulation]
-dimension = 2
-plane = "strain"
-solver = "static"
-duration = 1.0
-load_steps = 24
-[grid]
-min = [-0.034, -0.034]
-max = [0.034, 0.034]
-cell = [0.002, 0.002]
-anchor = {{ point = [0.0, 0.0], offset = [0.0, 0.5] }}
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 7800.0
-[[body]]
-material = "steel"
-box = {{ min = [-0.03, -0.03], max = [0.03, 0.03] }}
-{loads}
-[[crack]]
-name = "shut"
-line = {{ start = [-0.01, 0.0], end = [0.01, 0.0] }}
-contact = {{ law = "friction", friction = 0.2 }}
-[output]
-history_interval = 0.125
-[checkpoint]
-every_steps = 10
-"#
-    );
+    let law = "{ law = \"friction\", friction = 0.2 }";
+    let text = common::sheared_plate(0.002, 0.01, Some(law), 24, "")
+        + "[output]\nhistory_interval = 0.125\n[checkpoint]\nevery_steps = 10\n";
     restart_is_bit_exact(&text, 7, 2, "static_friction");
 }
 

@@ -626,52 +626,7 @@ fn sheared_shut(law: Option<&str>, steps: usize) -> (f64, f64, f64) {
 
 /// [`sheared_shut`] with `model` added to the steel's keys.
 fn sheared_shut_as(law: Option<&str>, steps: usize, model: &str) -> (f64, f64, f64) {
-    let crack = law.map_or(String::new(), |law| {
-        format!(
-            "[[crack]]\nname = \"shut\"\nline = {{ start = [-0.005, 0.0], end = [0.005, 0.0] }}\n\
-             contact = {law}\n"
-        )
-    });
-    let edge = |min: [f64; 2], max: [f64; 2], f: [f64; 2]| {
-        format!(
-            "[[load]]\nregion = {{ min = {min:?}, max = {max:?} }}\nforce = {f:?}\n\
-             time = {{ kind = \"table\", points = [[0.0, 0.0], [1.0, 1.0]] }}\n"
-        )
-    };
-    // Edge tractions (t = sigma . n) times the 60 mm edges, unit thickness.
-    let loads = [
-        edge([-0.03, 0.0295], [0.03, 0.03], [3.0e6, -6.0e6]),
-        edge([-0.03, -0.03], [0.03, -0.0295], [-3.0e6, 6.0e6]),
-        edge([0.0295, -0.03], [0.03, 0.03], [0.0, 3.0e6]),
-        edge([-0.03, -0.03], [-0.0295, 0.03], [0.0, -3.0e6]),
-    ]
-    .concat();
-    let text = format!(
-        r#"
-[simulation]
-dimension = 2
-plane = "strain"
-solver = "static"
-duration = 1.0
-load_steps = {steps}
-[grid]
-min = [-0.032, -0.032]
-max = [0.032, 0.032]
-cell = [0.001, 0.001]
-anchor = {{ point = [0.0, 0.0], offset = [0.0, 0.5] }}
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 7800.0
-{model}
-[[body]]
-material = "steel"
-box = {{ min = [-0.03, -0.03], max = [0.03, 0.03] }}
-{loads}
-{crack}
-"#
-    );
+    let text = common::sheared_plate(0.001, 0.005, law, steps, model);
     let e = common::run_text(&text).summary.energies;
     (e.strain, e.external_work, e.friction_work)
 }

@@ -466,3 +466,61 @@ pub fn feddersen(s: f64, a: f64, b: f64) -> f64 {
         * (1.0 - 0.025 * r * r + 0.06 * r.powi(4))
         * (1.0 / (pi * a / (2.0 * b)).cos()).sqrt()
 }
+
+/// A 60 mm steel plate (plane strain, cells of `cell` m) solved static in `steps` load
+/// steps of a load rising in proportion to sigma_yy = -100 MPa and tau_xy = 50 MPa on its
+/// edges (each edge's particle layer), with a crack of half-length `half` m on its
+/// mid-plane, half a cell off the node rows, under contact law `law` (None: no crack), the
+/// steel's keys extended by `model`.
+pub fn sheared_plate(cell: f64, half: f64, law: Option<&str>, steps: usize, model: &str) -> String {
+    let crack = law.map_or(String::new(), |law| {
+        format!(
+            "[[crack]]\nname = \"shut\"\nline = {{ start = [{}, 0.0], end = [{half}, 0.0] }}\n\
+             contact = {law}\n",
+            -half
+        )
+    });
+    let edge = |min: [f64; 2], max: [f64; 2], f: [f64; 2]| {
+        format!(
+            "[[load]]\nregion = {{ min = {min:?}, max = {max:?} }}\nforce = {f:?}\n\
+             time = {{ kind = \"table\", points = [[0.0, 0.0], [1.0, 1.0]] }}\n"
+        )
+    };
+    // Edge tractions (t = sigma . n) times the 60 mm edges, unit thickness.
+    let (a, b) = (0.03, 0.03 - 0.5 * cell);
+    let loads = [
+        edge([-a, b], [a, a], [3.0e6, -6.0e6]),
+        edge([-a, -a], [a, -b], [-3.0e6, 6.0e6]),
+        edge([b, -a], [a, a], [0.0, 3.0e6]),
+        edge([-a, -a], [-b, a], [0.0, -3.0e6]),
+    ]
+    .concat();
+    let g = a + 2.0 * cell;
+    format!(
+        r#"
+[simulation]
+dimension = 2
+plane = "strain"
+solver = "static"
+duration = 1.0
+load_steps = {steps}
+[grid]
+min = [{}, {}]
+max = [{g}, {g}]
+cell = [{cell}, {cell}]
+anchor = {{ point = [0.0, 0.0], offset = [0.0, 0.5] }}
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 7800.0
+{model}
+[[body]]
+material = "steel"
+box = {{ min = [-0.03, -0.03], max = [0.03, 0.03] }}
+{loads}
+{crack}
+"#,
+        -g, -g
+    )
+}
