@@ -68,8 +68,8 @@ impl<V> Pair<V> {
 }
 
 /// Every pair of fields across a crack with frictionless or Coulomb contact whose entries
-/// both carry mass, in row order (a row behind two cracks at once has no single normal and is left
-/// open, as in the explicit solver).
+/// both carry mass, in row order (a row behind two cracks at once has no single normal and
+/// is left open, as in the explicit solver).
 pub(super) fn pairs<D: Dim>(world: &World<D>) -> Vec<Pair<D::Vec>> {
     let (Some(cracks), Some(f)) = (world.cracks.as_ref(), fields(world)) else {
         return Vec::new();
@@ -155,8 +155,8 @@ pub(super) const FRICTION_TOL: f64 = 1e-6;
 /// normal force against its slip over the step (stuck when it did not slip); a stuck pair
 /// whose tangential force exceeds mu times the normal one slides, with the friction force
 /// capped there; a sliding pair whose slip does not oppose its friction force sticks, and
-/// otherwise takes mu times its normal force against its slip. Counts the changes of the pairs
-/// `counted` takes.
+/// otherwise takes mu times its normal force against its slip. Counts the changes of the
+/// pairs `counted` takes.
 pub(super) fn update<D: Dim>(
     pairs: &[Pair<D::Vec>],
     faces: &mut [Face<D::Vec>],
