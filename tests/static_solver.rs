@@ -660,16 +660,8 @@ fn coulomb_faces_stick_or_slide_as_the_law_says() {
     assert!((stuck - whole).abs() <= 1e-5 * whole, "{stuck} vs {whole}");
     assert!(rubbed <= 1e-4 * work, "{rubbed} of {work}");
     for mu in [0.2, 0.4] {
-        let (strain, work, rubbed) = friction(mu, 1);
         let expected = mu * sigma * (tau - mu * sigma) / (tau * tau) * (frictionless - whole);
-        assert!(
-            (rubbed / expected - 1.0).abs() < 0.03,
-            "mu {mu}: {rubbed} vs {expected}"
-        );
-        assert!(
-            (work - strain - rubbed).abs() <= 1e-8 * work,
-            "mu {mu}: {work} vs {strain} + {rubbed}"
-        );
+        slides_as_superposed(friction(mu, 1), expected);
     }
     let (_, _, once) = friction(0.2, 1);
     let (strain, work, rubbed) = friction(0.2, 3);
@@ -710,12 +702,7 @@ fn sheared_penny(law: Option<&str>) -> (f64, f64, f64) {
              [0.0, 1.0, 0.0], radius = 0.008 }}\ncontact = {law}\n"
         )
     });
-    let face = |min: [f64; 3], max: [f64; 3], f: [f64; 3]| {
-        format!(
-            "[[load]]\nregion = {{ min = {min:?}, max = {max:?} }}\nforce = {f:?}\n\
-             time = {{ kind = \"table\", points = [[0.0, 0.0], [1.0, 1.0]] }}\n"
-        )
-    };
+    let face = common::ramped_load::<3>;
     // Face tractions (t = sigma . n) times the 40 x 40 mm faces.
     let (a, b) = (0.02, 0.019);
     let loads = [
@@ -761,8 +748,14 @@ box = {{ min = [-0.02, -0.02, -0.02], max = [0.02, 0.02, 0.02] }}
 fn coulomb_faces_slide_on_a_penny() {
     let (whole, _, _) = sheared_penny(None);
     let (frictionless, _, _) = sheared_penny(Some("{ law = \"frictionless\" }"));
-    let (strain, work, rubbed) = sheared_penny(Some("{ law = \"friction\", friction = 0.2 }"));
-    let expected = 0.24 * (frictionless - whole);
+    let rubbing = sheared_penny(Some("{ law = \"friction\", friction = 0.2 }"));
+    slides_as_superposed(rubbing, 0.24 * (frictionless - whole));
+}
+
+/// Asserts a sliding crack's one-step energies (strain, external work, friction work):
+/// the friction's work within 3 % of the superposition's `expected`, and the loads' work
+/// equal to the strain energy plus the friction's to 1e-8.
+fn slides_as_superposed((strain, work, rubbed): (f64, f64, f64), expected: f64) {
     assert!(
         (rubbed / expected - 1.0).abs() < 0.03,
         "{rubbed} vs {expected}"

@@ -467,6 +467,15 @@ pub fn feddersen(s: f64, a: f64, b: f64) -> f64 {
         * (1.0 / (pi * a / (2.0 * b)).cos()).sqrt()
 }
 
+/// A `[[load]]` of force `force` (N) on the particles in the box `min`-`max`, rising in
+/// proportion to the time from 0 to 1 s.
+pub fn ramped_load<const N: usize>(min: [f64; N], max: [f64; N], force: [f64; N]) -> String {
+    format!(
+        "[[load]]\nregion = {{ min = {min:?}, max = {max:?} }}\nforce = {force:?}\n\
+         time = {{ kind = \"table\", points = [[0.0, 0.0], [1.0, 1.0]] }}\n"
+    )
+}
+
 /// A 60 mm steel plate (plane strain, cells of `cell` m) solved static in `steps` load
 /// steps of a load rising in proportion to sigma_yy = -100 MPa and tau_xy = 50 MPa on its
 /// edges (each edge's particle layer), with a crack of half-length `half` m on its
@@ -480,12 +489,7 @@ pub fn sheared_plate(cell: f64, half: f64, law: Option<&str>, steps: usize, mode
             -half
         )
     });
-    let edge = |min: [f64; 2], max: [f64; 2], f: [f64; 2]| {
-        format!(
-            "[[load]]\nregion = {{ min = {min:?}, max = {max:?} }}\nforce = {f:?}\n\
-             time = {{ kind = \"table\", points = [[0.0, 0.0], [1.0, 1.0]] }}\n"
-        )
-    };
+    let edge = ramped_load::<2>;
     // Edge tractions (t = sigma . n) times the 60 mm edges, unit thickness.
     let (a, b) = (0.03, 0.03 - 0.5 * cell);
     let loads = [
