@@ -79,17 +79,19 @@ fn column_under_its_own_weight() {
 /// Hill's plastic cylinder of scenarios/cylinder_plastic_2d.toml on 7.5 mm cells, solved
 /// static with `extra` added to its `[simulation]` table.
 fn coarse_cylinder(extra: &str) -> String {
+    cylinder(extra).replace("cell = [0.0025, 0.0025]", "cell = [0.0075, 0.0075]")
+}
+
+/// The same cylinder on its shipped 2.5 mm cells (15,086 particles).
+fn cylinder(extra: &str) -> String {
     let path = format!(
         "{}/scenarios/cylinder_plastic_2d.toml",
         env!("CARGO_MANIFEST_DIR")
     );
-    std::fs::read_to_string(&path)
-        .unwrap()
-        .replace("cell = [0.0025, 0.0025]", "cell = [0.0075, 0.0075]")
-        .replace(
-            "[simulation]",
-            &format!("[simulation]\nsolver = \"static\"\n{extra}"),
-        )
+    std::fs::read_to_string(&path).unwrap().replace(
+        "[simulation]",
+        &format!("[simulation]\nsolver = \"static\"\n{extra}"),
+    )
 }
 
 /// The cantilever of scenarios/cantilever_static_2d.toml (solved directly, by conjugate
@@ -672,7 +674,8 @@ fn coulomb_faces_stick_or_slide_as_the_law_says() {
     );
     // J2 plastic with a yield stress far above the stresses (Newton iterations, the
     // friction in their residual): in one load step the elastic answer to the Newton
-    // tolerance (it reads the same digits); in three, the Newton path's ties act on each
+    // tolerance (1e-8 of the load; the 14,400 particles take the coarse grid's inexact
+    // solves, and the energies read 1.4e-8 apart); in three, the Newton path's ties act on each
     // step's increment, so a pair keeps the normal gap it had at the step's start where
     // the linear path's ties on the total close it, and the two differ by 2.7e-6 of the
     // work; the Newton path's balance holds to 1e-7 (it reads 5e-10).
@@ -681,7 +684,7 @@ fn coulomb_faces_stick_or_slide_as_the_law_says() {
     let (strain_1, work_1, rubbed_1) = friction(0.2, 1);
     let (strain_p, work_p, rubbed_p) = sheared_shut_as(Some(law), 1, j2);
     for (a, b) in [(strain_p, strain_1), (work_p, work_1), (rubbed_p, rubbed_1)] {
-        assert!((a - b).abs() <= 1e-8 * b.abs(), "{a} vs {b}");
+        assert!((a - b).abs() <= 1e-7 * b.abs(), "{a} vs {b}");
     }
     let (strain_p, work_p, rubbed_p) = sheared_shut_as(Some(law), 3, j2);
     assert!((work_p - work).abs() <= 1e-5 * work, "{work_p} vs {work}");
@@ -1299,6 +1302,47 @@ fn cell_mean_dilatation_assembles_the_operator_it_applies() {
         .fold(0.0, f64::max);
     assert!(worst < 1e-6 * scale, "{worst} of {scale}");
     assert!(most_direct <= 6 && most_cg <= 7, "{most_direct}, {most_cg}");
+}
+
+/// Under "auto" a 2D plastic scene of 10^4 particles or more (nu at most 0.35) is solved by
+/// conjugate gradients with the coarse grid (factorized once), not by a factorization per
+/// Newton iteration: Hill's cylinder at its shipped 2.5 mm cells (15,086 particles) takes the
+/// coarse grid and reaches the direct solve's stresses within 1e-6 of the largest (each
+/// Newton step converged to 1e-8 of the load), while on 7.5 mm cells (1,669 particles), or
+/// with nu = 0.45, it stays direct.
+#[test]
+fn auto_takes_the_coarse_grid_for_large_plastic_scenes() {
+    let shipped = |linear: &str| cylinder(&format!("linear = \"{linear}\""));
+    let log = |t: &str| common::run_text(t).summary.static_solve.unwrap();
+    let auto = log(&shipped("auto"));
+    assert!(
+        auto.coarse_factorizations == 1 && auto.factorizations == 0 && auto.iterations > 0,
+        "{auto:?}"
+    );
+    let direct_kept = |t: &str| {
+        let s = log(t);
+        assert!(
+            s.factorizations > 0 && s.coarse_factorizations == 0,
+            "{s:?}"
+        );
+    };
+    direct_kept(&coarse_cylinder(""));
+    direct_kept(&shipped("auto").replace("nu = 0.3", "nu = 0.45"));
+    let stress = |t: &str| final_world::<D2>(t, 2).particles.stress;
+    let (direct, coarse) = (stress(&shipped("direct")), stress(&shipped("auto")));
+    let scale = direct
+        .iter()
+        .map(|s| s.xx.abs().max(s.yy.abs()))
+        .fold(0.0, f64::max);
+    let worst = (direct.iter().zip(&coarse))
+        .map(|(a, b)| {
+            (a.xx - b.xx)
+                .abs()
+                .max((a.yy - b.yy).abs())
+                .max((a.xy - b.xy).abs())
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-6 * scale, "{worst} of {scale}");
 }
 
 /// Lame's thick sphere in 3D, u(r) = p a^3 / (E (b^3 - a^3)) ((1 - 2 nu) r + (1 + nu) b^3

@@ -16,6 +16,27 @@ use crate::record::solve_log::Solved;
 use crate::store::world::{LinearSolver, World};
 use std::sync::Arc;
 
+/// Particles from which a 2D scene solved by Newton iterations takes the coarse grid under
+/// "auto": the direct solver factorizes the tangent at every iteration, the coarse grid
+/// once a run, and from about 10^4 particles the conjugate gradients cost less than the
+/// factorizations (docs/static-solver.md, "Linear solves").
+const NEWTON_TWO_LEVEL_PARTICLES: usize = 10_000;
+
+/// The largest Poisson's ratio at which "auto" takes the coarse grid for Newton iterations:
+/// conjugate gradients slow as the bulk stiffness outgrows the shear (on the plastic
+/// cylinder they break even with the factorizations at nu = 0.4 and take 45 times as long
+/// at 0.4999).
+const NEWTON_TWO_LEVEL_NU: f64 = 0.35;
+
+/// Whether a 2D scene's Newton iterations (a J2 material) are solved faster by conjugate
+/// gradients with the coarse grid than by a factorization per iteration.
+fn newton_pays_for_two_level<D: Dim>(world: &World<D>) -> bool {
+    let p = &world.particles;
+    !p.hardened.is_empty()
+        && p.len() >= NEWTON_TWO_LEVEL_PARTICLES
+        && (world.materials.iter()).all(|m| m.poisson <= NEWTON_TWO_LEVEL_NU)
+}
+
 /// The solves on one set of unknowns.
 pub(super) struct Solver<D: Dim> {
     /// What they share.
@@ -38,9 +59,10 @@ impl<D: Dim> Solver<D> {
             what,
         };
         let split = world.domain.is_split();
+        let auto_two_level = D::D == 3 || (!split && newton_pays_for_two_level(world));
         let coarse = match world.settings.linear {
             LinearSolver::TwoLevel => true,
-            LinearSolver::Auto => D::D == 3,
+            LinearSolver::Auto => auto_two_level,
             _ => false,
         };
         let coarse = match (coarse, &kept.coarse) {
@@ -60,7 +82,7 @@ impl<D: Dim> Solver<D> {
         let frame = Frame::new(world, dofs, coarse);
         let (direct, too_large) = match world.settings.linear {
             LinearSolver::Cg | LinearSolver::TwoLevel => (None, false),
-            LinearSolver::Auto if D::D == 3 || split => (None, false),
+            LinearSolver::Auto if auto_two_level || split => (None, false),
             LinearSolver::Auto => {
                 match Direct::new(world, dofs, &frame.modes, &mut kept.analysis) {
                     Ok(d) => (Some(d), false),
