@@ -1,9 +1,10 @@
 //! A coarse grid under the conjugate gradients' Jacobi preconditioner (`linear =
 //! "two_level"`, the 3D default): the two-level additive Schwarz method (Dryja & Widlund
 //! 1987; Smith, Bjørstad & Gropp 1996, ch. 2). The grid of [`RATIO`] times the cell size
-//! carries each fine entry's displacement by multilinear interpolation P; its stiffness is
-//! the Galerkin P^T K P, summed particle by particle and factorized (faer's sparse
-//! Cholesky) once per set of held components the particles see: a grown crack keeps it.
+//! (more on large 3D bodies) carries each fine entry's displacement by multilinear
+//! interpolation P; its stiffness is the Galerkin P^T K P, summed particle by particle and
+//! factorized (faer's sparse Cholesky) once per set of held components the particles see:
+//! a grown crack keeps it.
 //! Its sums (P^T K P, and P^T r in each iteration) round their terms to a power of two
 //! per row and so add exactly: split across ranks, each adds its own particles and
 //! entries, the ranks' rows are added, and every rank solves the coarse system of one.
@@ -55,14 +56,26 @@ const REACH: usize = 2;
 /// Coupling offsets per axis (-REACH..=REACH).
 const SPAN: usize = 2 * REACH + 1;
 
-/// Fine cells per coarse cell along each axis. On the penny cube of 10^6 particles (55^3
-/// nodes) a ratio of 2 took 38 iterations against Jacobi's 308, but its coarse factor
-/// held 64 million entries (11 s to factorize, a third of an iteration's time to apply);
-/// 4 takes 55 iterations with a factor of 4.3 million entries (0.2 s).
+/// Fine cells per coarse cell along each axis, at least. On the penny cube of 10^6
+/// particles (55^3 nodes) a ratio of 2 took 38 iterations against Jacobi's 308, but its
+/// coarse factor held 64 million entries (11 s to factorize, a third of an iteration's time
+/// to apply); 4 takes 55 iterations with a factor of 4.3 million entries (0.2 s).
 const RATIO: usize = 4;
 
-/// The relative stiffness added to the coarse diagonal (see the module's doc).
-const SHIFT: f64 = 1e-8;
+/// In 3D the ratio doubles while more coarse cells than this hold particles: a 3D factor
+/// fills in as n^(4/3), and past about 8,000 cells its factorization and its solve in
+/// every iteration cost more than the iterations a finer coarse grid saves (a steel cube of
+/// 7.5 million particles, 2 mm cells: 15,625 coarse cells at 4 cells, 47 iterations, 99 s
+/// and 5.6 GB; 2,197 at 8 cells, 87 iterations, 63 s and 3.6 GB; at 6,859 the two break
+/// even: docs/static-solver.md).
+const MOST_COARSE_CELLS_3D: usize = 8_000;
+
+/// The relative stiffness added to the coarse diagonal (see the module's doc). Coarse
+/// nodes that reach a body's surface through slivers of their cells make P^T K P nearly
+/// singular as well: the tube of `cylinder_surface_3d` stopped its factorization at 1e-8
+/// and factorizes from 1e-7; 1e-4 leaves a margin and changes no iteration count measured
+/// (the tube's 85, the penny's 55).
+const SHIFT: f64 = 1e-4;
 
 /// The coarse grid: the interpolation to the fine entries and its stiffness's factor,
 /// which a set of unknowns whose particles see the same held components shares with the
@@ -83,6 +96,8 @@ pub struct Coarse {
     layout: Layout,
     /// P^T K P's factor.
     stiffness: Arc<Stiffness>,
+    /// Fine cells per coarse cell along each axis.
+    ratio: usize,
 }
 
 /// The coarse stiffness P^T K P on its unknowns, factorized.
@@ -191,9 +206,24 @@ impl Layout {
 struct Shape {
     nodes: [usize; 3],
     stride: [usize; 3],
+    /// Fine cells per coarse cell along each axis.
+    ratio: usize,
 }
 
 impl Shape {
+    /// The coarse grid of `ratio` fine cells a coarse one over a fine grid of `cells`.
+    fn of<D: Dim>(cells: [usize; 3], ratio: usize) -> Self {
+        let mut nodes = [1usize; 3];
+        for (n, &c) in nodes.iter_mut().zip(&cells).take(D::D) {
+            *n = c.div_ceil(ratio) + 1;
+        }
+        Shape {
+            nodes,
+            stride: [1, nodes[0], nodes[0] * nodes[1]],
+            ratio,
+        }
+    }
+
     /// Coarse node `c`'s index per axis.
     fn ijk(&self, mut c: usize) -> [usize; 3] {
         let mut out = [0; 3];
@@ -210,33 +240,54 @@ impl Coarse {
     /// elastic P^T K P (without the ghost's, whose share is 1e-11), taken from `last` (the
     /// last load step's) where every particle sees the same held components through its
     /// entries (a grown crack gives particles new entries of the same nodes, whose values
-    /// P interpolates alike), else assembled and factorized. Says why when the
-    /// factorization fails.
+    /// P interpolates alike), else assembled and factorized. Its ratio is `last`'s, or
+    /// [`RATIO`] doubled in 3D while more than [`MOST_COARSE_CELLS_3D`] coarse cells hold
+    /// particles, halved back while P^T K P is not positive definite (a wall thinner than
+    /// two coarse cells can leave coarse nodes whose fine entries all lie on one plane).
+    /// Says why when the factorization fails at [`RATIO`].
     pub(super) fn new<D: Dim>(
         world: &World<D>,
         dofs: &Unknowns<D>,
         last: Option<&Coarse>,
     ) -> Result<Self, String> {
-        let geom = &world.grid.geom;
-        let mut nodes = [1usize; 3];
-        for (n, &cells) in nodes.iter_mut().zip(&geom.cells).take(D::D) {
-            *n = cells.div_ceil(RATIO) + 1;
-        }
-        let shape = Shape {
-            nodes,
-            stride: [1, nodes[0], nodes[0] * nodes[1]],
+        let mut ratio = match last {
+            Some(c) => c.ratio,
+            None => {
+                let mut ratio = RATIO;
+                while D::D == 3 && occupied(world, ratio) > MOST_COARSE_CELLS_3D {
+                    ratio *= 2;
+                }
+                ratio
+            }
         };
+        loop {
+            match Self::with_ratio(world, dofs, last, ratio) {
+                Err(_) if ratio > RATIO => ratio /= 2,
+                made => return made,
+            }
+        }
+    }
+
+    /// [`Coarse::new`] at `ratio` fine cells a coarse one.
+    fn with_ratio<D: Dim>(
+        world: &World<D>,
+        dofs: &Unknowns<D>,
+        last: Option<&Coarse>,
+        ratio: usize,
+    ) -> Result<Self, String> {
+        let geom = &world.grid.geom;
+        let shape = Shape::of::<D>(geom.cells, ratio);
         let parents: Vec<Parents> = (0..dofs.free.len())
             .into_par_iter()
             .map(|e| parents_of::<D>(geom.stride, shape, entry_node(world, e)))
             .collect();
-        let (start, children) = invert(&parents, nodes.iter().product());
+        let (start, children) = invert(&parents, shape.nodes.iter().product());
         let keep = keep_bits(dofs);
         let layout = Layout::of(world);
         // Split across ranks, each sees its own particles: all keep the factor or none.
         let sees = |c: &Coarse| !world.domain.any(!layout.sees_as(&keep, &c.layout, &c.keep));
         let stiffness = match last {
-            Some(c) if sees(c) => c.stiffness.clone(),
+            Some(c) if c.ratio == ratio && sees(c) => c.stiffness.clone(),
             _ => Arc::new(Stiffness::new::<D>(world, shape, &parents, &keep)?),
         };
         Ok(Coarse {
@@ -246,6 +297,7 @@ impl Coarse {
             keep,
             layout,
             stiffness,
+            ratio,
         })
     }
 
@@ -359,6 +411,23 @@ impl Stiffness {
     }
 }
 
+/// How many coarse cells of `ratio` fine cells hold a particle (at its initial place, where
+/// a static solve takes it), over every rank.
+fn occupied<D: Dim>(world: &World<D>, ratio: usize) -> usize {
+    let geom = &world.grid.geom;
+    let cell = |x: &D::Vec| {
+        (0..D::D).rev().fold(0u64, |at, a| {
+            let coarse = geom.cells[a].div_ceil(ratio);
+            let c = ((x[a] - geom.origin[a]) * geom.inv_h[a]).floor().max(0.0) as usize;
+            at * coarse as u64 + (c / ratio).min(coarse - 1) as u64
+        })
+    };
+    let mut cells: Vec<u64> = world.particles.x0.par_iter().map(cell).collect();
+    cells.par_sort_unstable();
+    cells.dedup();
+    world.domain.union(cells).len()
+}
+
 /// Per entry, the bits of the components the interpolation moves: the free ones, a
 /// sliver's its partner's.
 fn keep_bits<D: Dim>(dofs: &Unknowns<D>) -> Vec<u8> {
@@ -395,9 +464,9 @@ fn parents_of<D: Dim>(fine_stride: [usize; 3], shape: Shape, mut n: usize) -> Pa
     };
     p.weight[0] = 1.0;
     for (a, &i) in ijk.iter().enumerate().take(D::D) {
-        let (c0, t) = (i / RATIO, i % RATIO);
+        let (c0, t) = (i / shape.ratio, i % shape.ratio);
         let odd = t != 0;
-        let upper = t as f64 / RATIO as f64;
+        let upper = t as f64 / shape.ratio as f64;
         p.low[a] = c0 as u32;
         let count = p.count as usize;
         for k in 0..count {
