@@ -377,6 +377,42 @@ mod tests {
         }
     }
 
+    /// uGIMP on a particle whose domain lies inside one cell is the linear shape: each
+    /// node's weight and gradient the linear ones (the hat's value and slope at the centre,
+    /// the mean over the domain of a hat that is linear there), nodes beyond the cell zero.
+    /// The static solver takes the linear stencil on such scenes on this identity.
+    #[test]
+    fn ugimp_inside_a_cell_is_linear() {
+        let (inv_h, cell) = (500.0, 7.0);
+        for l in [0.05, 0.125, 0.25, 0.5] {
+            for s in 0..=100 {
+                // Domains from touching the cell's lower edge to touching its upper one.
+                let xi = cell + l + (1.0 - 2.0 * l) * s as f64 / 100.0;
+                let (gb, gw, gd) = ShapeKind::Ugimp.axis(xi, l, inv_h);
+                let (lb, lw, ld) = ShapeKind::Linear.axis(xi, l, inv_h);
+                let weight = |base: usize, w: &[f64; 3], node: usize| {
+                    if node >= base && node < base + 3 {
+                        w[node - base]
+                    } else {
+                        0.0
+                    }
+                };
+                for node in [6, 7, 8, 9] {
+                    let (ug, li) = (weight(gb, &gw, node), weight(lb, &lw, node));
+                    let (dug, dli) = (weight(gb, &gd, node), weight(lb, &ld, node));
+                    assert!(
+                        (ug - li).abs() < 1e-12,
+                        "l {l} xi {xi} node {node}: {ug} vs {li}"
+                    );
+                    assert!(
+                        (dug - dli).abs() < 1e-9 * inv_h,
+                        "l {l} xi {xi} node {node}: {dug} vs {dli}"
+                    );
+                }
+            }
+        }
+    }
+
     /// Partition of unity, zero gradient sum and linear completeness hold for every kind.
     #[test]
     fn partition_of_unity_and_linear_reproduction() {

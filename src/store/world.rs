@@ -224,9 +224,10 @@ impl<D: Dim> World<D> {
     /// With linear shape functions, the particles now in another grid cell than the one
     /// they started in (None with the other shapes). Each crossing of a cell edge jumps a
     /// linear stencil's gradients, and with them the particle's internal force (the
-    /// cell-crossing error that GIMP removes, Bardenhagen & Kober 2004).
+    /// cell-crossing error that GIMP removes, Bardenhagen & Kober 2004). None in a static
+    /// scene too, whose stiffness stays on the particles' initial places.
     pub fn cell_crossings(&self) -> Option<usize> {
-        if self.settings.shape != ShapeKind::Linear {
+        if self.settings.shape != ShapeKind::Linear || self.settings.solver == Solver::Static {
             return None;
         }
         let g = &self.grid.geom;

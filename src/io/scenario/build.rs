@@ -67,6 +67,8 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     }
     let min_mass = particles.mass.iter().copied().fold(f64::INFINITY, f64::min);
     let s = &src.scenario.simulation;
+    let shape =
+        super::settings::solve_shape::<D>(s.solver, s.shape, &particles.x0, &particles.half, &geom);
     let world = World {
         tiles: filled.tiles,
         grid: Grid::new(geom),
@@ -76,7 +78,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
             solver: s.solver,
             tolerance: s.tolerance.unwrap_or(STATIC_TOLERANCE),
             linear: s.linear.unwrap_or_default(),
-            shape: s.shape,
+            shape,
             dilatation: s.dilatation,
             update: s.update,
             plane: sim.plane,
