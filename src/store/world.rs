@@ -69,7 +69,8 @@ pub enum LinearSolver {
     /// Matrix-free conjugate gradients with a Jacobi preconditioner.
     Cg,
     /// Matrix-free conjugate gradients with Jacobi and a coarse grid of four times the
-    /// cell size (a two-level additive Schwarz preconditioner).
+    /// cell size, eight or more on large 3D bodies (a two-level additive Schwarz
+    /// preconditioner).
     #[serde(rename = "two_level")]
     TwoLevel,
 }
