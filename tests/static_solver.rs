@@ -1288,19 +1288,7 @@ fn cell_mean_dilatation_assembles_the_operator_it_applies() {
     };
     let (direct, most_direct) = solve("direct");
     let (cg, most_cg) = solve("cg");
-    let scale = direct
-        .iter()
-        .map(|s| s.xx.abs().max(s.yy.abs()))
-        .fold(0.0, f64::max);
-    let worst = (direct.iter().zip(&cg))
-        .map(|(a, b)| {
-            (a.xx - b.xx)
-                .abs()
-                .max((a.yy - b.yy).abs())
-                .max((a.xy - b.xy).abs())
-        })
-        .fold(0.0, f64::max);
-    assert!(worst < 1e-6 * scale, "{worst} of {scale}");
+    same_stresses(&direct, &cg);
     assert!(most_direct <= 6 && most_cg <= 7, "{most_direct}, {most_cg}");
 }
 
@@ -1330,11 +1318,17 @@ fn auto_takes_the_coarse_grid_for_large_plastic_scenes() {
     direct_kept(&shipped("auto").replace("nu = 0.3", "nu = 0.45"));
     let stress = |t: &str| final_world::<D2>(t, 2).particles.stress;
     let (direct, coarse) = (stress(&shipped("direct")), stress(&shipped("auto")));
-    let scale = direct
+    same_stresses(&direct, &coarse);
+}
+
+/// Asserts that two solves' particle stresses agree within 1e-6 of the first's largest
+/// normal stress: the Newton tolerance (1e-8 of the load) leaves far less between them.
+fn same_stresses(a: &[fissure::base::sym::Sym2], b: &[fissure::base::sym::Sym2]) {
+    let scale = a
         .iter()
         .map(|s| s.xx.abs().max(s.yy.abs()))
         .fold(0.0, f64::max);
-    let worst = (direct.iter().zip(&coarse))
+    let worst = (a.iter().zip(b))
         .map(|(a, b)| {
             (a.xx - b.xx)
                 .abs()
