@@ -416,10 +416,9 @@ impl Stiffness {
 fn occupied<D: Dim>(world: &World<D>, ratio: usize) -> usize {
     let geom = &world.grid.geom;
     let cell = |x: &D::Vec| {
+        let (fine, _) = geom.cell_range(*x, *x);
         (0..D::D).rev().fold(0u64, |at, a| {
-            let coarse = geom.cells[a].div_ceil(ratio);
-            let c = ((x[a] - geom.origin[a]) * geom.inv_h[a]).floor().max(0.0) as usize;
-            at * coarse as u64 + (c / ratio).min(coarse - 1) as u64
+            at * geom.cells[a].div_ceil(ratio) as u64 + (fine[a] / ratio) as u64
         })
     };
     let mut cells: Vec<u64> = world.particles.x0.par_iter().map(cell).collect();
