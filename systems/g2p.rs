@@ -95,7 +95,8 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
             });
             fastest
         },
-        |c| world.domain.settle(c, &[&momentum_w]),
+        world.domain.waits(),
+        |classes, run| world.domain.settle_pass(classes, &[&momentum_w], run),
     );
     let fastest = fastest.max(move_coded(world));
     if let Some(c) = world.cracks.as_ref() {

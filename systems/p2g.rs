@@ -73,11 +73,12 @@ fn scatter<D: Dim, const FORCE: bool>(world: &mut World<D>) {
                 }
             })
         },
-        |c| {
+        domain.waits(),
+        |classes, run| {
             if FORCE {
-                domain.settle(c, &[&mass_w, &momentum_w, &force_w]);
+                domain.settle_pass(classes, &[&mass_w, &momentum_w, &force_w], run);
             } else {
-                domain.settle(c, &[&mass_w, &momentum_w]);
+                domain.settle_pass(classes, &[&mass_w, &momentum_w], run);
             }
         },
     );

@@ -56,7 +56,8 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
                 }
             })
         },
-        |c| domain.settle(c, &[&force_w]),
+        domain.waits(),
+        |classes, run| domain.settle_pass(classes, &[&force_w], run),
     );
     if world.cracks.is_some() {
         update_coded(world, dt);

@@ -126,6 +126,41 @@ impl Comm {
         Vec::new()
     }
 
+    /// A scatter pass over `classes` colour classes with an exchange after each: `run(c,
+    /// false)` runs class c's tiles that need nothing from the class before, `run(c,
+    /// true)` the others once `unpack(c - 1, got)` has taken what `peers(c - 1)` sent
+    /// (in their order); then `pack(c)` gives what goes to each of `peers(c)`. Sends do
+    /// not wait to be received: a rank early with a class works on the next while its
+    /// values travel, and waits only for values its next tiles need.
+    pub fn colour_pass(
+        &self,
+        classes: usize,
+        peers: impl Fn(usize) -> Vec<usize>,
+        mut pack: impl FnMut(usize) -> Vec<Vec<u8>>,
+        mut unpack: impl FnMut(usize, Vec<Vec<u8>>),
+        mut run: impl FnMut(usize, bool),
+    ) {
+        #[cfg(feature = "mpi")]
+        if let Some(w) = &self.world {
+            let t = &self.traffic;
+            let mut pack = |c: usize| {
+                let out = pack(c);
+                t.messages.fetch_add(out.len() as u64, Ordering::Relaxed);
+                let bytes = out.iter().map(|b| b.len() as u64).sum();
+                t.bytes.fetch_add(bytes, Ordering::Relaxed);
+                out
+            };
+            w.colour_pass(classes, peers, &mut pack, &mut unpack, &mut run, t);
+            return;
+        }
+        for c in 0..classes {
+            debug_assert!(peers(c).is_empty(), "one rank has no peers");
+            run(c, false);
+            run(c, true);
+        }
+        let _ = (&mut pack, &mut unpack);
+    }
+
     /// Every rank's bytes, in rank order.
     pub fn all_gather(&self, mine: Vec<u8>) -> Vec<Vec<u8>> {
         #[cfg(feature = "mpi")]
@@ -200,6 +235,7 @@ mod mpi_world {
     use mpi::environment::Threading;
     use mpi::topology::SimpleCommunicator;
     use mpi::traits::*;
+    use std::cell::OnceCell;
     use std::sync::Arc;
 
     /// The MPI world communicator.
@@ -280,6 +316,53 @@ mod mpi_world {
                 });
                 got
             })
+        }
+
+        pub fn colour_pass(
+            &self,
+            classes: usize,
+            peers: impl Fn(usize) -> Vec<usize>,
+            pack: &mut dyn FnMut(usize) -> Vec<Vec<u8>>,
+            unpack: &mut dyn FnMut(usize, Vec<Vec<u8>>),
+            run: &mut dyn FnMut(usize, bool),
+            traffic: &super::Traffic,
+        ) {
+            let to: Vec<Vec<usize>> = (0..classes).map(&peers).collect();
+            // Every class's messages, made before the scope so that its sends may borrow
+            // them until the pass ends.
+            let out: Vec<OnceCell<Vec<Vec<u8>>>> = (0..classes).map(|_| OnceCell::new()).collect();
+            mpi::request::scope(|scope| {
+                let mut sends = Vec::new();
+                for c in 0..=classes {
+                    if c < classes {
+                        run(c, false);
+                    }
+                    if let Some(b) = c.checked_sub(1) {
+                        let got = traffic.timed(|| {
+                            (to[b].iter())
+                                .map(|&p| self.0.process_at_rank(p as i32).receive_vec::<u8>().0)
+                                .collect()
+                        });
+                        unpack(b, got);
+                    }
+                    if c == classes {
+                        break;
+                    }
+                    run(c, true);
+                    let bufs = out[c].get_or_init(|| pack(c));
+                    traffic.timed(|| {
+                        for (&p, buf) in to[c].iter().zip(bufs) {
+                            let r = self.0.process_at_rank(p as i32);
+                            sends.push(r.immediate_send(scope, &buf[..]));
+                        }
+                    });
+                }
+                traffic.timed(|| {
+                    sends.into_iter().for_each(|r| {
+                        r.wait();
+                    })
+                });
+            });
         }
 
         pub fn all_gather(&self, mine: &[u8]) -> Vec<Vec<u8>> {

@@ -6,12 +6,17 @@
 //! only (`tiles.rs`). Split across ranks, each rank scatters its own tiles of a class,
 //! then sends every shared node its tiles of that class reach to the peers that reach it
 //! too, which take the value as theirs. Before each class every rank holding a shared node
-//! therefore holds the one-rank running sum, and after the last class the full sum.
+//! therefore holds the one-rank running sum, and after the last class the full sum. While
+//! a class's values travel, each rank scatters the next class's tiles that reach none of
+//! the nodes it receives (`Partition::waits`): those tiles add to no node whose running
+//! sum is on its way, so the order of every sum stays that of one rank, and a rank ahead
+//! of its peer works instead of waiting.
 
 use crate::base::error::Unstable;
 use crate::base::exact_sum::ExactSum;
 use crate::ranks::comm::Comm;
 use crate::ranks::partition::Partition;
+use bitvec::slice::BitSlice;
 use bytemuck::Pod;
 use std::ops::Range;
 
@@ -45,31 +50,54 @@ impl Domain {
         self.partition.is_some()
     }
 
-    /// After colour class `class`: sends the shared nodes this rank's tiles of the class
-    /// reached, in every column of `columns`, and takes the peers' (see the module doc).
-    pub fn settle(&self, class: usize, columns: &[&dyn Shared]) {
+    /// A scatter pass over `classes` colour classes, settling the shared nodes of every
+    /// column of `columns` after each (see the module doc): `run(c, held)` scatters class
+    /// c's tiles that [`wait`](Self::waits) (`held`) or the others. After each class this
+    /// rank sends the shared nodes its tiles of the class reached and takes the peers'
+    /// before running the next class's held tiles; on one rank it runs the classes in turn.
+    pub fn settle_pass(
+        &self,
+        classes: usize,
+        columns: &[&dyn Shared],
+        run: impl FnMut(usize, bool),
+    ) {
         let Some(p) = &self.partition else {
+            let mut run = run;
+            for c in 0..classes {
+                run(c, false);
+                run(c, true);
+            }
             return;
         };
-        let talks = &p.talks[class];
-        let peers: Vec<usize> = talks.iter().map(|&k| p.peers[k]).collect();
-        let out: Vec<Vec<u8>> = (talks.iter())
-            .map(|&k| {
-                let mut buf = Vec::new();
-                columns
-                    .iter()
-                    .for_each(|c| c.pack(&p.sends[class][k], &mut buf));
-                buf
-            })
-            .collect();
-        let got = self.comm.exchange(&peers, &out);
-        for (&k, bytes) in talks.iter().zip(&got) {
-            let nodes = &p.receives[class][k];
-            let mut at = 0;
-            for c in columns {
-                at += c.unpack(nodes, &bytes[at..]);
+        let peers = |c: usize| p.talks[c].iter().map(|&k| p.peers[k]).collect();
+        let pack = |c: usize| {
+            (p.talks[c].iter())
+                .map(|&k| {
+                    let mut buf = Vec::new();
+                    columns
+                        .iter()
+                        .for_each(|col| col.pack(&p.sends[c][k], &mut buf));
+                    buf
+                })
+                .collect()
+        };
+        let unpack = |c: usize, got: Vec<Vec<u8>>| {
+            for (&k, bytes) in p.talks[c].iter().zip(&got) {
+                let nodes = &p.receives[c][k];
+                let mut at = 0;
+                for col in columns {
+                    at += col.unpack(nodes, &bytes[at..]);
+                }
             }
-        }
+        };
+        self.comm.colour_pass(classes, peers, pack, unpack, run);
+    }
+
+    /// The tiles whose scatter must wait for the colour class before their own to settle
+    /// (they reach a node a peer sends after it), None on one rank: the others of the
+    /// class run while that class's values travel ([`settle_pass`](Self::settle_pass)).
+    pub fn waits(&self) -> Option<&BitSlice> {
+        self.partition.as_ref().map(|p| p.waits.as_bitslice())
     }
 
     /// The grid entries, of `len` with the crack fields' extra rows from `nodes` on, that

@@ -80,6 +80,9 @@ pub struct Partition {
     pub sends: Vec<Vec<Vec<u32>>>,
     /// Per colour class, per peer: the shared nodes this rank receives after the class.
     pub receives: Vec<Vec<Vec<u32>>>,
+    /// Per tile: whether it is this rank's and reaches a node this rank receives after the
+    /// colour class before the tile's own (class 0 waits for none).
+    pub waits: BitVec,
     /// Per colour class: the peers (their indices in `peers`) this rank sends to or
     /// receives from after the class; the others are left out on both sides, since the
     /// lists are each other's mirror.
@@ -151,6 +154,19 @@ impl Partition {
                     .collect()
             })
             .collect();
+        let mut waits = bitvec![0; owner.len()];
+        for c in 1..classes {
+            let mut arriving = bitvec![0; total];
+            receives[c - 1]
+                .iter()
+                .flatten()
+                .for_each(|&n| arriving.set(n as usize, true));
+            for t in (0..owner.len()).filter(|&t| owner[t] as usize == me && grid.colour(t) == c) {
+                let mut reaches = false;
+                grid.for_each_reached(t, |n| reaches |= arriving[n]);
+                waits.set(t, reaches);
+            }
+        }
         let shared = (peers.iter())
             .map(|&q| reached[q].clone() & &reached[me])
             .collect();
@@ -179,6 +195,7 @@ impl Partition {
             shared,
             sends,
             receives,
+            waits,
             talks,
         })
     }

@@ -8,6 +8,7 @@
 
 use crate::base::dim::Dim;
 use crate::physics::shape::StencilCache;
+use bitvec::slice::BitSlice;
 
 /// Tiles wider than this many cells keep same-colour tiles' stencils disjoint.
 pub const MIN_TILE: usize = 3;
@@ -129,20 +130,22 @@ impl Tiles {
     /// Runs `f` on every non-empty tile: colour classes one after another, the tiles of a
     /// class in parallel. Tiles of one class never share a node.
     pub fn for_each_coloured(&self, f: impl Fn(u32) + Sync + Send) {
-        self.for_each_coloured_then(f, |_| {});
+        self.for_each_coloured_then(f, None, |classes, run| {
+            (0..classes).for_each(|c| run(c, false));
+        });
     }
 
-    /// As [`for_each_coloured`](Self::for_each_coloured), calling `after` with each class's
-    /// number once its tiles are done (where ranks settle the nodes they share).
+    /// As [`for_each_coloured`](Self::for_each_coloured), with the classes' order left to
+    /// `pass(classes, run)` (where ranks settle the nodes they share): `run(c, held)` runs
+    /// class c's tiles that `waits` holds (`held`) or the others (all of them without
+    /// `waits`), and `pass` must call it once each way for every class.
     pub fn for_each_coloured_then(
         &self,
         f: impl Fn(u32) + Sync + Send,
-        mut after: impl FnMut(usize),
+        waits: Option<&BitSlice>,
+        pass: impl FnOnce(usize, &mut dyn FnMut(usize, bool)),
     ) {
-        for (c, class) in self.colours.iter().enumerate() {
-            weighted_join(class, &|t| self.weight(t), &f, (), &|(), ()| ());
-            after(c);
-        }
+        self.fold_coloured(&f, (), &|(), ()| (), waits, pass);
     }
 
     /// As [`for_each_coloured_then`](Self::for_each_coloured_then), returning the largest
@@ -151,20 +154,40 @@ impl Tiles {
     pub fn max_coloured_then(
         &self,
         f: impl Fn(u32) -> f64 + Sync + Send,
-        mut after: impl FnMut(usize),
+        waits: Option<&BitSlice>,
+        pass: impl FnOnce(usize, &mut dyn FnMut(usize, bool)),
     ) -> f64 {
-        let mut most = 0.0f64;
-        for (c, class) in self.colours.iter().enumerate() {
-            most = most.max(weighted_join(
-                class,
-                &|t| self.weight(t),
-                &f,
-                0.0,
-                &f64::max,
-            ));
-            after(c);
-        }
-        most
+        self.fold_coloured(&f, 0.0, &f64::max, waits, pass)
+    }
+
+    /// The colour classes in the order `pass` runs them, each run's tiles in parallel
+    /// ([`weighted_join`]), folding `f`'s values.
+    fn fold_coloured<T: Send + Sync + Copy>(
+        &self,
+        f: &(impl Fn(u32) -> T + Sync),
+        init: T,
+        fold: &(impl Fn(T, T) -> T + Sync),
+        waits: Option<&BitSlice>,
+        pass: impl FnOnce(usize, &mut dyn FnMut(usize, bool)),
+    ) -> T {
+        let count = |t: u32| self.weight(t);
+        let mut acc = init;
+        let mut run = |c: usize, held: bool| {
+            let class = &self.colours[c];
+            let ran = match waits {
+                None if held => init,
+                None => weighted_join(class, &count, f, init, fold),
+                Some(waits) => {
+                    let part: Vec<u32> = (class.iter().copied())
+                        .filter(|&t| waits[t as usize] == held)
+                        .collect();
+                    weighted_join(&part, &count, f, init, fold)
+                }
+            };
+            acc = fold(acc, ran);
+        };
+        pass(self.colours.len(), &mut run);
+        acc
     }
 
     /// Rebuilds `start`, `order` and `colours` from `tile_of` (counting sort).

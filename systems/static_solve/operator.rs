@@ -120,7 +120,8 @@ pub(super) fn stiffness<D: Dim>(
                 unsafe { add_internal_force::<D, N>(&st, &rows, &s, -p.volume[i], &y_w) };
             })
         },
-        |c| domain.settle(c, &[&y_w]),
+        domain.waits(),
+        |classes, run| domain.settle_pass(classes, &[&y_w], run),
     );
     // The particles near a crack, on their sides' entries, in particle order.
     near_crack_sums(world, y, |i, emit| {

@@ -47,7 +47,8 @@ pub(super) fn entry_sums<D: Dim>(
                     });
                 }
             },
-            |c| domain.settle(c, &[&y_w]),
+            domain.waits(),
+            |classes, run| domain.settle_pass(classes, &[&y_w], run),
         );
     }
     near_crack_sums(world, &mut y, |i, emit| {
