@@ -137,8 +137,9 @@ impl Tiles {
 
     /// As [`for_each_coloured`](Self::for_each_coloured), with the classes' order left to
     /// `pass(classes, run)` (where ranks settle the nodes they share): `run(c, held)` runs
-    /// class c's tiles that `waits` holds (`held`) or the others (all of them without
-    /// `waits`), and `pass` must call it once each way for every class.
+    /// class c's tiles that `waits` holds (`held`) or the others, and `pass` calls it once
+    /// each way for every class; without `waits`, `run(c, false)` runs the whole class and
+    /// `run(c, true)` nothing.
     pub fn for_each_coloured_then(
         &self,
         f: impl Fn(u32) + Sync + Send,
