@@ -62,12 +62,9 @@ impl Domain {
         run: impl FnMut(usize, bool),
     ) {
         let Some(p) = &self.partition else {
-            let mut run = run;
-            for c in 0..classes {
-                run(c, false);
-                run(c, true);
-            }
-            return;
+            return self
+                .comm
+                .colour_pass(classes, |_| Vec::new(), |_| Vec::new(), |_, _| {}, run);
         };
         let peers = |c: usize| p.talks[c].iter().map(|&k| p.peers[k]).collect();
         let pack = |c: usize| {
