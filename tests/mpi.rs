@@ -707,6 +707,45 @@ fn a_build_without_mpi_refuses_several_ranks() {
     assert!(err.contains("--features mpi"), "{err}");
 }
 
+/// Each rank builds only its own tiles' particles, so a check on the whole scene combines
+/// the ranks' answers: a crack whose front lies near no particle of any rank, or whose
+/// tip lies near particles of one rank only, is judged as one process judges it, and a
+/// refusal is one message, the one process's, not a hang.
+#[test]
+#[cfg(feature = "mpi")]
+fn a_scene_built_rank_by_rank_is_checked_whole() {
+    let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_whole", std::process::id()));
+    let away = ["--set", "crack[0].line.end=[0.05, 0.027]"];
+    let one = launch("scenarios/dcb_2d.toml", None, &dir, &away);
+    let two = launch("scenarios/dcb_2d.toml", Some(2), &dir, &away);
+    let (one, two) = (
+        String::from_utf8_lossy(&one.stderr),
+        String::from_utf8_lossy(&two.stderr),
+    );
+    assert!(one.contains("is outside every body"), "{one}");
+    assert_eq!(two.matches("error:").count(), 1, "{two}");
+    let line = |s: &str| s.lines().find(|l| l.contains("error:")).map(str::to_owned);
+    assert_eq!(line(&one), line(&two));
+    // The tip near particles of one rank only (4 mm from the clamped end): accepted, and
+    // its J and K those of one process (the beam cut nearly through fails the scene's
+    // expects, which is not what is tested here).
+    let near = [
+        "--set",
+        "crack[0].line.end=[0.004, 0.012]",
+        "--until",
+        "1e-4",
+    ];
+    let fracture = |ranks: Option<usize>| {
+        let out = dir.join(format!("near_{}", ranks.unwrap_or(1)));
+        let done = launch("scenarios/dcb_2d.toml", ranks, &out, &near);
+        let said = String::from_utf8_lossy(&done.stderr);
+        assert!(!said.contains("error:"), "{said}");
+        std::fs::read(out.join("fracture.csv")).expect("fracture.csv written")
+    };
+    assert_eq!(fracture(None), fracture(Some(2)));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// What a split run cannot do yet is refused by name, once (by the first rank): the sparse
 /// direct solver, and the commands that run on one process.
 #[cfg(feature = "mpi")]

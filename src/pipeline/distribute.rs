@@ -14,8 +14,10 @@ use crate::store::world::{LinearSolver, Solver, World};
 use crate::systems::bin;
 use std::borrow::Cow;
 
-/// Keeps this rank's particles of a scene every rank built whole: those in the tiles the
-/// partition gives it, numbered by their index in the whole scene. Loads and probes keep
+/// Splits a scene across the ranks of `comm`: a scene built rank by rank
+/// ([`build_share`](crate::io::scenario::build_share)) already holds this rank's share; one
+/// every rank built whole (a resumed run's) keeps the particles in the tiles the partition
+/// gives this rank, numbered by their index in the whole scene. Loads and probes keep
 /// their whole lists, with the entries of other ranks' particles marked [`ABSENT`].
 pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> anyhow::Result<()> {
     if !comm.is_split() {
@@ -26,6 +28,26 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
         return Ok(());
     }
     refuse_unsupported(world)?;
+    if world.domain.partition.is_none() {
+        keep_share(world, comm)?;
+    }
+    if let Some(c) = world.cracks.as_mut() {
+        c.scratch.forget_particles();
+    }
+    for load in &mut world.loads {
+        load.ids = load.particles.clone();
+    }
+    for probe in probes.iter_mut() {
+        probe.ids = probe.particles.clone();
+    }
+    world.tiles.tile_of.clear();
+    world.tiles.fresh = false;
+    localize(world, probes);
+    Ok(())
+}
+
+/// Divides the tiles of a scene this rank holds whole and keeps its own tiles' particles.
+fn keep_share<D: Dim>(world: &mut World<D>, comm: Comm) -> anyhow::Result<()> {
     bin_for_split(world).map_err(|u| anyhow::anyhow!("{u}"))?;
     let tiles = &world.tiles;
     let counts: Vec<u32> = tiles.start.windows(2).map(|w| w[1] - w[0]).collect();
@@ -42,23 +64,11 @@ pub fn split<D: Dim>(world: &mut World<D>, probes: &mut [Probe], comm: Comm) -> 
         .collect();
     world.particles.id = (0..world.particles.len() as u64).collect();
     world.particles.permute(&keep);
-    if let Some(c) = world.cracks.as_mut() {
-        c.scratch.forget_particles();
-    }
-    for load in &mut world.loads {
-        load.ids = load.particles.clone();
-    }
-    for probe in probes.iter_mut() {
-        probe.ids = probe.particles.clone();
-    }
-    world.tiles.tile_of.clear();
-    world.tiles.fresh = false;
     world.domain = Domain {
         comm,
         partition: Some(partition),
         rebalances: 0,
     };
-    localize(world, probes);
     Ok(())
 }
 

@@ -146,7 +146,7 @@ impl Domain {
 
     /// The largest of every rank's `x`.
     pub fn max(&self, x: f64) -> f64 {
-        if !self.is_split() {
+        if !self.comm.is_split() {
             return x;
         }
         (self.comm.all_gather(x.to_le_bytes().to_vec()).iter())
@@ -179,7 +179,7 @@ impl Domain {
         mine: Vec<Vec<T>>,
         key: impl Fn(&T) -> K,
     ) -> Vec<Vec<T>> {
-        if !self.is_split() {
+        if !self.comm.is_split() {
             return mine;
         }
         // Each rank's message: the lists' lengths, then their items.
@@ -306,7 +306,7 @@ impl Domain {
     /// value travel. The bits are those of one rank only where the terms add exactly
     /// (multiples of a quantum whose sums stay well inside the doubles' precision).
     pub fn add_rows(&self, values: &mut [f64], width: usize) {
-        if !self.is_split() {
+        if !self.comm.is_split() {
             return;
         }
         // Each rank's message: per nonzero row its index, then the row.

@@ -12,7 +12,7 @@ use crate::base::dim::{D2, D3, Dim};
 use crate::base::error::Unstable;
 use crate::base::sym::SymTensor;
 use crate::io::output::summary::Summary;
-use crate::io::scenario::{Scene, Source, build};
+use crate::io::scenario::{Scene, Source, build_share};
 use crate::io::snapshot::Reader;
 use crate::io::snapshot::state::restore;
 use crate::ranks::comm::Comm;
@@ -99,8 +99,8 @@ pub fn thread_count(asked: usize) -> usize {
 pub fn run(src: &Source, opts: &RunOptions) -> anyhow::Result<Outcome> {
     opts.writing(false);
     pool(opts)?.install(|| match src.scenario.simulation.dimension {
-        2 => drive::<D2>(src, build::<D2>(src)?, None, opts),
-        3 => drive::<D3>(src, build::<D3>(src)?, None, opts),
+        2 => drive::<D2>(src, build_share::<D2>(src, opts.comm.clone())?, None, opts),
+        3 => drive::<D3>(src, build_share::<D3>(src, opts.comm.clone())?, None, opts),
         _ => Err(src.error("simulation.dimension", "must be 2 or 3").into()),
     })
 }

@@ -240,11 +240,27 @@ pub fn particles_on_cracks<D: Dim>(world: &World<D>) -> Vec<ParticlesOnReport> {
     let geom = &world.grid.geom;
     let mut cell = [f64::INFINITY; 3];
     (0..D::D).for_each(|a| cell[a] = geom.h[a]);
-    (particles_on(cracks, &world.particles.x, cell).into_iter())
+    let found = particles_on(cracks, &world.particles.x, cell);
+    (every_rank(world, found).into_iter())
         .map(|(c, particles)| ParticlesOnReport {
             crack: cracks.topology.cracks()[c].name.clone(),
             particles,
         })
+        .collect()
+}
+
+/// Per-crack counts `(crack, count)` of this rank's particles added over every rank, the
+/// cracks with none left out.
+fn every_rank<D: Dim>(world: &World<D>, mine: Vec<(usize, usize)>) -> Vec<(usize, usize)> {
+    let Some(cracks) = &world.cracks else {
+        return mine;
+    };
+    let mut counts = vec![0.0; cracks.topology.cracks().len()];
+    mine.iter().for_each(|&(c, n)| counts[c] = n as f64);
+    world.domain.add_rows(&mut counts, 1);
+    (counts.iter().enumerate())
+        .filter(|c| *c.1 > 0.0)
+        .map(|(c, &n)| (c, n as usize))
         .collect()
 }
 
@@ -261,7 +277,7 @@ pub fn tips_on_particle_lines<D: Dim>(world: &World<D>) -> Vec<TipLinesReport> {
         &world.grid.geom,
         world.settings.shape,
     );
-    (found.into_iter())
+    (every_rank(world, found).into_iter())
         .map(|(c, lines)| TipLinesReport {
             crack: cracks.topology.cracks()[c].name.clone(),
             lines,
@@ -277,14 +293,16 @@ pub(super) fn ranks<D: Dim>(world: &World<D>, steps: u64) -> Option<RanksReport>
         return None;
     }
     let [messages, bytes, collectives, inside] = comm.traffic();
+    let peak = crate::io::output::summary::peak_resident_bytes().unwrap_or(0);
     let mine = [
         world.particles.len() as u64,
         messages,
         bytes,
         collectives,
         inside,
+        peak,
     ];
-    let all: Vec<[u64; 5]> = (comm.all_gather(bytemuck::cast_slice(&mine).to_vec()).iter())
+    let all: Vec<[u64; 6]> = (comm.all_gather(bytemuck::cast_slice(&mine).to_vec()).iter())
         .map(|b| bytemuck::pod_read_unaligned(b))
         .collect();
     let per_step = |k: usize| all.iter().map(move |r| r[k] as f64 / steps.max(1) as f64);
@@ -304,6 +322,10 @@ pub(super) fn ranks<D: Dim>(world: &World<D>, steps: u64) -> Option<RanksReport>
             all.iter().map(|r| r[4] as f64 * 1e-9).fold(0.0, f64::max),
         ],
         rebalances: world.domain.rebalances,
+        peak_resident_bytes: [
+            all.iter().map(|r| r[5]).sum::<u64>() / all.len() as u64,
+            all.iter().map(|r| r[5]).max().unwrap_or(0),
+        ],
     })
 }
 

@@ -58,6 +58,9 @@ pub struct RanksReport {
     pub mpi_seconds: [f64; 2],
     /// Times the tiles were divided anew as the particles moved.
     pub rebalances: u32,
+    /// Peak resident memory of a rank's process (bytes; Linux `VmHWM`, 0 where the system
+    /// does not report it): mean and most over the ranks.
+    pub peak_resident_bytes: [u64; 2],
 }
 
 /// The run summary written to summary.json at the end of a run.

@@ -10,6 +10,8 @@ use crate::base::dim::Dim;
 use crate::physics::bodies::{Solid, fill, first_outside};
 use crate::physics::material::Material;
 use crate::physics::shape::ShapeKind;
+use crate::ranks::domain::Domain;
+use crate::ranks::partition::{Partition, TileGrid};
 use crate::store::grid::GridGeom;
 use crate::store::particles::Particles;
 use crate::store::tiles::Tiles;
@@ -17,7 +19,8 @@ use crate::store::tiles::Tiles;
 /// Largest particle count one body may ask for.
 const MAX_PARTICLES: f64 = 2.0e8;
 
-/// The particles of every body, stored tile by tile, with what the later tables need.
+/// The particles of every body (split across ranks, this rank's share), stored tile by
+/// tile, with what the later tables need.
 pub(super) struct Filled<D: Dim> {
     /// The particle store, in tile order.
     pub particles: Particles<D>,
@@ -29,18 +32,24 @@ pub(super) struct Filled<D: Dim> {
     pub tiles: Tiles,
     /// Each body's region, in the order listed (where a crack's front may lie).
     pub claims: Vec<Claim>,
+    /// Split across ranks, this rank's tiles (None on one rank).
+    pub partition: Option<Partition>,
 }
 
 /// Fills every `[[body]]` in order (the first listed keeps a point two bodies share),
 /// after refusing a scene whose bodies' bounding boxes would hold more particles than the
 /// machine's memory; then orders the particles by tile, so the tile-ordered scatter streams
-/// through memory.
+/// through memory. Split across ranks, each rank first counts every tile's particles
+/// without storing them, divides the tiles, and then stores only its own tiles' particles,
+/// each numbered by its place in the whole scene's tile order: no rank ever holds the
+/// whole scene.
 pub(super) fn bodies<D: Dim>(
     src: &Source,
     grid: &GridPlan<D>,
     materials: &[Material],
     thickness: f64,
     tile: usize,
+    domain: &Domain,
 ) -> R<Filled<D>> {
     let sc = &src.scenario;
     let geom = &grid.geom;
@@ -62,49 +71,169 @@ pub(super) fn bodies<D: Dim>(
         }
         most += n;
     }
-    super::memory::check(src, D::D, most, grid.nodes, super::memory::available())?;
-    let mut particles = Particles::<D>::default();
-    let shape = sc.simulation.shape;
+    let ranks = domain.comm.size();
+    // The least any rank has free (every rank takes part, whatever it could read).
+    let free = domain.min(super::memory::available().unwrap_or(f64::INFINITY));
+    let free = free.is_finite().then_some(free);
+    super::memory::check(src, D::D, (most, ranks), grid.nodes, free)?;
     let mut used = vec![false; materials.len()];
-    let mut ppc = Vec::new();
+    let mut plans = Vec::new();
     let mut claims = Vec::new();
     for (b, body) in sc.bodies.iter().enumerate() {
-        add_body::<D>(
-            src,
-            b,
-            body,
-            geom,
-            materials,
-            &mut used,
-            shape,
-            thickness,
-            &mut particles,
-            &mut claims,
-        )?;
-        ppc.resize(particles.len(), body.ppc as f64);
+        let (plan, claim) = plan_body::<D>(src, b, body, geom, materials, &mut used, thickness)?;
+        plans.push(plan);
+        claims.push(claim);
     }
-
     let tiles = Tiles::new::<D>(tile, geom.cells);
-    let mut keyed: Vec<(u32, u32)> = (0..particles.len())
-        .map(|i| {
-            let x = particles.x[i];
-            let mut cell = [0; 3];
-            for a in 0..D::D {
-                cell[a] = ((x[a] - geom.origin[a]) * geom.inv_h[a]) as usize;
-            }
-            (tiles.tile_of_cell(cell), i as u32)
-        })
-        .collect();
-    keyed.sort_unstable();
-    particles.permute(&keyed.iter().map(|k| k.1).collect::<Vec<_>>());
-    let ppc: Vec<f64> = keyed.iter().map(|k| ppc[k.1 as usize]).collect();
+    let shape = sc.simulation.shape;
+    let bodies = Bodies {
+        plans: &plans,
+        claims: &claims,
+        geom,
+        shape,
+        tiles: &tiles,
+    };
+    let partition = if domain.comm.is_split() {
+        let counts = bodies.place(src, |_| false)?.counts;
+        let grid = TileGrid {
+            counts: tiles.counts,
+            size: tiles.size,
+            cells: geom.cells,
+            dims: D::D,
+        };
+        let p = Partition::new(grid, &counts, ranks, domain.comm.rank())
+            .map_err(|e| src.error("simulation.tile", e.to_string()))?;
+        Some(p)
+    } else {
+        None
+    };
+    let me = domain.comm.rank();
+    let placed = bodies.place(src, |t| {
+        partition.as_ref().is_none_or(|p| p.owns_tile(t, me))
+    })?;
+    let (particles, ppc) = placed.in_scene_order(partition.is_some());
     Ok(Filled {
         particles,
         ppc,
         used,
         tiles,
         claims,
+        partition,
     })
+}
+
+/// What every body puts on the lattice points it claims, and where they fall.
+struct Bodies<'a, D: Dim> {
+    plans: &'a [BodyPlan],
+    claims: &'a [Claim],
+    geom: &'a GridGeom<D>,
+    shape: ShapeKind,
+    tiles: &'a Tiles,
+}
+
+/// The particles of the tiles a pass kept, in fill order, with every tile's count of all
+/// the bodies' particles.
+struct Placed<D: Dim> {
+    particles: Particles<D>,
+    ppc: Vec<f64>,
+    /// Particles per tile, kept or not.
+    counts: Vec<u32>,
+    /// Each kept particle's tile and its place among that tile's particles.
+    keys: Vec<(u32, u32)>,
+}
+
+impl<D: Dim> Placed<D> {
+    /// The kept particles and their particles per cell, ordered by their number in the
+    /// whole scene: the particles of the tiles before their own, then their place among
+    /// their tile's in fill order (one process's tile order). With `numbered`, each
+    /// particle's `id` is that number.
+    fn in_scene_order(self, numbered: bool) -> (Particles<D>, Vec<f64>) {
+        let mut before = 0;
+        let first: Vec<u64> = (self.counts.iter())
+            .map(|&n| {
+                let f = before;
+                before += u64::from(n);
+                f
+            })
+            .collect();
+        let id: Vec<u64> = (self.keys.iter())
+            .map(|&(t, k)| first[t as usize] + u64::from(k))
+            .collect();
+        let mut order: Vec<u32> = (0..id.len() as u32).collect();
+        order.sort_unstable_by_key(|&i| id[i as usize]);
+        let mut particles = self.particles;
+        particles.permute(&order);
+        if numbered {
+            particles.id = order.iter().map(|&i| id[i as usize]).collect();
+        }
+        let ppc = order.iter().map(|&i| self.ppc[i as usize]).collect();
+        (particles, ppc)
+    }
+}
+
+impl<D: Dim> Bodies<'_, D> {
+    /// Fills every body in turn, storing the particles of the tiles `keep` accepts, and
+    /// refuses a body with no particle or one whose stencil would leave the grid.
+    fn place(&self, src: &Source, keep: impl Fn(u32) -> bool) -> R<Placed<D>> {
+        let geom = self.geom;
+        let (origin, h) = (D::to_xyz(geom.origin), D::to_xyz(geom.h));
+        let mut out = Placed {
+            particles: Particles::default(),
+            ppc: Vec::new(),
+            counts: vec![0; self.tiles.len()],
+            keys: Vec::new(),
+        };
+        for (b, (plan, claim)) in self.plans.iter().zip(self.claims).enumerate() {
+            let earlier: Vec<&Claim> = (self.claims[..b].iter())
+                .filter(|c| c.reaches(claim.bounds, D::D))
+                .collect();
+            let (mut found, mut outside) = (false, None);
+            let g = &claim.geometry;
+            fill(g, D::D, origin, h, geom.cells, plan.ppc, |x| {
+                if outside.is_some()
+                    || !claim.keeps(x, D::D)
+                    || earlier.iter().any(|c| c.contains(x, D::D))
+                {
+                    return;
+                }
+                if !geom.fits(self.shape, to_vec::<D>(x), to_vec::<D>(plan.half)) {
+                    outside = Some(x);
+                    return;
+                }
+                found = true;
+                let mut cell = [0; 3];
+                for a in 0..D::D {
+                    cell[a] = ((x[a] - origin[a]) * geom.inv_h[a]) as usize;
+                }
+                let t = self.tiles.tile_of_cell(cell);
+                if keep(t) {
+                    out.keys.push((t, out.counts[t as usize]));
+                    plan.push(x, self.shape, &mut out.particles);
+                    out.ppc.push(plan.ppc as f64);
+                }
+                out.counts[t as usize] += 1;
+            });
+            if let Some(x) = outside {
+                return Err(src.error(
+                    &format!("body[{b}]"),
+                    format!(
+                        "body extends beyond the grid: a particle at ({:.4e}, {:.4e}, {:.4e}) m \
+                         needs its shape-function support inside the grid; enlarge the grid by \
+                         a cell",
+                        x[0], x[1], x[2]
+                    ),
+                ));
+            }
+            if !found {
+                return Err(src.error(
+                    &format!("body[{b}]"),
+                    "body contains no particle (is it smaller than a particle spacing, outside \
+                     the grid, clipped or cut away, or covered by the bodies listed before it?)",
+                ));
+            }
+        }
+        Ok(out)
+    }
 }
 
 /// The geometry of body `b`, from exactly one geometry key.
@@ -274,21 +403,55 @@ fn inside_grid<D: Dim>(
     ))
 }
 
-/// Fills body `b` with particles, less the points of the bodies before it (`claims`, to
-/// which it adds its own), and appends them to the store.
-#[allow(clippy::too_many_arguments)]
-fn add_body<D: Dim>(
+/// What body `b` puts on each of its points but the position: material, mass, volume,
+/// size and velocity.
+struct BodyPlan {
+    material: u16,
+    ppc: usize,
+    mass: f64,
+    volume: f64,
+    /// Half the particle's size on each axis (m).
+    half: [f64; 3],
+    velocity: [f64; 3],
+    /// Angular velocity (rad/s) about `centre`.
+    omega: [f64; 3],
+    centre: [f64; 3],
+}
+
+impl BodyPlan {
+    /// Appends the particle at `x`.
+    fn push<D: Dim>(&self, x: [f64; 3], shape: ShapeKind, particles: &mut Particles<D>) {
+        let (w, r) = (self.omega, [0, 1, 2].map(|a| x[a] - self.centre[a]));
+        let spin = [
+            w[1] * r[2] - w[2] * r[1],
+            w[2] * r[0] - w[0] * r[2],
+            w[0] * r[1] - w[1] * r[0],
+        ];
+        let v = [0, 1, 2].map(|a| self.velocity[a] + spin[a]);
+        particles.push(
+            to_vec::<D>(x),
+            to_vec::<D>(v),
+            self.mass,
+            self.volume,
+            self.material,
+        );
+        if shape == ShapeKind::Ugimp {
+            particles.half.push(to_vec::<D>(self.half));
+        }
+    }
+}
+
+/// Body `b`'s particle plan and its region, checked (its material, particles per cell,
+/// size, clip, holes, velocities, and that the grid does not cut it).
+fn plan_body<D: Dim>(
     src: &Source,
     b: usize,
     body: &BodySpec,
     geom: &GridGeom<D>,
     materials: &[Material],
     used: &mut [bool],
-    shape: ShapeKind,
     thickness: f64,
-    particles: &mut Particles<D>,
-    claims: &mut Vec<Claim>,
-) -> R<()> {
+) -> R<(BodyPlan, Claim)> {
     let key = |k: &str| format!("body[{b}].{k}");
     let mat = material_named(src, &key("material"), materials, &body.material)?;
     used[mat] = true;
@@ -300,7 +463,6 @@ fn add_body<D: Dim>(
     }
     let g = geometry::<D>(src, b, body)?;
     let (lo, hi) = g.bounds();
-    let origin = D::to_xyz(geom.origin);
     let h = D::to_xyz(geom.h);
     let mut estimate = 1.0;
     for a in 0..D::D {
@@ -316,30 +478,15 @@ fn add_body<D: Dim>(
         Some(clip) => Some(super::region::region::<D>(src, &key("clip"), clip)?),
         None => None,
     };
-    let holes = holes::<D>(src, b, body)?;
-    // What the clip and the holes leave of the body's shape.
-    let kept = |x: &[f64; 3]| {
-        clip.as_ref().is_none_or(|c| c.contains(*x, D::D, 0.0))
-            && (holes.iter())
-                .all(|(c, r)| (0..D::D).map(|a| (x[a] - c[a]).powi(2)).sum::<f64>() >= r * r)
+    let claim = Claim {
+        geometry: g,
+        clip,
+        holes: holes::<D>(src, b, body)?,
+        bounds: (lo, hi),
     };
-    let cells = geom.cells;
-    inside_grid::<D>(src, b, &g, geom, body.ppc, |x| kept(&x))?;
-    let mut pts = fill(&g, D::D, origin, h, cells, body.ppc);
-    pts.retain(kept);
-    let earlier: Vec<&Claim> = (claims.iter())
-        .filter(|c| c.reaches((lo, hi), D::D))
-        .collect();
-    if !earlier.is_empty() {
-        pts.retain(|x| !earlier.iter().any(|c| c.contains(*x, D::D)));
-    }
-    if pts.is_empty() {
-        return Err(src.error(
-            &format!("body[{b}]"),
-            "body contains no particle (is it smaller than a particle spacing, outside the grid, \
-             clipped or cut away, or covered by the bodies listed before it?)",
-        ));
-    }
+    inside_grid::<D>(src, b, &claim.geometry, geom, body.ppc, |x| {
+        claim.keeps(x, D::D)
+    })?;
     let n = body.ppc as f64;
     let mut volume = thickness;
     let mut half = [0.0; 3];
@@ -372,41 +519,15 @@ fn add_body<D: Dim>(
         Some(c) => vec3::<D>(src, &key("spin_center"), c)?,
         None => [0, 1, 2].map(|a| 0.5 * (lo[a] + hi[a])),
     };
-    let rho = materials[mat].density;
-    for x in pts {
-        if !geom.fits(shape, to_vec::<D>(x), to_vec::<D>(half)) {
-            return Err(src.error(
-                &format!("body[{b}]"),
-                format!(
-                    "body extends beyond the grid: a particle at ({:.4e}, {:.4e}, {:.4e}) m needs \
-                     its shape-function support inside the grid; enlarge the grid by a cell",
-                    x[0], x[1], x[2]
-                ),
-            ));
-        }
-        let r = [0, 1, 2].map(|a| x[a] - centre[a]);
-        let spin = [
-            omega[1] * r[2] - omega[2] * r[1],
-            omega[2] * r[0] - omega[0] * r[2],
-            omega[0] * r[1] - omega[1] * r[0],
-        ];
-        let v = [0, 1, 2].map(|a| v0[a] + spin[a]);
-        particles.push(
-            to_vec::<D>(x),
-            to_vec::<D>(v),
-            rho * volume,
-            volume,
-            mat as u16,
-        );
-        if shape == ShapeKind::Ugimp {
-            particles.half.push(to_vec::<D>(half));
-        }
-    }
-    claims.push(Claim {
-        geometry: g,
-        clip,
-        holes,
-        bounds: (lo, hi),
-    });
-    Ok(())
+    let plan = BodyPlan {
+        material: mat as u16,
+        ppc: body.ppc,
+        mass: materials[mat].density * volume,
+        volume,
+        half,
+        velocity: v0,
+        omega,
+        centre,
+    };
+    Ok((plan, claim))
 }

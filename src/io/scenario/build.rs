@@ -7,6 +7,7 @@ use super::output::{CheckpointPlan, OutputPlan, checkpoint_plan, output_plan};
 use super::source::Source;
 use crate::base::dim::Dim;
 use crate::fracture::plan::FracturePlan;
+use crate::ranks::comm::Comm;
 use crate::ranks::domain::Domain;
 use crate::record::expect::Expect;
 use crate::record::probe::Probe;
@@ -36,25 +37,50 @@ pub struct Scene<D: Dim> {
     pub fracture: Option<FracturePlan>,
 }
 
-/// Builds the scene described by `src` in dimension `D`.
+/// Builds the scene described by `src` in dimension `D`, whole, on this process.
 pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
+    build_share(src, Comm::single())
+}
+
+/// Builds this rank's share of the scene described by `src` in dimension `D`: split across
+/// the ranks of `comm`, its own tiles' particles (their `id` each one's number in the
+/// whole scene) and the partition, with the loads and probes listing their particles by
+/// those numbers, every check made on the whole scene; on one rank, the whole scene. Every
+/// rank calls it, and all return the same error.
+pub fn build_share<D: Dim>(src: &Source, comm: Comm) -> R<Scene<D>> {
     let sim = super::settings::simulation::<D>(src)?;
     let grid = super::grid::grid::<D>(src)?;
     let materials = super::material::materials(src, &src.scenario.materials)?;
-    let filled = super::bodies::bodies::<D>(src, &grid, &materials, sim.thickness, sim.tile)?;
+    let mut domain = Domain {
+        comm,
+        ..Domain::default()
+    };
+    let filled =
+        super::bodies::bodies::<D>(src, &grid, &materials, sim.thickness, sim.tile, &domain)?;
+    domain.partition = filled.partition;
     super::statics::check(src)?;
     let geom = grid.geom;
     let mut particles = filled.particles;
+    let ppc = &filled.ppc;
     let (dt, dt_limit) =
         super::settings::time_step::<D>(src, &sim, &materials, &filled.used, &geom)?;
     let bcs = super::boundaries::boundaries::<D>(src, &geom)?;
-    let loads = super::loads::loads::<D>(src, &geom, &particles, &filled.ppc)?;
-    let probes = super::probes::probes::<D>(src, &geom, &particles, &bcs, &materials)?;
+    let loads = super::loads::loads::<D>(src, &geom, &particles, ppc, &domain)?;
+    let probes =
+        super::probes::probes::<D>(src, &geom, &particles, ppc, &domain, &bcs, &materials)?;
     let expects =
         super::expects::expects::<D>(src, &probes, &geom, &materials, sim.plane, sim.thickness)?;
     let output = output_plan(src, sim.duration)?;
     let checkpoint = checkpoint_plan(src)?;
-    let cracks = super::cracks::build::<D>(src, &particles, &filled.claims, &materials, &geom, dt)?;
+    let cracks = super::cracks::build::<D>(
+        src,
+        &particles,
+        &domain,
+        &filled.claims,
+        &materials,
+        &geom,
+        dt,
+    )?;
     let fracture = super::cracks::fracture_plan(src, cracks.as_ref(), &geom)?;
     super::cracks::check_front_expects(src, &expects, cracks.as_ref(), geom.min_cell())?;
     if fracture.is_some() {
@@ -65,10 +91,11 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
     if (materials.iter().zip(&filled.used)).any(|(m, &u)| u && m.j2.is_some()) {
         particles.make_plastic();
     }
-    let min_mass = particles.mass.iter().copied().fold(f64::INFINITY, f64::min);
+    let min_mass = domain.min(particles.mass.iter().copied().fold(f64::INFINITY, f64::min));
     let s = &src.scenario.simulation;
+    let p = &particles;
     let shape =
-        super::settings::solve_shape::<D>(s.solver, s.shape, &particles.x0, &particles.half, &geom);
+        super::settings::solve_shape::<D>(s.solver, s.shape, &p.x0, &p.half, &geom, &domain);
     let world = World {
         tiles: filled.tiles,
         grid: Grid::new(geom),
@@ -95,7 +122,7 @@ pub fn build<D: Dim>(src: &Source) -> R<Scene<D>> {
         step: 0,
         work: Work::default(),
         cracks,
-        domain: Domain::single(),
+        domain,
     };
     Ok(Scene {
         name: src.name(),

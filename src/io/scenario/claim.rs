@@ -21,11 +21,14 @@ pub(super) struct Claim {
 impl Claim {
     /// Whether `x` (padded to three components, `dims` of them used) is the body's.
     pub fn contains(&self, x: [f64; 3], dims: usize) -> bool {
+        self.geometry.contains(x) && self.keeps(x, dims)
+    }
+
+    /// Whether the clip and the holes leave `x` to the body (its geometry aside).
+    pub fn keeps(&self, x: [f64; 3], dims: usize) -> bool {
         let outside_holes = (self.holes.iter())
             .all(|(c, r)| (0..dims).map(|a| (x[a] - c[a]).powi(2)).sum::<f64>() >= r * r);
-        self.geometry.contains(x)
-            && self.clip.as_ref().is_none_or(|c| c.contains(x, dims, 0.0))
-            && outside_holes
+        self.clip.as_ref().is_none_or(|c| c.contains(x, dims, 0.0)) && outside_holes
     }
 
     /// Whether its bounding box meets the box `lo`..`hi` on the first `dims` axes.

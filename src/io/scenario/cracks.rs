@@ -11,6 +11,7 @@ use crate::base::geometry::Element;
 use crate::fracture::plan::{FracturePlan, KMethod, e_prime};
 use crate::physics::growth::TipState;
 use crate::physics::material::{Material, Plane};
+use crate::ranks::domain::Domain;
 use crate::record::expect::{Along, Expect, Measure, Shape};
 use crate::store::crack::{COLORS, Contact, Cracks, Law, MAX_CRACKS, colors};
 use crate::store::grid::GridGeom;
@@ -31,6 +32,7 @@ const REACH_CELLS: f64 = 2.0;
 pub(super) fn build<D: Dim>(
     src: &Source,
     particles: &Particles<D>,
+    domain: &Domain,
     bodies: &[Claim],
     materials: &[Material],
     geom: &GridGeom<D>,
@@ -50,7 +52,12 @@ pub(super) fn build<D: Dim>(
     let mut store = Cracks::<D>::default();
     for (c, spec) in specs.iter().enumerate() {
         let piece = piece::<D>(src, c, spec, geom, bodies)?;
-        placed(src, &piece, geom, &occupied)?;
+        // The vertices near some particle of any rank.
+        let mine: Vec<u32> = (0..piece.points.len() as u32)
+            .filter(|&j| occupied.near(piece.points[j as usize]))
+            .collect();
+        let near = domain.union(mine);
+        placed(src, &piece, geom, |j| near.binary_search(&j).is_ok())?;
         apart(src, &store, &piece, geom)?;
         let contact = contact(src, c, spec)?;
         let name = spec.name.clone().unwrap_or_else(|| format!("crack{c}"));
@@ -149,12 +156,13 @@ fn piece<D: Dim>(
 
 /// Every vertex of `piece` lies in the grid and every front vertex in a body; the rest may
 /// overhang a body's edge by any length (a crack that cuts through it), so that a scene
-/// keeps its cracks when its cells are refined. Some vertex must lie in a body.
+/// keeps its cracks when its cells are refined. Some vertex must lie in a body. `is_near`
+/// tells whether vertex j lies within `REACH_CELLS` of a particle (on any rank).
 fn placed<D: Dim>(
     src: &Source,
     piece: &Piece<D>,
     geom: &GridGeom<D>,
-    occupied: &Occupied<D>,
+    is_near: impl Fn(u32) -> bool,
 ) -> R<()> {
     let front: Vec<u32> = piece.fronts.iter().flat_map(|f| f.1.clone()).collect();
     let mut touches = false;
@@ -170,7 +178,7 @@ fn placed<D: Dim>(
                 format!("vertex {j} at ({}) m lies outside the grid", at.join(", ")),
             ));
         }
-        let near = occupied.near(*x);
+        let near = is_near(j as u32);
         touches |= near;
         if !near && front.contains(&(j as u32)) {
             return Err(src.error(

@@ -6,22 +6,25 @@ use super::source::Source;
 use super::traction::{Face, StressField, tractions};
 use crate::base::dim::Dim;
 use crate::physics::loads::Load;
+use crate::ranks::domain::Domain;
 use crate::store::grid::GridGeom;
 use crate::store::particles::Particles;
 
 /// Every `[[load]]`: a total force shared equally by its region's particles, or a
-/// traction (pressure or a closed-form field) over the face they make.
+/// traction (pressure or a closed-form field) over the face they make. Each load lists
+/// its particles by their numbers in the whole scene, on every rank.
 pub(super) fn loads<D: Dim>(
     src: &Source,
     geom: &GridGeom<D>,
     particles: &Particles<D>,
     ppc: &[f64],
+    domain: &Domain,
 ) -> R<Vec<Load<D>>> {
     let sc = &src.scenario;
     let mut loads = Vec::new();
     for (i, l) in sc.loads.iter().enumerate() {
         let key = |k: &str| format!("load[{i}].{k}");
-        let sel = particles_in(src, &key("region"), &l.region, particles)?;
+        let sel = particles_in(src, &key("region"), &l.region, particles, ppc, domain)?;
         if let Some(msg) = l.time.check() {
             return Err(src.error(&key("time"), msg));
         }
@@ -35,7 +38,7 @@ pub(super) fn loads<D: Dim>(
             }
             (None, Some(field)) => {
                 let face = Face::new::<D>(src, &key, l, geom.h)?;
-                tractions(src, &face, &field, &sel, particles, ppc)?
+                tractions::<D>(src, &face, &field, &sel)?
             }
             (Some(_), Some(_)) => {
                 return Err(src.error(&key("force"), "give a force or a traction, not both"));
@@ -50,7 +53,7 @@ pub(super) fn loads<D: Dim>(
         };
         loads.push(Load {
             forces,
-            particles: sel,
+            particles: sel.iter().map(|q| q.id as u32).collect(),
             ids: Vec::new(),
             time: l.time.clone(),
         });

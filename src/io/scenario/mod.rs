@@ -28,7 +28,7 @@ mod statics;
 mod surface;
 mod traction;
 
-pub use build::{Scene, build};
+pub use build::{Scene, build, build_share};
 pub use check::folder_name_problem;
 pub use output::{CheckpointPlan, OutputPlan};
 pub use settings::MAX_STEPS;

@@ -8,16 +8,20 @@ use super::source::Source;
 use crate::base::dim::Dim;
 use crate::physics::loads::VelocityBc;
 use crate::physics::material::Material;
+use crate::ranks::domain::Domain;
 use crate::record::probe::{Probe, ProbeQty};
 use crate::store::grid::GridGeom;
 use crate::store::particles::Particles;
 
-/// Every `[[probe]]`: its quantity and component, and the particles it averages (the
-/// boundary nodes it sums for a reaction), with their centroid.
+/// Every `[[probe]]`: its quantity and component, and the particles it averages (by their
+/// numbers in the whole scene, on every rank; the boundary nodes it sums for a reaction),
+/// with their centroid.
 pub(super) fn probes<D: Dim>(
     src: &Source,
     geom: &GridGeom<D>,
     particles: &Particles<D>,
+    ppc: &[f64],
+    domain: &Domain,
     bcs: &[VelocityBc<D>],
     materials: &[Material],
 ) -> R<Vec<Probe>> {
@@ -43,10 +47,10 @@ pub(super) fn probes<D: Dim>(
             });
             continue;
         }
-        let sel = particles_in(src, &key("region"), &p.region, particles)?;
+        let sel = particles_in(src, &key("region"), &p.region, particles, ppc, domain)?;
         let mut centre = [0.0; 3];
-        for &q in &sel {
-            let x = D::to_xyz(particles.x[q as usize]);
+        for q in &sel {
+            let x = q.x;
             for a in 0..3 {
                 centre[a] += x[a] / sel.len() as f64;
             }
@@ -70,9 +74,7 @@ pub(super) fn probes<D: Dim>(
             }
         }
         if qty == ProbeQty::Opening {
-            let beyond = (sel.iter())
-                .filter(|&&q| D::to_xyz(particles.x[q as usize])[comp] > centre[comp])
-                .count();
+            let beyond = (sel.iter()).filter(|q| q.x[comp] > centre[comp]).count();
             if beyond == 0 || beyond == sel.len() {
                 return Err(src.error(
                     &key("region"),
@@ -86,7 +88,7 @@ pub(super) fn probes<D: Dim>(
         }
         probes.push(Probe {
             name: p.name.clone(),
-            particles: sel,
+            particles: sel.iter().map(|q| q.id as u32).collect(),
             ids: Vec::new(),
             supports: Vec::new(),
             qty,

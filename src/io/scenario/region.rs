@@ -7,7 +7,9 @@ use super::schema::RegionSpec;
 use super::source::Source;
 use crate::base::dim::Dim;
 use crate::base::geometry::{Aabb, meeting_pairs};
+use crate::ranks::domain::Domain;
 use crate::store::particles::Particles;
+use bytemuck::{Pod, Zeroable};
 use glam::{DVec2, DVec3};
 
 /// Most vertices a region polygon may have (its self-crossing check is quadratic).
@@ -109,18 +111,38 @@ fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
         || (d4 == 0.0 && on(a, b, d))
 }
 
-/// The particles inside the region a `region` table describes, refused when it holds none.
+/// A particle a region picked: its number in the whole scene, its position (m), volume
+/// (m^3) and its body's particles per cell per direction.
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+#[repr(C)]
+pub(super) struct Picked {
+    pub id: u64,
+    pub x: [f64; 3],
+    pub volume: f64,
+    pub ppc: f64,
+}
+
+/// The particles inside the region a `region` table describes, on every rank, in the whole
+/// scene's order (each rank picks among its own); refused when it holds none.
 pub(super) fn particles_in<D: Dim>(
     src: &Source,
     key: &str,
     r: &RegionSpec,
     particles: &Particles<D>,
-) -> R<Vec<u32>> {
+    ppc: &[f64],
+    domain: &Domain,
+) -> R<Vec<Picked>> {
     let r = region::<D>(src, key, r)?;
-    let sel: Vec<u32> = (0..particles.len())
+    let mine: Vec<Picked> = (0..particles.len())
         .filter(|&p| r.contains(D::to_xyz(particles.x[p]), D::D, 0.0))
-        .map(|p| p as u32)
+        .map(|p| Picked {
+            id: particles.id.get(p).copied().unwrap_or(p as u64),
+            x: D::to_xyz(particles.x[p]),
+            volume: particles.volume[p],
+            ppc: ppc[p],
+        })
         .collect();
+    let sel = domain.in_order(mine, |q| q.id);
     if sel.is_empty() {
         return Err(src.error(key, "the region contains no particle"));
     }

@@ -6,6 +6,7 @@ use super::source::Source;
 use crate::base::dim::Dim;
 use crate::physics::material::{Material, Plane};
 use crate::physics::shape::ShapeKind;
+use crate::ranks::domain::Domain;
 use crate::store::grid::GridGeom;
 use crate::store::tiles::MIN_TILE;
 use crate::store::world::{Dilatation, Solver};
@@ -201,7 +202,11 @@ pub(super) fn solve_shape<D: Dim>(
     x: &[D::Vec],
     half: &[D::Vec],
     geom: &GridGeom<D>,
+    domain: &Domain,
 ) -> ShapeKind {
+    if solver != Solver::Static || shape != ShapeKind::Ugimp {
+        return shape;
+    }
     let inside = |(x, l): (&D::Vec, &D::Vec)| {
         (0..D::D).all(|a| {
             let xi = (x[a] - geom.origin[a]) * geom.inv_h[a];
@@ -209,10 +214,11 @@ pub(super) fn solve_shape<D: Dim>(
             xi - l >= cell - INSIDE && xi + l <= cell + 1.0 + INSIDE
         })
     };
-    let all_inside = half.len() == x.len() && x.iter().zip(half).all(inside);
-    if solver == Solver::Static && shape == ShapeKind::Ugimp && all_inside {
-        ShapeKind::Linear
-    } else {
+    // Every rank's particles inside their cells.
+    let mine = half.len() == x.len() && x.iter().zip(half).all(inside);
+    if domain.any(!mine) {
         shape
+    } else {
+        ShapeKind::Linear
     }
 }

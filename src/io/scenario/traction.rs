@@ -2,13 +2,13 @@
 //! face (planar, or a circle or sphere about a centre) as a force on each face particle.
 
 use super::check::{to_vec, vec3};
+use super::region::Picked;
 use super::schema::{LoadSpec, PressureSpec};
 use super::source::Source;
 use crate::base::dim::Dim;
 use crate::base::error::ScenarioError;
 use crate::physics::loads::{centre_crack_stress, rotate_stress};
 use crate::physics::near_tip;
-use crate::store::particles::Particles;
 
 type R<T> = Result<T, ScenarioError>;
 
@@ -265,19 +265,16 @@ impl<'a> Face<'a> {
 /// staircase and the rows are many and close). The face lies half a row spacing beyond the
 /// outermost row, and a particle's face point is its projection on it. On a round face of
 /// radius R a particle at radius r carries (R / r)^(d-1) of its share, so that the shares of
-/// a curved layer add up to the face's area. `ppc` is each particle's particles per cell
-/// per direction.
+/// a curved layer add up to the face's area.
 pub(super) fn tractions<D: Dim>(
     src: &Source,
     face: &Face,
     field: &StressField,
-    sel: &[u32],
-    particles: &Particles<D>,
-    ppc: &[f64],
+    sel: &[Picked],
 ) -> R<Vec<D::Vec>> {
     let mut placed = Vec::with_capacity(sel.len());
-    for &p in sel {
-        let x = D::to_xyz(particles.x[p as usize]);
+    for q in sel {
+        let x = q.x;
         let (along, n) = face.locate(x).ok_or_else(|| {
             src.error(
                 &(face.key)("region"),
@@ -298,12 +295,12 @@ pub(super) fn tractions<D: Dim>(
         (last - first) / (rows.len() - 1) as f64
     } else {
         let n = placed[0].2;
-        (0..face.dims).map(|a| face.h[a] * n[a].abs()).sum::<f64>() / ppc[sel[0] as usize]
+        (0..face.dims).map(|a| face.h[a] * n[a].abs()).sum::<f64>() / sel[0].ppc
     };
     let depth = last - first + spacing;
     let outer = last + 0.5 * spacing;
     let mut forces = Vec::with_capacity(sel.len());
-    for (&p, &(x, along, n)) in sel.iter().zip(&placed) {
+    for (q, &(x, along, n)) in sel.iter().zip(&placed) {
         let to_face = outer - along;
         let at = [0, 1, 2].map(|a| x[a] + to_face * n[a]);
         let t = field.traction(at, n).ok_or_else(|| {
@@ -320,7 +317,7 @@ pub(super) fn tractions<D: Dim>(
             Shape::Plane(_) => 1.0,
             Shape::Round { .. } => (outer / along).abs().powi(face.dims as i32 - 1),
         };
-        let area = particles.volume[p as usize] / depth * curved;
+        let area = q.volume / depth * curved;
         forces.push(to_vec::<D>(t.map(|c| c * area)));
     }
     Ok(forces)
