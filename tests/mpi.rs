@@ -269,8 +269,9 @@ interval = 0.05
 }
 
 /// The disc's run on 4 ranks (some of them empty) writes snapshot sets of a manifest and 4
-/// pieces, keeping the newest 2; a set resumed on 3 ranks and on one process ends as the
-/// uninterrupted serial run, bit for bit; a set with a piece missing is refused, once.
+/// pieces, keeping the newest 2; a set resumed on 3 ranks and on one process, and a
+/// one-process snapshot resumed on 2 ranks, end as the uninterrupted serial run, bit for
+/// bit; a set with a piece missing is refused, once.
 #[cfg(feature = "mpi")]
 fn snapshots_resume_on_any_rank_count(dir: &Path, file: &Path) {
     let every = [
@@ -306,6 +307,16 @@ fn snapshots_resume_on_any_rank_count(dir: &Path, file: &Path) {
             &format!("the 4-rank set resumed on {ranks:?}"),
         );
     }
+    // A one-process snapshot (one file, no pieces) resumed on 2 ranks, each keeping its
+    // share of the file's particles.
+    let mut whole: Vec<std::path::PathBuf> = (std::fs::read_dir(serial.join("snapshots")))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    whole.sort();
+    let out = dir.join("resumed2_from_one");
+    succeeded(&resume(&whole[0], Some(2), &out));
+    same_outputs(&serial, &out, "the one-process snapshot resumed on 2 ranks");
     let piece = names.iter().find(|n| n.ends_with(".fpiece")).unwrap();
     std::fs::remove_file(snaps.join(piece)).unwrap();
     let done = resume(&older, Some(2), &dir.join("incomplete"));

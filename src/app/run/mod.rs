@@ -14,7 +14,7 @@ use crate::base::sym::SymTensor;
 use crate::io::output::summary::Summary;
 use crate::io::scenario::{Scene, Source, build_share};
 use crate::io::snapshot::Reader;
-use crate::io::snapshot::state::restore;
+use crate::io::snapshot::state::restore_share;
 use crate::ranks::comm::Comm;
 use crate::record::history::History;
 use crate::record::state::RunState;
@@ -117,7 +117,7 @@ pub fn resume(path: &Path, opts: &RunOptions) -> anyhow::Result<Outcome> {
         file: &Path,
         opts: &RunOptions,
     ) -> anyhow::Result<Outcome> {
-        let restored = agreed(&opts.comm, restore::<D>(r))?;
+        let restored = agreed(&opts.comm, restore_share::<D>(r, opts.comm.clone()))?;
         let resumed = (restored.state, file.to_path_buf());
         drive::<D>(&restored.source, restored.scene, Some(resumed), opts)
     }

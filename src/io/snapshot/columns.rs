@@ -69,6 +69,53 @@ pub fn read_particles<D: Dim>(
     Ok(())
 }
 
+/// Appends rows `rows` of the `n` particle rows of `r` to `p`. Each optional column (uGIMP
+/// size, gradients, plastic state) is taken where the file holds it: a split run's rank
+/// builds its share of the scene, which may hold no particle to say which columns the
+/// scene keeps.
+pub fn append_rows<D: Dim>(
+    r: &mut Reader,
+    p: &mut Particles<D>,
+    rows: &[usize],
+    n: usize,
+) -> Result<(), SnapshotError> {
+    let at = (rows, n);
+    append(r, "particles.x", &mut p.x, at)?;
+    append(r, "particles.v", &mut p.v, at)?;
+    append(r, "particles.x0", &mut p.x0, at)?;
+    append(r, "particles.mass", &mut p.mass, at)?;
+    append(r, "particles.volume", &mut p.volume, at)?;
+    append(r, "particles.stress", &mut p.stress, at)?;
+    append(r, "particles.material", &mut p.material, at)?;
+    append(r, "particles.half", &mut p.half, at)?;
+    append(r, "particles.grad_u", &mut p.grad_u, at)?;
+    append(r, "particles.grad_v", &mut p.grad_v, at)?;
+    append(r, "particles.plastic_strain", &mut p.plastic_strain, at)?;
+    append(r, "particles.hardened", &mut p.hardened, at)
+}
+
+/// Appends rows `rows` of column `name` (of `n` rows, or none: a column the scene does
+/// not keep) to `col`.
+fn append<T: Columnar>(
+    r: &mut Reader,
+    name: &str,
+    col: &mut Vec<T>,
+    (rows, n): (&[usize], usize),
+) -> Result<(), SnapshotError> {
+    let all: Vec<T> = r.column_any(name)?;
+    if all.is_empty() {
+        return Ok(());
+    }
+    if all.len() != n {
+        return Err(r.invalid(format!(
+            "column `{name}` holds {} rows; expected {n} or none",
+            all.len()
+        )));
+    }
+    col.extend(rows.iter().map(|&k| all[k]));
+    Ok(())
+}
+
 /// Reads column `name` into `col`: whole, or row k into `col[at[k]]`. A column the scene
 /// does not keep (empty) must be empty in the file too.
 fn put<T: Columnar>(

@@ -8,8 +8,10 @@ use super::columns;
 use super::format::{ColumnSet, Reader, SnapshotError};
 use crate::base::dim::Dim;
 use crate::io::scenario::Source;
+use crate::ranks::partition::{Partition, TileGrid};
 use crate::store::particles::Particles;
-use crate::store::world::World;
+use crate::store::world::{Solver, World};
+use bitvec::vec::BitVec;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -130,44 +132,153 @@ pub fn listing(r: &mut Reader) -> Result<Vec<Piece>, SnapshotError> {
 /// Puts the particles of the pieces the manifest `r` names back into `p` (the whole
 /// scene's store), each at its id; every particle must come from exactly one piece.
 pub(super) fn read<D: Dim>(r: &mut Reader, p: &mut Particles<D>) -> Result<(), SnapshotError> {
-    let pieces = listing(r)?;
-    let dir = r.path().parent().unwrap_or(Path::new(".")).to_path_buf();
     let n = p.len();
     let mut seen = bitvec::bitvec![0; n];
-    for (rank, piece) in pieces.iter().enumerate() {
-        let path = dir.join(&piece.name);
-        if !path.exists() {
-            return Err(r.invalid(format!(
-                "piece {} (rank {rank}) is missing: the snapshot set is incomplete",
-                piece.name
-            )));
+    Rows::of(r)?.each(r, &mut seen, |mut f, ids| {
+        columns::read_particles(&mut f, p, Some(&ids))
+    })?;
+    Rows::all_seen(r, &seen)
+}
+
+/// Split across ranks: keeps this rank's share of the stored particles (a whole snapshot's
+/// or a set's) in `w`, those in the tiles a partition of the stored places gives it (a
+/// static scene's initial places, where its solves use them), in whole-scene order, the
+/// partition replacing the one the scene was built with. Every rank reads every piece's
+/// ids and places twice, one piece at a time (to count the tiles, then to pick its own),
+/// and keeps only its own particles' columns: the same share as the whole store split.
+pub(super) fn read_share<D: Dim>(r: &mut Reader, w: &mut World<D>) -> Result<(), SnapshotError> {
+    // The built particles make way for the stored ones.
+    w.particles = Particles::default();
+    let n = r.header.particles as usize;
+    let place = if w.settings.solver == Solver::Static {
+        "particles.x0"
+    } else {
+        "particles.x"
+    };
+    let (geom, tiles) = (&w.grid.geom, &w.tiles);
+    let tile = |f: &Reader, id: u64, x: D::Vec| {
+        let mut cell = [0; 3];
+        for a in 0..D::D {
+            let c = ((x[a] - geom.origin[a]) * geom.inv_h[a]).floor();
+            if !(c >= 0.0 && c < geom.cells[a] as f64) {
+                return Err(f.invalid(format!("particle {id} lies outside the grid (corrupt)")));
+            }
+            cell[a] = c as usize;
         }
-        let mut f = Reader::open(&path)?;
-        if f.checksum != piece.checksum || f.header.particles != piece.particles {
-            return Err(f.invalid(format!(
-                "not the piece the manifest {} names (checksum {:016x}, expected {:016x}): \
-                 from another run or damaged",
-                r.path().display(),
-                f.checksum,
-                piece.checksum
-            )));
+        Ok(tiles.tile_of_cell(cell))
+    };
+    let rows = Rows::of(r)?;
+    let mut counts = vec![0u32; tiles.len()];
+    let mut seen = bitvec::bitvec![0; n];
+    rows.each(r, &mut seen, |mut f, ids| {
+        let x: Vec<D::Vec> = f.column(place, ids.len())?;
+        for (&id, &x) in ids.iter().zip(&x) {
+            counts[tile(&f, id, x)? as usize] += 1;
         }
-        let ids: Vec<u64> = f.column("particles.id", piece.particles as usize)?;
-        for &id in &ids {
-            if id as usize >= n || seen.replace(id as usize, true) {
-                return Err(f.invalid(format!(
-                    "particle id {id} is outside the scene's {n} particles or in two pieces"
-                )));
+        Ok(())
+    })?;
+    Rows::all_seen(r, &seen)?;
+    let grid = TileGrid {
+        counts: tiles.counts,
+        size: tiles.size,
+        cells: geom.cells,
+        dims: D::D,
+    };
+    let comm = &w.domain.comm;
+    let (me, ranks) = (comm.rank(), comm.size());
+    let partition =
+        Partition::new(grid, &counts, ranks, me).map_err(|e| r.invalid(e.to_string()))?;
+    let mut p = Particles::<D>::default();
+    seen.fill(false);
+    rows.each(r, &mut seen, |mut f, ids| {
+        let x: Vec<D::Vec> = f.column(place, ids.len())?;
+        let mut mine = Vec::new();
+        for (k, (&id, &x)) in ids.iter().zip(&x).enumerate() {
+            if partition.owns_tile(tile(&f, id, x)?, me) {
+                mine.push(k);
             }
         }
-        columns::read_particles(&mut f, p, Some(&ids))?;
-    }
-    if let Some(missing) = seen.first_zero() {
-        return Err(r.invalid(format!(
-            "no piece holds particle {missing}: the snapshot set is incomplete"
-        )));
-    }
+        columns::append_rows(&mut f, &mut p, &mine, ids.len())?;
+        p.id.extend(mine.iter().map(|&k| ids[k]));
+        Ok(())
+    })?;
+    let mut order: Vec<u32> = (0..p.len() as u32).collect();
+    order.sort_unstable_by_key(|&k| p.id[k as usize]);
+    p.permute(&order);
+    w.particles = p;
+    w.domain.partition = Some(partition);
+    w.tiles.tile_of.clear();
+    w.tiles.fresh = false;
     Ok(())
+}
+
+/// Where a snapshot's particle rows are: its own columns (a whole snapshot, ids 0..n) or
+/// the pieces its manifest names.
+struct Rows {
+    pieces: Option<Vec<Piece>>,
+}
+
+impl Rows {
+    fn of(r: &mut Reader) -> Result<Self, SnapshotError> {
+        Ok(Rows {
+            pieces: listed(r).then(|| listing(r)).transpose()?,
+        })
+    }
+
+    /// Hands `visit` each file holding rows, opened, one at a time, with its rows'
+    /// whole-scene ids, marked in `seen` (refused when outside the scene or already seen).
+    fn each(
+        &self,
+        r: &Reader,
+        seen: &mut BitVec,
+        mut visit: impl FnMut(Reader, Vec<u64>) -> Result<(), SnapshotError>,
+    ) -> Result<(), SnapshotError> {
+        let n = seen.len();
+        let Some(pieces) = &self.pieces else {
+            seen.fill(true);
+            return visit(Reader::open(r.path())?, (0..n as u64).collect());
+        };
+        let dir = r.path().parent().unwrap_or(Path::new(".")).to_path_buf();
+        for (rank, piece) in pieces.iter().enumerate() {
+            let path = dir.join(&piece.name);
+            if !path.exists() {
+                return Err(r.invalid(format!(
+                    "piece {} (rank {rank}) is missing: the snapshot set is incomplete",
+                    piece.name
+                )));
+            }
+            let mut f = Reader::open(&path)?;
+            if f.checksum != piece.checksum || f.header.particles != piece.particles {
+                return Err(f.invalid(format!(
+                    "not the piece the manifest {} names (checksum {:016x}, expected \
+                     {:016x}): from another run or damaged",
+                    r.path().display(),
+                    f.checksum,
+                    piece.checksum
+                )));
+            }
+            let ids: Vec<u64> = f.column("particles.id", piece.particles as usize)?;
+            for &id in &ids {
+                if id as usize >= n || seen.replace(id as usize, true) {
+                    return Err(f.invalid(format!(
+                        "particle id {id} is outside the scene's {n} particles or in two pieces"
+                    )));
+                }
+            }
+            visit(f, ids)?;
+        }
+        Ok(())
+    }
+
+    /// Refuses a set in which no piece holds some particle.
+    fn all_seen(r: &Reader, seen: &BitVec) -> Result<(), SnapshotError> {
+        match seen.first_zero() {
+            Some(missing) => Err(r.invalid(format!(
+                "no piece holds particle {missing}: the snapshot set is incomplete"
+            ))),
+            None => Ok(()),
+        }
+    }
 }
 
 /// Checks every piece the manifest `r` names: present, the one named (checksum, count),

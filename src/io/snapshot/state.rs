@@ -10,9 +10,10 @@ use super::pieces::{self, Piece, Table};
 use super::topology::{self, Encoded};
 use crate::base::dim::Dim;
 use crate::fracture::plan::{PathResult, TipResult};
-use crate::io::scenario::{Scene, Source, build};
+use crate::io::scenario::{Scene, Source, build_share};
 use crate::physics::growth::{GrowthRow, TipState};
 use crate::physics::material::Material;
+use crate::ranks::comm::Comm;
 use crate::record::history::{History, Row};
 use crate::record::solve_log::SolveRow;
 use crate::record::state::RunState;
@@ -211,10 +212,19 @@ pub struct Restored<D: Dim> {
 /// Rebuilds the run stored in `r` as a `D`-dimensional run: the scene from the stored
 /// scenario, then each store's columns in the order [`write`] adds them.
 pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
+    restore_share(r, Comm::single())
+}
+
+/// [`restore`] on the ranks of `comm`: split across them, each rank builds its share of
+/// the scene and keeps its share of the stored particles (`pieces::read_share`), never
+/// the whole store. Every rank calls it, and all return the same error.
+pub fn restore_share<D: Dim>(r: &mut Reader, comm: Comm) -> anyhow::Result<Restored<D>> {
     let h = r.header.clone();
-    let (source, mut scene) = stored_scene::<D>(r, &h)?;
+    let (source, mut scene) = stored_scene::<D>(r, &h, comm)?;
     let w = &mut scene.world;
-    if pieces::listed(r) {
+    if w.domain.is_split() {
+        pieces::read_share(r, w)?;
+    } else if pieces::listed(r) {
         pieces::read(r, &mut w.particles)?;
     } else {
         read_particles(r, &mut w.particles, None)?;
@@ -238,7 +248,11 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
 
 /// The stored scenario, checked against the header (dimension, build, hash), and the scene
 /// it builds, which must have the snapshot's particle and node counts and time step.
-fn stored_scene<D: Dim>(r: &mut Reader, h: &Header) -> anyhow::Result<(Source, Scene<D>)> {
+fn stored_scene<D: Dim>(
+    r: &mut Reader,
+    h: &Header,
+    comm: Comm,
+) -> anyhow::Result<(Source, Scene<D>)> {
     if h.dimension as usize != D::D {
         return Err(r
             .invalid(format!(
@@ -266,9 +280,12 @@ fn stored_scene<D: Dim>(r: &mut Reader, h: &Header) -> anyhow::Result<(Source, S
     }
     let file = utf8(r, "scenario.file")?;
     let source = Source::parse(&file, &text, &[])?;
-    let scene = build::<D>(&source)?;
+    let scene = build_share::<D>(&source, comm)?;
     let w = &scene.world;
-    let n = w.particles.len();
+    // Particles over every rank (whole numbers, so the sum is exact).
+    let mut n = [w.particles.len() as f64];
+    w.domain.add_rows(&mut n, 1);
+    let n = n[0] as usize;
     if n as u64 != h.particles || w.grid.geom.node_count() as u64 != h.nodes {
         return Err(r
             .invalid(format!(
