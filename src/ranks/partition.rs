@@ -117,14 +117,31 @@ impl Partition {
         let owner = owners(&grid, particles, ranks)?;
         let nodes = grid.nodes();
         let total = nodes.iter().product::<usize>();
-        // The nodes each rank's tiles reach.
-        let mut reached = vec![bitvec![0; total]; ranks];
+        // The nodes rank r's tiles reach; held for this rank and its peers only (a table
+        // for every rank would cost a bit per node per rank).
+        let reached_by = |r: usize| {
+            let mut b = bitvec![0; total];
+            for t in (0..owner.len()).filter(|&t| owner[t] as usize == r) {
+                grid.for_each_reached(t, |n| b.set(n, true));
+            }
+            b
+        };
+        let mine = reached_by(me);
+        let mut meets = vec![false; ranks];
         for (t, &r) in owner.iter().enumerate() {
-            grid.for_each_reached(t, |n| reached[r as usize].set(n, true));
+            if r as usize != me && !meets[r as usize] {
+                grid.for_each_reached(t, |n| meets[r as usize] |= mine[n]);
+            }
         }
-        let peers: Vec<usize> = (0..ranks)
-            .filter(|&q| q != me && (reached[q].clone() & &reached[me]).any())
-            .collect();
+        let peers: Vec<usize> = (0..ranks).filter(|&q| meets[q]).collect();
+        let theirs: Vec<BitVec> = peers.iter().map(|&q| reached_by(q)).collect();
+        let reached = |r: usize| match peers.binary_search(&r) {
+            Ok(k) => &theirs[k],
+            Err(_) => {
+                debug_assert_eq!(r, me, "nodes reached by a rank that is no peer");
+                &mine
+            }
+        };
         let classes = 1 << grid.dims;
         // The shared nodes `from`'s tiles of class `c` reach that `to`'s tiles reach too,
         // tile by tile in index order: the same list on both sides.
@@ -132,8 +149,9 @@ impl Partition {
             let mut list = Vec::new();
             for t in (0..owner.len()).filter(|&t| owner[t] as usize == from) {
                 if grid.colour(t) == c {
+                    let to = reached(to);
                     grid.for_each_reached(t, |n| {
-                        if reached[to][n] {
+                        if to[n] {
                             list.push(n as u32);
                         }
                     });
@@ -167,9 +185,7 @@ impl Partition {
                 waits.set(t, reaches);
             }
         }
-        let shared = (peers.iter())
-            .map(|&q| reached[q].clone() & &reached[me])
-            .collect();
+        let shared = theirs.iter().map(|b| b.clone() & &mine).collect();
         let mut owned_nodes = bitvec![0; total];
         let [nx, ny, _] = nodes;
         for n in 0..total {
@@ -183,7 +199,7 @@ impl Partition {
             }
             owned_nodes.set(n, owner[t] as usize == me);
         }
-        let span = match (reached[me].first_one(), reached[me].last_one()) {
+        let span = match (mine.first_one(), mine.last_one()) {
             (Some(a), Some(b)) => a..b + 1,
             _ => 0..0,
         };
@@ -331,5 +347,46 @@ mod tests {
                 assert!(sent, "node {n} shared but never sent");
             }
         }
+    }
+
+    /// On 7 ranks of a 3D grid, where not every two ranks meet, each rank's peers are the
+    /// ranks whose tiles reach a node its own tiles reach, and its shared nodes those both
+    /// reach (a brute-force table of every rank's nodes).
+    #[test]
+    fn peers_are_the_ranks_that_reach_a_common_node() {
+        let g = TileGrid {
+            counts: [5, 4, 3],
+            size: 3,
+            cells: [14, 12, 9],
+            dims: 3,
+        };
+        let tiles = 60;
+        let particles: Vec<u32> = (0..tiles).map(|t| (t * 7 % 11) as u32 + 1).collect();
+        let ranks = 7;
+        let parts: Vec<Partition> = (0..ranks)
+            .map(|r| Partition::new(g, &particles, ranks, r).unwrap())
+            .collect();
+        let total = parts[0].owned_nodes.len();
+        let reached: Vec<BitVec> = (0..ranks)
+            .map(|r| {
+                let mut b = bitvec![0; total];
+                for t in (0..tiles).filter(|&t| parts[0].owner[t] as usize == r) {
+                    g.for_each_reached(t, |n| b.set(n, true));
+                }
+                b
+            })
+            .collect();
+        let mut apart = 0;
+        for (r, p) in parts.iter().enumerate() {
+            let meet: Vec<usize> = (0..ranks)
+                .filter(|&q| q != r && (reached[q].clone() & &reached[r]).any())
+                .collect();
+            apart += ranks - 1 - meet.len();
+            assert_eq!(p.peers, meet, "rank {r}");
+            for (k, &q) in p.peers.iter().enumerate() {
+                assert_eq!(p.shared[k], reached[q].clone() & &reached[r]);
+            }
+        }
+        assert!(apart > 0, "some ranks do not meet");
     }
 }
