@@ -42,98 +42,59 @@ pub fn header<D: Dim>(src: &Source, world: &World<D>, particles: u64) -> Header 
     }
 }
 
-/// The particle columns; the optional ones (uGIMP size, gradients, plastic state) where
-/// the rebuilt scene keeps them. `at`: the rows of `p` the file's rows go to (a piece of a
-/// split run), else all of them in order.
-pub fn read_particles<D: Dim>(
-    r: &mut Reader,
-    p: &mut Particles<D>,
-    at: Option<&[u64]>,
-) -> Result<(), SnapshotError> {
-    put(r, "particles.x", &mut p.x, at)?;
-    put(r, "particles.v", &mut p.v, at)?;
-    put(r, "particles.x0", &mut p.x0, at)?;
-    put(r, "particles.mass", &mut p.mass, at)?;
-    put(r, "particles.volume", &mut p.volume, at)?;
-    put(r, "particles.stress", &mut p.stress, at)?;
-    put(r, "particles.material", &mut p.material, at)?;
-    put(r, "particles.half", &mut p.half, at)?;
-    if !p.grad_u.is_empty() {
-        put(r, "particles.grad_u", &mut p.grad_u, at)?;
-        put(r, "particles.grad_v", &mut p.grad_v, at)?;
-    }
-    if !p.hardened.is_empty() {
-        put(r, "particles.plastic_strain", &mut p.plastic_strain, at)?;
-        put(r, "particles.hardened", &mut p.hardened, at)?;
-    }
-    Ok(())
+/// Which optional particle columns a scene keeps: uGIMP's size, the gradients J needs, the
+/// plastic state.
+#[derive(Clone, Copy, Debug)]
+pub struct Kept {
+    pub half: bool,
+    pub gradients: bool,
+    pub plastic: bool,
 }
 
-/// Appends rows `rows` of the `n` particle rows of `r` to `p`. Each optional column (uGIMP
-/// size, gradients, plastic state) is taken where the file holds it: a split run's rank
-/// builds its share of the scene, which may hold no particle to say which columns the
-/// scene keeps.
+/// Appends rows `rows` (None: all) of the `n` particle rows of `r` to `p`, whose columns
+/// are sized for `total` particles in all: every column the scene keeps (`kept`) must hold
+/// `n` rows, every other none.
 pub fn append_rows<D: Dim>(
     r: &mut Reader,
     p: &mut Particles<D>,
-    rows: &[usize],
-    n: usize,
+    (rows, n, total): (Option<&[usize]>, usize, usize),
+    kept: Kept,
 ) -> Result<(), SnapshotError> {
-    let at = (rows, n);
-    append(r, "particles.x", &mut p.x, at)?;
-    append(r, "particles.v", &mut p.v, at)?;
-    append(r, "particles.x0", &mut p.x0, at)?;
-    append(r, "particles.mass", &mut p.mass, at)?;
-    append(r, "particles.volume", &mut p.volume, at)?;
-    append(r, "particles.stress", &mut p.stress, at)?;
-    append(r, "particles.material", &mut p.material, at)?;
-    append(r, "particles.half", &mut p.half, at)?;
-    append(r, "particles.grad_u", &mut p.grad_u, at)?;
-    append(r, "particles.grad_v", &mut p.grad_v, at)?;
-    append(r, "particles.plastic_strain", &mut p.plastic_strain, at)?;
-    append(r, "particles.hardened", &mut p.hardened, at)
+    let at = |k: bool| (rows, if k { n } else { 0 }, total);
+    append(r, "particles.x", &mut p.x, at(true))?;
+    append(r, "particles.v", &mut p.v, at(true))?;
+    append(r, "particles.x0", &mut p.x0, at(true))?;
+    append(r, "particles.mass", &mut p.mass, at(true))?;
+    append(r, "particles.volume", &mut p.volume, at(true))?;
+    append(r, "particles.stress", &mut p.stress, at(true))?;
+    append(r, "particles.material", &mut p.material, at(true))?;
+    append(r, "particles.half", &mut p.half, at(kept.half))?;
+    append(r, "particles.grad_u", &mut p.grad_u, at(kept.gradients))?;
+    append(r, "particles.grad_v", &mut p.grad_v, at(kept.gradients))?;
+    append(
+        r,
+        "particles.plastic_strain",
+        &mut p.plastic_strain,
+        at(kept.plastic),
+    )?;
+    append(r, "particles.hardened", &mut p.hardened, at(kept.plastic))
 }
 
-/// Appends rows `rows` of column `name` (of `n` rows, or none: a column the scene does
-/// not keep) to `col`.
+/// Appends rows `rows` (None: all) of column `name`, which must hold `n` items, to `col`,
+/// sized for `total` items at once (nothing when `n` is 0: a column the scene does not
+/// keep).
 fn append<T: Columnar>(
     r: &mut Reader,
     name: &str,
     col: &mut Vec<T>,
-    (rows, n): (&[usize], usize),
+    (rows, n, total): (Option<&[usize]>, usize, usize),
 ) -> Result<(), SnapshotError> {
-    let all: Vec<T> = r.column_any(name)?;
-    if all.is_empty() {
-        return Ok(());
-    }
-    if all.len() != n {
-        return Err(r.invalid(format!(
-            "column `{name}` holds {} rows; expected {n} or none",
-            all.len()
-        )));
-    }
-    col.extend(rows.iter().map(|&k| all[k]));
-    Ok(())
-}
-
-/// Reads column `name` into `col`: whole, or row k into `col[at[k]]`. A column the scene
-/// does not keep (empty) must be empty in the file too.
-fn put<T: Columnar>(
-    r: &mut Reader,
-    name: &str,
-    col: &mut [T],
-    at: Option<&[u64]>,
-) -> Result<(), SnapshotError> {
-    match at {
-        _ if col.is_empty() => {
-            r.column::<T>(name, 0)?;
-        }
-        None => col.copy_from_slice(&r.column::<T>(name, col.len())?),
-        Some(rows) => {
-            let values: Vec<T> = r.column(name, rows.len())?;
-            for (&i, v) in rows.iter().zip(values) {
-                col[i as usize] = v;
-            }
+    let all: Vec<T> = r.column(name, n)?;
+    if n > 0 {
+        col.reserve_exact(total.saturating_sub(col.len()));
+        match rows {
+            None => col.extend_from_slice(&all),
+            Some(rows) => col.extend(rows.iter().map(|&k| all[k])),
         }
     }
     Ok(())

@@ -9,7 +9,9 @@ use super::format::{ColumnSet, Reader, SnapshotError};
 use crate::base::dim::Dim;
 use crate::io::scenario::Source;
 use crate::ranks::partition::{Partition, TileGrid};
+use crate::store::grid::GridGeom;
 use crate::store::particles::Particles;
+use crate::store::tiles::Tiles;
 use crate::store::world::{Solver, World};
 use bitvec::vec::BitVec;
 use serde::{Deserialize, Serialize};
@@ -129,34 +131,97 @@ pub fn listing(r: &mut Reader) -> Result<Vec<Piece>, SnapshotError> {
     Ok(pieces)
 }
 
-/// Puts the particles of the pieces the manifest `r` names back into `p` (the whole
-/// scene's store), each at its id; every particle must come from exactly one piece.
-pub(super) fn read<D: Dim>(r: &mut Reader, p: &mut Particles<D>) -> Result<(), SnapshotError> {
-    let n = p.len();
-    let mut seen = bitvec::bitvec![0; n];
-    Rows::of(r)?.each(r, &mut seen, |mut f, ids| {
-        columns::read_particles(&mut f, p, Some(&ids))
-    })?;
-    Rows::all_seen(r, &seen)
-}
-
-/// Split across ranks: keeps this rank's share of the stored particles (a whole snapshot's
-/// or a set's) in `w`, those in the tiles a partition of the stored places gives it (a
-/// static scene's initial places, where its solves use them), in whole-scene order, the
-/// partition replacing the one the scene was built with. Every rank reads every piece's
-/// ids and places twice, one piece at a time (to count the tiles, then to pick its own),
-/// and keeps only its own particles' columns: the same share as the whole store split.
-pub(super) fn read_share<D: Dim>(r: &mut Reader, w: &mut World<D>) -> Result<(), SnapshotError> {
-    // The built particles make way for the stored ones.
+/// Puts the stored particles (a whole snapshot's, or those of the pieces its manifest
+/// names: every particle from exactly one) into `w` in whole-scene order. Split across
+/// ranks, each rank keeps its share: those in the tiles a partition of the stored places
+/// gives it (a static scene's initial places, where its solves use them), the partition
+/// replacing the one the scene was built with; every rank reads every piece's ids and
+/// places twice, one piece at a time (to count the tiles, then to pick its own), and
+/// keeps only its own particles' columns: the same share as the whole store split.
+pub(super) fn read<D: Dim>(r: &mut Reader, w: &mut World<D>) -> Result<(), SnapshotError> {
+    // Which optional columns the scene keeps (split, a rank's share of the built scene may
+    // hold no particle to say), then the built particles make way for the stored ones.
+    let b = &w.particles;
+    let kept = |col_empty: bool| w.domain.any(!col_empty);
+    let kept = columns::Kept {
+        half: kept(b.half.is_empty()),
+        gradients: kept(b.grad_u.is_empty()),
+        plastic: kept(b.hardened.is_empty()),
+    };
     w.particles = Particles::default();
     let n = r.header.particles as usize;
-    let place = if w.settings.solver == Solver::Static {
+    let rows = Rows::of(r)?;
+    let mut seen = bitvec::bitvec![0; n];
+    let split = w.domain.comm.is_split();
+    let (partition, total) = if split {
+        let (part, own) = divide(r, w, &rows, &mut seen)?;
+        (Some(part), own)
+    } else {
+        (None, n)
+    };
+    let (place, me) = (place_column(w), w.domain.comm.rank());
+    let tile = tile_of(&w.grid.geom, &w.tiles);
+    let mut p = Particles::<D>::default();
+    seen.fill(false);
+    // One process reading one file takes its rows as they stand, in id order.
+    let in_order = partition.is_none() && !listed(r);
+    rows.each(r, &mut seen, |mut f, ids| {
+        let Some(part) = &partition else {
+            columns::append_rows(&mut f, &mut p, (None, ids.len(), total), kept)?;
+            if !in_order {
+                p.id.extend_from_slice(&ids);
+            }
+            return Ok(());
+        };
+        let x: Vec<D::Vec> = f.column(place, ids.len())?;
+        let mut mine = Vec::new();
+        for (k, (&id, &x)) in ids.iter().zip(&x).enumerate() {
+            if part.owns_tile(tile(&f, id, x)?, me) {
+                mine.push(k);
+            }
+        }
+        columns::append_rows(&mut f, &mut p, (Some(&mine), ids.len(), total), kept)?;
+        p.id.extend(mine.iter().map(|&k| ids[k]));
+        Ok(())
+    })?;
+    // The tiles' borrow ends here: `w` is written below.
+    drop(tile);
+    Rows::all_seen(r, &seen)?;
+    // Rows from several pieces interleave in id; a whole snapshot's are in order.
+    if !p.id.is_sorted() {
+        let mut order: Vec<u32> = (0..p.len() as u32).collect();
+        order.sort_unstable_by_key(|&k| p.id[k as usize]);
+        p.permute(&order);
+    }
+    if !split {
+        p.id = Vec::new();
+    }
+    w.particles = p;
+    if partition.is_some() {
+        w.domain.partition = partition;
+    }
+    w.tiles.tile_of.clear();
+    w.tiles.fresh = false;
+    Ok(())
+}
+
+/// The column of the places a run bins its particles by: where they are, or, in a static
+/// scene, where they started.
+fn place_column<D: Dim>(w: &World<D>) -> &'static str {
+    if w.settings.solver == Solver::Static {
         "particles.x0"
     } else {
         "particles.x"
-    };
-    let (geom, tiles) = (&w.grid.geom, &w.tiles);
-    let tile = |f: &Reader, id: u64, x: D::Vec| {
+    }
+}
+
+/// The tile holding the place `x` of particle `id` read from `f`, refused when outside the
+/// grid.
+fn tile_of<'a, D: Dim>(
+    geom: &'a GridGeom<D>,
+    tiles: &'a Tiles,
+) -> impl Fn(&Reader, u64, D::Vec) -> Result<u32, SnapshotError> + 'a {
+    move |f: &Reader, id: u64, x: D::Vec| {
         let mut cell = [0; 3];
         for a in 0..D::D {
             let c = ((x[a] - geom.origin[a]) * geom.inv_h[a]).floor();
@@ -166,50 +231,43 @@ pub(super) fn read_share<D: Dim>(r: &mut Reader, w: &mut World<D>) -> Result<(),
             cell[a] = c as usize;
         }
         Ok(tiles.tile_of_cell(cell))
-    };
-    let rows = Rows::of(r)?;
-    let mut counts = vec![0u32; tiles.len()];
-    let mut seen = bitvec::bitvec![0; n];
-    rows.each(r, &mut seen, |mut f, ids| {
+    }
+}
+
+/// The partition of the tiles by the stored particles' places, for the ranks `w` runs on,
+/// and the particles it gives this rank: every piece's ids and places read one piece at a
+/// time, each tile's particles counted.
+fn divide<D: Dim>(
+    r: &Reader,
+    w: &World<D>,
+    rows: &Rows,
+    seen: &mut BitVec,
+) -> Result<(Partition, usize), SnapshotError> {
+    let (place, tile) = (place_column(w), tile_of(&w.grid.geom, &w.tiles));
+    let mut counts = vec![0u32; w.tiles.len()];
+    rows.each(r, seen, |mut f, ids| {
         let x: Vec<D::Vec> = f.column(place, ids.len())?;
         for (&id, &x) in ids.iter().zip(&x) {
             counts[tile(&f, id, x)? as usize] += 1;
         }
         Ok(())
     })?;
-    Rows::all_seen(r, &seen)?;
+    Rows::all_seen(r, seen)?;
     let grid = TileGrid {
-        counts: tiles.counts,
-        size: tiles.size,
-        cells: geom.cells,
+        counts: w.tiles.counts,
+        size: w.tiles.size,
+        cells: w.grid.geom.cells,
         dims: D::D,
     };
     let comm = &w.domain.comm;
-    let (me, ranks) = (comm.rank(), comm.size());
-    let partition =
-        Partition::new(grid, &counts, ranks, me).map_err(|e| r.invalid(e.to_string()))?;
-    let mut p = Particles::<D>::default();
-    seen.fill(false);
-    rows.each(r, &mut seen, |mut f, ids| {
-        let x: Vec<D::Vec> = f.column(place, ids.len())?;
-        let mut mine = Vec::new();
-        for (k, (&id, &x)) in ids.iter().zip(&x).enumerate() {
-            if partition.owns_tile(tile(&f, id, x)?, me) {
-                mine.push(k);
-            }
-        }
-        columns::append_rows(&mut f, &mut p, &mine, ids.len())?;
-        p.id.extend(mine.iter().map(|&k| ids[k]));
-        Ok(())
-    })?;
-    let mut order: Vec<u32> = (0..p.len() as u32).collect();
-    order.sort_unstable_by_key(|&k| p.id[k as usize]);
-    p.permute(&order);
-    w.particles = p;
-    w.domain.partition = Some(partition);
-    w.tiles.tile_of.clear();
-    w.tiles.fresh = false;
-    Ok(())
+    let me = comm.rank();
+    let part =
+        Partition::new(grid, &counts, comm.size(), me).map_err(|e| r.invalid(e.to_string()))?;
+    let own = (counts.iter().enumerate())
+        .filter(|&(t, _)| part.owns_tile(t as u32, me))
+        .map(|(_, &c)| c as usize)
+        .sum();
+    Ok((part, own))
 }
 
 /// Where a snapshot's particle rows are: its own columns (a whole snapshot, ids 0..n) or

@@ -4,7 +4,7 @@
 //! surfaces, work, history); grid scratch, particle bins and crack velocity fields are
 //! rebuilt by the first step.
 
-use super::columns::{add_particles, header, read_particles};
+use super::columns::{add_particles, header};
 use super::format::{ColumnSet, Header, Reader, SnapshotError};
 use super::pieces::{self, Piece, Table};
 use super::topology::{self, Encoded};
@@ -216,19 +216,13 @@ pub fn restore<D: Dim>(r: &mut Reader) -> anyhow::Result<Restored<D>> {
 }
 
 /// [`restore`] on the ranks of `comm`: split across them, each rank builds its share of
-/// the scene and keeps its share of the stored particles (`pieces::read_share`), never
-/// the whole store. Every rank calls it, and all return the same error.
+/// the scene and keeps its share of the stored particles (`pieces::read`), never the
+/// whole store. Every rank calls it, and all return the same error.
 pub fn restore_share<D: Dim>(r: &mut Reader, comm: Comm) -> anyhow::Result<Restored<D>> {
     let h = r.header.clone();
     let (source, mut scene) = stored_scene::<D>(r, &h, comm)?;
     let w = &mut scene.world;
-    if w.domain.is_split() {
-        pieces::read_share(r, w)?;
-    } else if pieces::listed(r) {
-        pieces::read(r, &mut w.particles)?;
-    } else {
-        read_particles(r, &mut w.particles, None)?;
-    }
+    pieces::read(r, w)?;
     read_materials(r, &mut w.materials)?;
     read_work(r, &mut w.work)?;
     if let Some(cr) = &mut w.cracks {
