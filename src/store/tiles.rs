@@ -8,6 +8,7 @@
 
 use crate::base::dim::Dim;
 use crate::physics::shape::StencilCache;
+use crate::store::grid::GridGeom;
 use bitvec::slice::BitSlice;
 
 /// Tiles wider than this many cells keep same-colour tiles' stencils disjoint.
@@ -63,6 +64,20 @@ impl Tiles {
             colours: vec![Vec::new(); D::COLOURS],
             tile_of: Vec::new(),
         }
+    }
+
+    /// Linear index of the tile holding the place `x` (m), None when `x` lies outside the
+    /// grid `geom` (or is not finite).
+    pub fn tile_at<D: Dim>(&self, geom: &GridGeom<D>, x: D::Vec) -> Option<u32> {
+        let mut cell = [0; 3];
+        for a in 0..D::D {
+            let c = ((x[a] - geom.origin[a]) * geom.inv_h[a]).floor();
+            if !(c >= 0.0 && c < geom.cells[a] as f64) {
+                return None;
+            }
+            cell[a] = c as usize;
+        }
+        Some(self.tile_of_cell(cell))
     }
 
     /// Linear index of the tile holding `cell` (which must be inside the grid).

@@ -201,11 +201,8 @@ impl<D: Dim> Bodies<'_, D> {
                     return;
                 }
                 found = true;
-                let mut cell = [0; 3];
-                for a in 0..D::D {
-                    cell[a] = ((x[a] - origin[a]) * geom.inv_h[a]) as usize;
-                }
-                let t = self.tiles.tile_of_cell(cell);
+                let t = (self.tiles.tile_at(geom, to_vec::<D>(x)))
+                    .expect("a particle whose stencil fits lies in the grid");
                 if keep(t) {
                     out.keys.push((t, out.counts[t as usize]));
                     plan.push(x, self.shape, &mut out.particles);

@@ -222,15 +222,8 @@ fn tile_of<'a, D: Dim>(
     tiles: &'a Tiles,
 ) -> impl Fn(&Reader, u64, D::Vec) -> Result<u32, SnapshotError> + 'a {
     move |f: &Reader, id: u64, x: D::Vec| {
-        let mut cell = [0; 3];
-        for a in 0..D::D {
-            let c = ((x[a] - geom.origin[a]) * geom.inv_h[a]).floor();
-            if !(c >= 0.0 && c < geom.cells[a] as f64) {
-                return Err(f.invalid(format!("particle {id} lies outside the grid (corrupt)")));
-            }
-            cell[a] = c as usize;
-        }
-        Ok(tiles.tile_of_cell(cell))
+        (tiles.tile_at(geom, x))
+            .ok_or_else(|| f.invalid(format!("particle {id} lies outside the grid (corrupt)")))
     }
 }
 
