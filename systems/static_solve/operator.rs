@@ -165,8 +165,9 @@ pub(super) fn apply<D: Dim>(
 
 /// The diagonal of K (its free components; 1 elsewhere, so the preconditioner leaves the
 /// fixed ones alone): for node n and axis a, sum over particles of V e_a . (C : sym(e_a ⊗
-/// grad S_n)) . grad S_n. A tied entry adds its own to its partner's: a particle reaches
-/// one entry of a node, so the two share no particle and K has no term between them.
+/// grad S_n)) . grad S_n. A tied entry adds its own to its partner's (along the normal
+/// for a sliding pair: [`Unknowns::fold_diagonal`]): a particle reaches one entry of a
+/// node, so the two share no particle and K has no term between them.
 pub(super) fn diagonal<D: Dim>(world: &World<D>, dofs: &Unknowns<D>) -> Vec<D::Vec> {
     let free = &dofs.free;
     let plane = world.settings.plane;
@@ -182,7 +183,7 @@ pub(super) fn diagonal<D: Dim>(world: &World<D>, dofs: &Unknowns<D>) -> Vec<D::V
         }
         d
     });
-    dofs.fold(&mut d);
+    dofs.fold_diagonal(&mut d);
     for (d, &k) in d.iter_mut().zip(free) {
         for a in 0..D::D {
             if k[a] == 0.0 || d[a] <= 0.0 {

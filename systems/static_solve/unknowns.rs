@@ -98,6 +98,31 @@ impl<D: Dim> Unknowns<D> {
         }
     }
 
+    /// Folds a per-component diagonal of K into the diagonal on the unknowns: a tied
+    /// entry's whole into its partner's; for a frictionless pair along the unit normal n,
+    /// the partner gains n_a^2 (n . D_s n) on axis a and the tied entry keeps the diagonal
+    /// of (I - n n^T) D_s (I - n n^T), D_s its diagonal. Unlike [`Self::fold`] (a force),
+    /// neither goes negative on a normal oblique to the axes.
+    pub fn fold_diagonal(&self, d: &mut [D::Vec]) {
+        for &(s, m) in &self.ties {
+            d[m] += d[s];
+            d[s] = D::zero();
+        }
+        for &(s, m, n) in &self.normal_ties {
+            let ds = d[s];
+            let normal: f64 = (0..D::D).map(|b| n[b] * n[b] * ds[b]).sum();
+            for a in 0..D::D {
+                d[m][a] += n[a] * n[a] * normal;
+                d[s][a] = (0..D::D)
+                    .map(|b| {
+                        let p = f64::from(u8::from(a == b)) - n[a] * n[b];
+                        p * p * ds[b]
+                    })
+                    .sum();
+            }
+        }
+    }
+
     /// Clears the components that are not unknowns: the normal part of each frictionless
     /// pair's tied entry (the free mask clears the rest).
     pub fn project(&self, x: &mut [D::Vec]) {
@@ -184,5 +209,50 @@ mod tests {
         let (left, right) = (dot(&x, &folded), dot(&expanded, &y));
         assert!((left - right).abs() < 1e-14, "{left} vs {right}");
         assert!((expanded[2] - expanded[1]).length() == 0.0);
+    }
+
+    /// On an entry-diagonal K (each entry's stiffness per axis, no coupling) with a
+    /// sliding pair along an oblique normal, the folded diagonal is the operator's own:
+    /// e . fold(K expand(e)) for e the partner's axis and the tied entry's axis projected
+    /// off the normal; equal stiffness on every axis, where folding it as a force would
+    /// leave a zero.
+    #[test]
+    fn a_folded_diagonal_is_the_folded_operators() {
+        let n = DVec2::new(1.0, 1.0).normalize();
+        let dofs = Unknowns::<D2> {
+            free: vec![DVec2::ONE, DVec2::ONE],
+            ties: vec![],
+            normal_ties: vec![(1, 0, n)],
+            groups: None,
+        };
+        let k = [DVec2::new(3.0, 5.0), DVec2::new(2.0, 2.0)];
+        let operator = |x: &[DVec2]| {
+            let mut e = x.to_vec();
+            dofs.expand(&mut e);
+            let mut y: Vec<DVec2> = e.iter().zip(&k).map(|(e, k)| *e * *k).collect();
+            dofs.fold(&mut y);
+            dofs.project(&mut y);
+            y
+        };
+        let mut d = k.to_vec();
+        dofs.fold_diagonal(&mut d);
+        for entry in 0..2 {
+            for axis in 0..2 {
+                let mut x = vec![DVec2::ZERO; 2];
+                x[entry][axis] = 1.0;
+                dofs.project(&mut x);
+                let y = operator(&x);
+                let exact = x[0].dot(y[0]) + x[1].dot(y[1]);
+                let folded = d[entry][axis];
+                assert!(
+                    (folded - exact).abs() < 1e-14,
+                    "{entry} {axis}: {folded} vs {exact}"
+                );
+                assert!(folded > 0.0);
+            }
+        }
+        let mut as_force = k.to_vec();
+        dofs.fold(&mut as_force);
+        assert!(as_force[1].min_element() <= 1e-15, "{:?}", as_force[1]);
     }
 }
