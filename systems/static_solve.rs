@@ -243,14 +243,27 @@ fn entry_displacements<D: Dim>(world: &World<D>, disp: &[D::Vec]) -> Vec<D::Vec>
         .collect()
 }
 
-/// The error of a load step whose crack-face contact did not settle.
+/// The error of a load step whose crack-face contact did not settle: what its last round
+/// changed, and, when only friction moved, what to try.
 fn unsettled(world: &World<impl Dim>, t_end: f64, rounds: usize, last: faces::Changes) -> Unstable {
+    let friction = if last.slid == 0 {
+        String::new()
+    } else if last.closed + last.opened == 0 {
+        format!(
+            ", and changed only the friction of {} sliding or stuck pairs: Coulomb friction's \
+             fixed point was not reached; a smaller `friction`, frictionless faces or \
+             solver = \"explicit\" may answer",
+            last.slid
+        )
+    } else {
+        format!(", and changed the friction of {} more", last.slid)
+    };
     Unstable {
         step: world.step + 1,
         time: t_end,
         what: format!(
             "the crack faces' contact did not settle in {rounds} solves (the last closed {} \
-             pairs and opened {})",
+             pairs and opened {}{friction})",
             last.closed, last.opened
         ),
     }
