@@ -133,24 +133,31 @@ pub(super) fn solve<D: Dim>(
         };
         if next.norm >= now.norm {
             history.push(next.relative());
-            return Err(diverged(world, t_end, &history));
+            return Err(diverged(world, t_end, &history, friction.is_some()));
         }
         now = next;
         history.push(now.relative());
     }
-    Err(diverged(world, t_end, &history))
+    Err(diverged(world, t_end, &history, friction.is_some()))
 }
 
-/// The error of a load step whose Newton iteration did not converge, with its residuals.
-fn diverged<D: Dim>(world: &World<D>, t_end: f64, history: &[f64]) -> Unstable {
+/// The error of a load step whose Newton iteration did not converge, with its residuals
+/// and, where crack faces rub (`rubbing`), the other cause seen on such scenes.
+fn diverged<D: Dim>(world: &World<D>, t_end: f64, history: &[f64], rubbing: bool) -> Unstable {
     let list: Vec<String> = history.iter().map(|r| format!("{r:.2e}")).collect();
+    let faces = if rubbing {
+        "; or the Coulomb faces' friction forces hold it up (seen on 3D cracks oblique to \
+         the grid: frictionless faces or solver = \"explicit\" may answer)"
+    } else {
+        ""
+    };
     Unstable {
         step: world.step + 1,
         time: t_end,
         what: format!(
             "the plastic load step did not converge in {} Newton iterations (relative \
              residuals {}): past a limit load, or too large a load step (give more \
-             `load_steps`)",
+             `load_steps`){faces}",
             history.len() - 1,
             list.join(", ")
         ),
