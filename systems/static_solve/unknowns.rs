@@ -99,7 +99,7 @@ impl<D: Dim> Unknowns<D> {
     }
 
     /// Folds a per-component diagonal of K into the diagonal on the unknowns: a tied
-    /// entry's whole into its partner's; for a frictionless pair along the unit normal n,
+    /// entry's whole into its partner's; for a closed pair tied along its unit normal n,
     /// the partner gains n_a^2 (n . D_s n) on axis a and the tied entry keeps the diagonal
     /// of (I - n n^T) D_s (I - n n^T), D_s its diagonal. Unlike [`Self::fold`] (a force),
     /// neither goes negative on a normal oblique to the axes.
@@ -115,7 +115,7 @@ impl<D: Dim> Unknowns<D> {
                 d[m][a] += n[a] * n[a] * normal;
                 d[s][a] = (0..D::D)
                     .map(|b| {
-                        let p = f64::from(u8::from(a == b)) - n[a] * n[b];
+                        let p = (if a == b { 1.0 } else { 0.0 }) - n[a] * n[b];
                         p * p * ds[b]
                     })
                     .sum();
