@@ -168,15 +168,11 @@ fn tiles_now<D: Dim>(world: &World<D>) -> (Cow<'_, [u32]>, Option<usize>) {
     let mut lost = None;
     let tiles = (0..p.len())
         .map(|i| {
-            let mut cell = [0usize; 3];
-            for (a, slot) in cell.iter_mut().enumerate().take(D::D) {
-                let c = ((p.x[i][a] - geom.origin[a]) * geom.inv_h[a]).floor();
-                if !(c >= 0.0 && c < geom.cells[a] as f64) {
-                    lost.get_or_insert(i);
-                }
-                *slot = (c.max(0.0) as usize).min(geom.cells[a] - 1);
+            let (t, inside) = world.tiles.tile_nearest(geom, p.x[i]);
+            if !inside {
+                lost.get_or_insert(i);
             }
-            world.tiles.tile_of_cell(cell)
+            t
         })
         .collect();
     (Cow::Owned(tiles), lost)

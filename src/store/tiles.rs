@@ -69,15 +69,21 @@ impl Tiles {
     /// Linear index of the tile holding the place `x` (m), None when `x` lies outside the
     /// grid `geom` (or is not finite).
     pub fn tile_at<D: Dim>(&self, geom: &GridGeom<D>, x: D::Vec) -> Option<u32> {
+        let (t, inside) = self.tile_nearest(geom, x);
+        inside.then_some(t)
+    }
+
+    /// Linear index of the tile holding the grid cell nearest the place `x` (m), and
+    /// whether `x` lies inside the grid `geom` (a non-finite place takes the first cell).
+    pub fn tile_nearest<D: Dim>(&self, geom: &GridGeom<D>, x: D::Vec) -> (u32, bool) {
         let mut cell = [0; 3];
+        let mut inside = true;
         for a in 0..D::D {
             let c = ((x[a] - geom.origin[a]) * geom.inv_h[a]).floor();
-            if !(c >= 0.0 && c < geom.cells[a] as f64) {
-                return None;
-            }
-            cell[a] = c as usize;
+            inside &= c >= 0.0 && c < geom.cells[a] as f64;
+            cell[a] = (c.max(0.0) as usize).min(geom.cells[a] - 1);
         }
-        Some(self.tile_of_cell(cell))
+        (self.tile_of_cell(cell), inside)
     }
 
     /// Linear index of the tile holding `cell` (which must be inside the grid).
