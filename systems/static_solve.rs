@@ -315,11 +315,17 @@ fn with_contact<D: Dim>(
             let solver = Solver::new(world, &dofs, kept)?;
             built = Some((now, dofs, solver));
         }
-        let Some((_, dofs, solver)) = built.as_ref() else {
+        let Some((_, dofs, solver)) = built.as_mut() else {
             unreachable!("the unknowns are built before the first round")
         };
+        dofs.set_springs(&pairs, &faces);
+        let (dofs, solver) = (&*dofs, &*solver);
         let mut load = world.grid.force.clone();
         faces::add_friction::<D>(&pairs, &faces, &mut load);
+        // The friction tangents act on the slip over the step, from the step's start.
+        if !start.is_empty() {
+            faces::add_spring_forces::<D>(&dofs.springs, &start, &mut load);
+        }
         let tied = |s: usize, m: usize| dofs.ties.binary_search(&(s, m)).is_ok();
         let kept_slip = faces::kept_slip::<D>(&pairs, &faces, &start, tied);
         if let Some(d) = &kept_slip {
@@ -495,9 +501,11 @@ fn faces_round<D: Dim>(
         .zip(&world.grid.force)
         .for_each(|(r, &f)| *r -= f);
     let gap_tol = 1e-9 * sums.max(largest(u));
+    let most_turn = faces::turn_cap(world);
     // Split across ranks, a pair on a shared node changes alike on each: its owner counts it.
     let counted = |p: &faces::Pair<D::Vec>| sums.owns(p.own);
-    let mine = faces::update::<D>(pairs, faces, (u, start), &r, (gap_tol, force_tol), counted);
+    let tols = (gap_tol, force_tol, most_turn);
+    let mine = faces::update::<D>(pairs, faces, (u, start), &r, tols, counted);
     faces::Changes {
         closed: sums.count(mine.closed),
         opened: sums.count(mine.opened),
@@ -599,7 +607,7 @@ fn friction_work<D: Dim>(
     let moved = |e: usize| u[e] - start.get(e).copied().unwrap_or(D::zero());
     let mut dissipated = vec![0.0; u.len()];
     for (p, face) in pairs.iter().zip(faces) {
-        if let Face::Sliding { force } = *face {
+        if let Face::Sliding { force, .. } = *face {
             let (a, b) = p.above_below();
             let slip = along(moved(a) - moved(b), p.normal);
             let before = carried.get(a).map_or(D::zero(), |&r| along(r, p.normal));

@@ -3,7 +3,7 @@
 //! across ranks gives the same bits.
 
 use super::frame::Frame;
-use super::operator::{Law, apply};
+use super::operator::{Law, apply, with_springs};
 use super::rigid;
 use super::unknowns::Unknowns;
 use super::vectors::{DotPair, Sums};
@@ -35,6 +35,7 @@ pub(super) fn conjugate_gradients<D: Dim>(
         modes,
         coarse,
     } = frame;
+    let diag = &with_springs(diag, dofs)[..];
     let n = f.len();
     let sums = Sums::of(world);
     let norm_f = sums.dot::<D>(f, f).sqrt();

@@ -7,6 +7,7 @@
 
 use super::cholesky::{analyse, factorize};
 use super::dilatation::{Groups, isotropic, trace};
+use super::faces::spring_force;
 use super::frame::Frame;
 use super::operator::{Law, apply};
 use super::unknowns::Unknowns;
@@ -132,16 +133,15 @@ impl<D: Dim> Direct<D> {
             .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
         let mut memory = MemBuffer::try_new(scratch)
             .map_err(|_| failed("out of memory for the direct solver's workspace".into()))?;
-        let kept = match law {
-            Law::Elastic => self.elastic.get(),
-            _ => None,
-        };
+        // The friction tangents change from one contact round to the next.
+        let cache = matches!(law, Law::Elastic) && dofs.springs.is_empty();
+        let kept = if cache { self.elastic.get() } else { None };
         let owned: Vec<f64>;
         let factorizations = usize::from(kept.is_none());
         let factor: &[f64] = match kept {
             Some(f) => f,
             None => {
-                let values = self.assemble(world, law, &frame.ghost, dofs.groups.as_ref());
+                let values = self.assemble(world, law, &frame.ghost, dofs);
                 let f = factorize(symbolic, pattern, &values, &mut memory).ok_or_else(|| {
                     failed(
                         "the static solve's stiffness is not positive definite (is the body \
@@ -149,7 +149,7 @@ impl<D: Dim> Direct<D> {
                             .into(),
                     )
                 })?;
-                if matches!(law, Law::Elastic) {
+                if cache {
                     self.elastic.get_or_init(|| f)
                 } else {
                     owned = f;
@@ -197,14 +197,16 @@ impl<D: Dim> Direct<D> {
     /// K's lower triangle on the pattern: each particle's V B^T C B under `law` (B-bar
     /// with mean-dilatation `groups`, group by group), free particles tile by tile in
     /// colour classes, then the particles near a crack in order (the same sums in the same
-    /// order for any thread count), and the ghost stiffness.
+    /// order for any thread count), the ghost stiffness and the friction tangents of
+    /// `dofs`' springs.
     fn assemble(
         &self,
         world: &World<D>,
         law: Law<D>,
         ghost: &[D::Vec],
-        groups: Option<&Groups>,
+        dofs: &Unknowns<D>,
     ) -> Vec<f64> {
+        let groups = dofs.groups.as_ref();
         let mut values = vec![0.0; self.analysis.pattern.compute_nnz()];
         let tiles = &world.tiles;
         let fields = fields(world);
@@ -254,6 +256,30 @@ impl<D: Dim> Direct<D> {
                     let g: f64 = (0..D::D).map(|a| ghost[e][a] * bi[a] * bj[a]).sum();
                     // SAFETY: the particle passes are over; this loop is the only writer.
                     unsafe { self.add(&writer, i, j, g) };
+                }
+            }
+        }
+        let comb = &self.layout.comb;
+        for s in &dofs.springs {
+            // The force on entry l per unit motion of entry k along b: -force(e_b) on the
+            // same entry, +force(e_b) on the other.
+            let mut column = [D::zero(); 3];
+            for (b, c) in column.iter_mut().enumerate().take(D::D) {
+                let mut e = D::zero();
+                e[b] = 1.0;
+                *c = -spring_force::<D>(s, e);
+            }
+            for l in [s.above, s.below] {
+                for k in [s.above, s.below] {
+                    let sign = if l == k { 1.0 } else { -1.0 };
+                    for &(r, cr) in &comb[l] {
+                        for &(c, cc) in comb[k].iter().filter(|(c, _)| *c <= r) {
+                            let v: f64 = (0..D::D).map(|b| cc[b] * D::dot(cr, column[b])).sum();
+                            // SAFETY: the particle passes are over; this loop is the only
+                            // writer.
+                            unsafe { self.add(&writer, r, c, sign * v) };
+                        }
+                    }
                 }
             }
         }

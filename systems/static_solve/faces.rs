@@ -46,6 +46,11 @@ pub(super) enum Face<V> {
     Sliding {
         /// The friction force on the field above (N), along the face.
         force: V,
+        /// How fast the force turns with the slip across its direction (N/m): mu times the
+        /// normal force over the slip, the friction's tangent ([`Spring`]); the cap
+        /// ([`turn_cap`]) on a pair just come unstuck, whose slip is not known yet, so that
+        /// it starts to slide along its stuck force.
+        turn: f64,
     },
 }
 
@@ -145,6 +150,91 @@ impl Changes {
 /// direction is then held to what a preconditioner's answer means.
 pub(super) const FRICTION_TOL: f64 = 1e-6;
 
+/// A sliding pair's friction linearized about its last slip s (Newton's tangent of the
+/// force -mu p s / |s|, 3D only: along a 2D face the direction cannot turn): the force on
+/// the field above changes by -k (P - d d^T) (its slip less s), P the projection on the face,
+/// d the slip's direction, k = mu p / |s| (capped at [`turn_cap`]). The rounds of the
+/// active set are then Newton iterations on the slip's direction, which a fixed point of
+/// force and slip alone did not settle on faces oblique to the grid; at the settled round
+/// the slip is along d and the spring carries nothing.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Spring<V> {
+    /// The entries above and below the crack.
+    pub above: usize,
+    pub below: usize,
+    /// The crack's unit normal.
+    pub normal: V,
+    /// The slip's unit direction (against the friction force).
+    pub along: V,
+    /// k (N/m).
+    pub k: f64,
+}
+
+/// Spring `s`'s force on the field above for a relative displacement `x` (above less
+/// below): -k (P - d d^T) x.
+pub(super) fn spring_force<D: Dim>(s: &Spring<D::Vec>, x: D::Vec) -> D::Vec {
+    let t = x - s.normal * D::dot(x, s.normal);
+    (t - s.along * D::dot(t, s.along)) * -s.k
+}
+
+/// The springs of the sliding pairs with a known slip whose row `acting` takes (none in
+/// 2D).
+pub(super) fn springs<D: Dim>(
+    pairs: &[Pair<D::Vec>],
+    faces: &[Face<D::Vec>],
+    acting: impl Fn(usize) -> bool,
+) -> Vec<Spring<D::Vec>> {
+    if D::D < 3 {
+        return Vec::new();
+    }
+    let length = |v: D::Vec| D::dot(v, v).sqrt();
+    (pairs.iter().zip(faces))
+        .filter_map(|(p, face)| match *face {
+            Face::Sliding { force, turn } if turn > 0.0 && length(force) > 0.0 && acting(p.row) => {
+                let (above, below) = p.above_below();
+                Some(Spring {
+                    above,
+                    below,
+                    normal: p.normal,
+                    along: force * (-1.0 / length(force)),
+                    k: turn,
+                })
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// Adds the springs' share of K x to `y` (x every entry's displacement): minus each
+/// spring's force on the field above, plus it on the one below.
+pub(super) fn add_spring_forces<D: Dim>(
+    springs: &[Spring<D::Vec>],
+    x: &[D::Vec],
+    y: &mut [D::Vec],
+) {
+    for s in springs {
+        let f = spring_force::<D>(s, x[s.above] - x[s.below]);
+        y[s.above] -= f;
+        y[s.below] += f;
+    }
+}
+
+/// The largest `turn` a sliding pair takes, in units of a grid entry's stiffness E h (the
+/// largest Young's modulus, the smallest cell edge): a slip of next to nothing would
+/// otherwise tie its direction without bound. Ten: at 1 (E h itself) a pair whose slip
+/// asked for twice that still settled only at 0.83 a round (a random oblique penny; 13
+/// rounds at 10, the same at 100).
+const TURN_CAP: f64 = 10.0;
+
+/// The largest `turn` a sliding pair takes (N/m): [`TURN_CAP`] times E h.
+pub(super) fn turn_cap<D: Dim>(world: &World<D>) -> f64 {
+    let e = (world.materials.iter())
+        .map(|m| m.youngs)
+        .fold(0.0, f64::max);
+    let h = D::to_xyz(world.grid.geom.h);
+    TURN_CAP * e * (0..D::D).map(|a| h[a]).fold(f64::INFINITY, f64::min)
+}
+
 /// Updates each pair's `faces` state from the solution `u` (every entry's displacement;
 /// `start`, the entries' displacement at the step's start, empty for zero) and
 /// `ku_less_f`, K u - f_ext per entry without ties folded and without the friction forces,
@@ -155,14 +245,15 @@ pub(super) const FRICTION_TOL: f64 = 1e-6;
 /// normal force against its slip over the step (stuck when it did not slip); a stuck pair
 /// whose tangential force exceeds mu times the normal one slides, with the friction force
 /// capped there; a sliding pair whose slip does not oppose its friction force sticks, and
-/// otherwise takes mu times its normal force against its slip. Counts the changes of the
-/// pairs `counted` takes.
+/// otherwise takes mu times its normal force against its slip. Each sliding pair's `turn`
+/// is set from its slip, at most `most_turn`. Counts the changes of the pairs `counted`
+/// takes.
 pub(super) fn update<D: Dim>(
     pairs: &[Pair<D::Vec>],
     faces: &mut [Face<D::Vec>],
     (u, start): (&[D::Vec], &[D::Vec]),
     ku_less_f: &[D::Vec],
-    (gap_tol, force_tol): (f64, f64),
+    (gap_tol, force_tol, most_turn): (f64, f64, f64),
     counted: impl Fn(&Pair<D::Vec>) -> bool,
 ) -> Changes {
     let mut changes = Changes::default();
@@ -192,6 +283,7 @@ pub(super) fn update<D: Dim>(
         let moved = |e: usize| u[e] - start.get(e).copied().unwrap_or(D::zero());
         let slip = along(moved(a) - moved(b), n);
         let size = length(slip);
+        let turn = (cap / size).min(most_turn);
         match *face {
             Face::Closed => {
                 *face = if size <= gap_tol {
@@ -199,6 +291,7 @@ pub(super) fn update<D: Dim>(
                 } else {
                     Face::Sliding {
                         force: slip * (-cap / size),
+                        turn,
                     }
                 };
                 changes.slid += count;
@@ -209,11 +302,12 @@ pub(super) fn update<D: Dim>(
                 if size > cap + force_tol {
                     *face = Face::Sliding {
                         force: t * (cap / size),
+                        turn: most_turn,
                     };
                     changes.slid += count;
                 }
             }
-            Face::Sliding { force } => {
+            Face::Sliding { force, .. } => {
                 if size <= gap_tol || D::dot(slip, force) > 0.0 {
                     *face = Face::Stuck;
                     changes.slid += count;
@@ -221,7 +315,7 @@ pub(super) fn update<D: Dim>(
                 }
                 let next = slip * (-cap / size);
                 if length(next - force) > FRICTION_TOL * length(next) + force_tol {
-                    *face = Face::Sliding { force: next };
+                    *face = Face::Sliding { force: next, turn };
                     changes.slid += count;
                 }
             }
@@ -239,7 +333,7 @@ pub(super) fn add_friction<D: Dim>(
     f: &mut [D::Vec],
 ) {
     for (p, face) in pairs.iter().zip(faces) {
-        if let Face::Sliding { force } = *face {
+        if let Face::Sliding { force, .. } = *face {
             let (a, b) = p.above_below();
             f[a] += force;
             f[b] -= force;
@@ -271,4 +365,42 @@ pub(super) fn kept_slip<D: Dim>(
         }
     }
     any.then_some(kept)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::base::dim::D3;
+    use glam::DVec3;
+
+    /// The spring is the friction force's derivative: f(s) = -c s / |s| on a face of
+    /// oblique normal n, s a slip along it; for a small change ds in the face, the change
+    /// f(s + ds) - f(s) is the spring's force for ds to first order (within 1e-3 of it at
+    /// |ds| = 1e-4 |s|, the second-order term being about |ds| / |s| of it), whatever part
+    /// of ds lies along s (which turns nothing) or along n (which the face's tie carries).
+    #[test]
+    fn a_spring_is_the_friction_forces_tangent() {
+        let n = DVec3::new(0.3, 0.9, 0.3).normalize();
+        let along = |v: DVec3| v - n * v.dot(n);
+        let s = along(DVec3::new(1.0, -2.0, 0.5)) * 1e-6;
+        let c = 3.0;
+        let friction = |s: DVec3| s * (-c / s.length());
+        let spring = Spring {
+            above: 0,
+            below: 1,
+            normal: n,
+            along: s.normalize(),
+            k: c / s.length(),
+        };
+        for ds in [DVec3::new(0.2, 0.1, -0.7), DVec3::new(-1.0, 0.4, 0.3)] {
+            let ds = ds * (1e-4 * s.length());
+            let exact = friction(s + along(ds)) - friction(s);
+            let tangent = spring_force::<D3>(&spring, ds);
+            assert!(
+                (exact - tangent).length() <= 1e-3 * exact.length(),
+                "{exact} vs {tangent}"
+            );
+        }
+        assert!(spring_force::<D3>(&spring, s).length() < 1e-12 * c);
+    }
 }

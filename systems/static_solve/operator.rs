@@ -1,6 +1,7 @@
 //! Products with the stiffness K of a static scene, matrix-free: particle by particle, the
 //! stress a displacement gradient gives under a [`Law`], scattered as nodal forces.
 
+use super::faces::add_spring_forces;
 use super::scatter::{entry_sums, near_crack_sums};
 use super::unknowns::Unknowns;
 use super::{each_entry, fields, gradient};
@@ -13,6 +14,7 @@ use crate::store::world::{CHUNK, World};
 use crate::systems::p2g::add_internal_force;
 use crate::systems::stress::velocity_gradient;
 use rayon::prelude::*;
+use std::borrow::Cow;
 
 /// Which stress a particle's displacement gradient gives, in a product with K.
 #[derive(Clone, Copy)]
@@ -62,7 +64,8 @@ pub(super) fn elastic<D: Dim>(m: &Material, plane: Plane, l: &D::Mat) -> D::Sym 
 /// y = K x, particle by particle: grad x gathered at each particle (tied entries taking
 /// the value of the entry they move with), the stress it gives under `law`, and that stress's nodal
 /// force, tile by tile in colour classes (the same scatter, in the same order, for any
-/// thread count), tied entries' forces folded into their partners'. With mean-dilatation
+/// thread count), the sliding faces' friction tangents added (`dofs.springs`), tied
+/// entries' forces folded into their partners'. With mean-dilatation
 /// groups the stresses come first, from the group-mean strains, and scatter with their
 /// groups' mean pressure ([`Groups`](super::dilatation::Groups)).
 pub(super) fn stiffness<D: Dim>(
@@ -131,6 +134,7 @@ pub(super) fn stiffness<D: Dim>(
             emit(n, D::stress_dot(&s, g) * p.volume[i])
         });
     });
+    add_spring_forces::<D>(&dofs.springs, x, y);
     dofs.fold(y);
 }
 
@@ -192,4 +196,25 @@ pub(super) fn diagonal<D: Dim>(world: &World<D>, dofs: &Unknowns<D>) -> Vec<D::V
         }
     }
     d
+}
+
+/// `diag` (the frame's, without the friction tangents) with the diagonal of `dofs`'
+/// springs added on the free components: k (1 - n_a^2 - d_a^2) on both entries of each.
+pub(super) fn with_springs<'a, D: Dim>(
+    diag: &'a [D::Vec],
+    dofs: &Unknowns<D>,
+) -> Cow<'a, [D::Vec]> {
+    if dofs.springs.is_empty() {
+        return Cow::Borrowed(diag);
+    }
+    let mut d = diag.to_vec();
+    for s in &dofs.springs {
+        for e in [s.above, s.below] {
+            let (d, free) = (&mut d[e], dofs.free[e]);
+            for a in (0..D::D).filter(|&a| free[a] != 0.0) {
+                d[a] += s.k * (1.0 - s.normal[a] * s.normal[a] - s.along[a] * s.along[a]);
+            }
+        }
+    }
+    Cow::Owned(d)
 }

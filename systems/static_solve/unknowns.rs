@@ -2,10 +2,10 @@
 //! particle reaches the entry, no boundary holds it), the crack fields that hold a sliver
 //! of mass, tied to their node's heaviest entry, the closed crack faces that slide
 //! (frictionless or against friction), tied along the crack's normal, and the stuck ones,
-//! tied whole.
+//! tied whole; with the sliding ones' friction tangents, which K carries.
 
 use super::dilatation::Groups;
-use super::faces::{Face, Pair};
+use super::faces::{self, Face, Pair, Spring};
 use super::{entries, fields};
 use crate::base::dim::Dim;
 use crate::store::world::{Dilatation, World};
@@ -22,6 +22,8 @@ pub(super) struct Unknowns<D: Dim> {
     pub normal_ties: Vec<(usize, usize, D::Vec)>,
     /// The particles' mean-dilatation groups (`dilatation = "cell_mean"`), else None.
     pub groups: Option<Groups>,
+    /// The sliding pairs' friction tangents (3D), part of K: [`faces::Spring`].
+    pub springs: Vec<Spring<D::Vec>>,
 }
 
 impl<D: Dim> Unknowns<D> {
@@ -63,12 +65,23 @@ impl<D: Dim> Unknowns<D> {
         }
         let groups =
             (world.settings.dilatation == Dilatation::CellMean).then(|| Groups::new(world));
-        Unknowns {
+        let mut dofs = Unknowns {
             free,
             ties,
             normal_ties,
             groups,
-        }
+            springs: Vec::new(),
+        };
+        dofs.set_springs(pairs, faces);
+        dofs
+    }
+
+    /// Takes the sliding pairs' friction tangents from `faces` (the same pairs in the same
+    /// kinds of state as when these unknowns were made, only their forces moved).
+    pub fn set_springs(&mut self, pairs: &[Pair<D::Vec>], faces: &[Face<D::Vec>]) {
+        let tied = &self.normal_ties;
+        let acting = |row: usize| tied.binary_search_by_key(&row, |t| t.0).is_ok();
+        self.springs = faces::springs::<D>(pairs, faces, acting);
     }
 
     /// Gives each tied entry the value of the entry it moves with (along the normal for a
@@ -193,6 +206,7 @@ mod tests {
             ties: vec![(2, 1)],
             normal_ties: vec![(1, 0, n)],
             groups: None,
+            springs: Vec::new(),
         };
         let mut x = vec![DVec2::new(1.0, -2.0), DVec2::new(3.0, 5.0), DVec2::ZERO];
         dofs.project(&mut x);
@@ -224,6 +238,7 @@ mod tests {
             ties: vec![],
             normal_ties: vec![(1, 0, n)],
             groups: None,
+            springs: Vec::new(),
         };
         let k = [DVec2::new(3.0, 5.0), DVec2::new(2.0, 2.0)];
         let operator = |x: &[DVec2]| {
