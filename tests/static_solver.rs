@@ -663,7 +663,7 @@ fn coulomb_faces_stick_or_slide_as_the_law_says() {
     assert!(rubbed <= 1e-4 * work, "{rubbed} of {work}");
     for mu in [0.2, 0.4] {
         let expected = mu * sigma * (tau - mu * sigma) / (tau * tau) * (frictionless - whole);
-        slides_as_superposed(friction(mu, 1), expected);
+        slides_as_superposed(friction(mu, 1), expected, 0.03);
     }
     let (_, _, once) = friction(0.2, 1);
     let (strain, work, rubbed) = friction(0.2, 3);
@@ -766,7 +766,7 @@ fn coulomb_faces_slide_on_a_penny() {
     let (whole, _, _) = sheared_penny(None);
     let (frictionless, _, _) = sheared_penny(Some("{ law = \"frictionless\" }"));
     let rubbing = sheared_penny(Some("{ law = \"friction\", friction = 0.2 }"));
-    slides_as_superposed(rubbing, 0.24 * (frictionless - whole));
+    slides_as_superposed(rubbing, 0.24 * (frictionless - whole), 0.03);
 }
 
 /// Conjugate gradients on closed frictionless faces whose normal, (1, 1, 1) / sqrt 3, is
@@ -818,22 +818,15 @@ fn coulomb_faces_slide_on_a_penny_oblique_to_the_grid() {
         .sqrt();
     let (mu, pressed) = (0.2, -sigma_n);
     let expected = mu * pressed * (tau - mu * pressed) / (tau * tau) * (frictionless - whole);
-    assert!(
-        (rubbed / expected - 1.0).abs() < 0.05,
-        "{rubbed} vs {expected}"
-    );
-    assert!(
-        (work - strain - rubbed).abs() <= 1e-8 * work,
-        "{work} vs {strain} + {rubbed}"
-    );
+    slides_as_superposed((strain, work, rubbed), expected, 0.05);
 }
 
 /// Asserts a sliding crack's one-step energies (strain, external work, friction work):
-/// the friction's work within 3 % of the superposition's `expected`, and the loads' work
-/// equal to the strain energy plus the friction's to 1e-8.
-fn slides_as_superposed((strain, work, rubbed): (f64, f64, f64), expected: f64) {
+/// the friction's work within `tolerance` of the superposition's `expected`, and the loads'
+/// work equal to the strain energy plus the friction's to 1e-8.
+fn slides_as_superposed((strain, work, rubbed): (f64, f64, f64), expected: f64, tolerance: f64) {
     assert!(
-        (rubbed / expected - 1.0).abs() < 0.03,
+        (rubbed / expected - 1.0).abs() < tolerance,
         "{rubbed} vs {expected}"
     );
     assert!(
