@@ -159,8 +159,9 @@ pub(super) const FRICTION_TOL: f64 = 1e-6;
 /// the slip is along d and the spring carries nothing.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Spring<V> {
-    /// The entries above and below the crack.
+    /// The entry above the crack.
     pub above: usize,
+    /// The entry below it.
     pub below: usize,
     /// The crack's unit normal.
     pub normal: V,
