@@ -259,27 +259,21 @@ impl<D: Dim> Direct<D> {
                 }
             }
         }
-        let comb = &self.layout.comb;
         for s in &dofs.springs {
             // The force on entry l per unit motion of entry k along b: -force(e_b) on the
             // same entry, +force(e_b) on the other.
-            let mut column = [D::zero(); 3];
-            for (b, c) in column.iter_mut().enumerate().take(D::D) {
+            let mut same = [D::zero(); 3];
+            for (b, c) in same.iter_mut().enumerate().take(D::D) {
                 let mut e = D::zero();
                 e[b] = 1.0;
                 *c = -spring_force::<D>(s, e);
             }
+            let other = same.map(|c| c * -1.0);
             for l in [s.above, s.below] {
                 for k in [s.above, s.below] {
-                    let sign = if l == k { 1.0 } else { -1.0 };
-                    for &(r, cr) in &comb[l] {
-                        for &(c, cc) in comb[k].iter().filter(|(c, _)| *c <= r) {
-                            let v: f64 = (0..D::D).map(|b| cc[b] * D::dot(cr, column[b])).sum();
-                            // SAFETY: the particle passes are over; this loop is the only
-                            // writer.
-                            unsafe { self.add(&writer, r, c, sign * v) };
-                        }
-                    }
+                    let block = if l == k { &same } else { &other };
+                    // SAFETY: the particle passes are over; this loop is the only writer.
+                    unsafe { self.add_block(&writer, l, k, block) };
                 }
             }
         }
@@ -378,7 +372,6 @@ impl<D: Dim> Direct<D> {
                 stress[k * D::D + b] = law.stress(m, plane, i, &l);
             }
         }
-        let comb = &self.layout.comb;
         let mut block = [D::zero(); 3];
         for (lk, &(l, gl)) in support.iter().enumerate() {
             for (k, &(kn, _)) in support.iter().enumerate() {
@@ -391,13 +384,25 @@ impl<D: Dim> Direct<D> {
                     }
                     *f *= volume;
                 }
-                for &(r, cr) in &comb[l] {
-                    for &(c, cc) in comb[kn].iter().filter(|(c, _)| *c <= r) {
-                        let v: f64 = (0..D::D).map(|b| cc[b] * D::dot(cr, block[b])).sum();
-                        // SAFETY: passed on from the caller.
-                        unsafe { self.add(values, r, c, v) };
-                    }
-                }
+                // SAFETY: passed on from the caller.
+                unsafe { self.add_block(values, l, kn, &block) };
+            }
+        }
+    }
+
+    /// Adds the block of K between grid entries `l` and `k` (`block[b]`: the force on `l`
+    /// per unit motion of `k` along axis b) to the unknowns each entry is made of, lower
+    /// triangle only.
+    ///
+    /// # Safety
+    /// No other thread may write the columns of the entries' unknowns.
+    unsafe fn add_block(&self, values: &Disjoint<f64>, l: usize, k: usize, block: &[D::Vec; 3]) {
+        let comb = &self.layout.comb;
+        for &(r, cr) in &comb[l] {
+            for &(c, cc) in comb[k].iter().filter(|(c, _)| *c <= r) {
+                let v: f64 = (0..D::D).map(|b| cc[b] * D::dot(cr, block[b])).sum();
+                // SAFETY: passed on from the caller.
+                unsafe { self.add(values, r, c, v) };
             }
         }
     }
