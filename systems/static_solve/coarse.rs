@@ -77,6 +77,14 @@ const MOST_COARSE_CELLS_3D: usize = 8_000;
 /// (the tube's 85, the penny's 55).
 const SHIFT: f64 = 1e-4;
 
+/// A coarse component is an unknown when its diagonal holds at least this many of its
+/// row's quanta ([`quanta`]). The rounding of a row's terms adds up to about the square
+/// root of their number (10^4 particles by 375 entries in 3D: about 10^3 quanta), which
+/// 2^24 quanta keep under [`SHIFT`]. Below it, a node that only the tails of a B-spline
+/// stencil reach (a diagonal of a few quanta on the penny's cube) is rounding, not
+/// stiffness, and made P^T K P indefinite; uGIMP's lightest rows on that cube hold 2^30.
+const LEAST_QUANTA: f64 = (1u64 << 24) as f64;
+
 /// The coarse grid: the interpolation to the fine entries and its stiffness's factor,
 /// which a set of unknowns whose particles see the same held components shares with the
 /// last one (a crack that grows changes the entries, not P^T K P: [`Coarse::new`]).
@@ -391,8 +399,8 @@ impl Stiffness {
         parents: &[Parents],
         keep: &[u8],
     ) -> Result<Self, String> {
-        let blocks = assemble(world, shape, parents, keep);
-        let (unknown, count, pattern, values) = lower_triangle::<D>(shape, &blocks);
+        let (blocks, quanta) = assemble(world, shape, parents, keep);
+        let (unknown, count, pattern, values) = lower_triangle::<D>(shape, &blocks, &quanta);
         let symbolic = analyse(&pattern, "the coarse grid")?;
         let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
         let mut memory = MemBuffer::try_new(scratch)
@@ -531,8 +539,13 @@ fn offset<D: Dim>(row: [usize; 3], col: [usize; 3]) -> usize {
 /// passes (bins 0, 3, 6, ..., then 1, 4, ..., then 2, 5, ...), the bins of a pass in
 /// parallel on disjoint rows. Each term is rounded to its row's [`quanta`], so that the
 /// sums are exact: the same bits in any order, for any thread count and any split of the
-/// particles across ranks, whose rows are then added.
-fn assemble<D: Dim>(world: &World<D>, shape: Shape, parents: &[Parents], keep: &[u8]) -> Vec<f64> {
+/// particles across ranks, whose rows are then added. Returns the blocks and the quanta.
+fn assemble<D: Dim>(
+    world: &World<D>,
+    shape: Shape,
+    parents: &[Parents],
+    keep: &[u8],
+) -> (Vec<f64>, Vec<(f64, f64)>) {
     let last = D::D - 1;
     let planes = shape.nodes[last];
     let p = &world.particles;
@@ -589,7 +602,7 @@ fn assemble<D: Dim>(world: &World<D>, shape: Shape, parents: &[Parents], keep: &
             });
     }
     world.domain.add_rows(&mut blocks, span * dd);
-    blocks
+    (blocks, quanta)
 }
 
 /// A bound on the elastic law's stiffness: |C : e| <= stiffest |e| (Frobenius norms) for
@@ -750,11 +763,13 @@ unsafe fn add_particle<D: Dim>(
     }
 }
 
-/// The coarse unknowns (each node's components with stiffness) and P^T K P's lower
-/// triangle on them (column by column, rows sorted), the diagonal raised by [`SHIFT`].
+/// The coarse unknowns (each node's components whose stiffness stands above the rounding
+/// of its row's `quanta`: [`LEAST_QUANTA`]) and P^T K P's lower triangle on them (column
+/// by column, rows sorted), the diagonal raised by [`SHIFT`].
 fn lower_triangle<D: Dim>(
     shape: Shape,
     blocks: &[f64],
+    quanta: &[(f64, f64)],
 ) -> (Vec<u32>, usize, SymbolicSparseColMat<usize>, Vec<f64>) {
     let (d, dd, span) = (D::D, D::D * D::D, span::<D>());
     let total = shape.nodes.iter().product::<usize>();
@@ -763,7 +778,7 @@ fn lower_triangle<D: Dim>(
     let mut count = 0usize;
     for c in 0..total {
         for a in 0..d {
-            if blocks[(c * span + centre) * dd + a * d + a] > 0.0 {
+            if blocks[(c * span + centre) * dd + a * d + a] > LEAST_QUANTA * quanta[c].0 {
                 unknown[c * d + a] = count as u32;
                 count += 1;
             }
