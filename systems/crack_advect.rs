@@ -117,7 +117,9 @@ impl<D: Dim> Mover<'_, D> {
     fn advect(&self, cracks: Option<&mut Cracks<D>>, momentum: impl Fn(usize) -> D::Vec, dt: f64) {
         let Some(Cracks {
             topology,
-            geometry: Positions { x: xs, top, bottom },
+            geometry: Positions {
+                x: xs, top, bottom, ..
+            },
             scratch,
             ..
         }) = cracks

@@ -106,7 +106,7 @@ pub fn run<D: Dim>(world: &mut World<D>, kept: &mut Kept) -> Result<Solved, Unst
     let x = std::mem::replace(&mut p.x, p.x0.clone());
     world.tiles.fresh = false;
     bin::run(world)?;
-    classify::run(world)?;
+    classify_undeformed(world)?;
     // Mass (which nodes the particles support) and the loads at the step's end.
     let t_start = world.time;
     world.time = t_end;
@@ -230,6 +230,26 @@ fn plastic_step<D: Dim>(
     let solved = step.solved;
     newton::commit(world, step, &after);
     Ok(solved)
+}
+
+/// Classifies the particles, at their initial places, against the cracks where they lie in
+/// the undeformed body (their places before the first load step, moved by growth only):
+/// K is the undeformed body's, and the cracks moved with the solutions, a fraction of a
+/// cell in a slender beam, would split other particle-node pairs from step to step.
+fn classify_undeformed<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
+    let Some(c) = world.cracks.as_mut() else {
+        return Ok(());
+    };
+    let g = &mut c.geometry;
+    if g.x0.len() != g.x.len() {
+        g.x0 = g.x.clone();
+    }
+    let deformed = std::mem::replace(&mut g.x, g.x0.clone());
+    let classified = classify::run(world);
+    if let Some(c) = world.cracks.as_mut() {
+        c.geometry.x = deformed;
+    }
+    classified
 }
 
 /// Each entry's mass-weighted displacement from the particles' `disp` (as the explicit

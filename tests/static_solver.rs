@@ -895,6 +895,31 @@ fn enf_solved_static() {
     assert!((k_ii - fe).abs() <= 1e-2 * fe.abs(), "{k_ii} vs {fe}");
 }
 
+/// The ENF's faces under Coulomb friction (mu = 0.3) over 30 load steps: the loads' work
+/// equals the strain energy plus the friction's within 1e-4 (it reads 3e-6; the steps'
+/// trapezoids). Each load step classifies the particles, at their initial places, against
+/// the crack in the undeformed body: the arms sag by a third of a cell, and while the
+/// crack moved with them each step split other particle-node pairs, and the friction work
+/// booked on the new fields was 12 times the energy the faces took (the balance 7e-3 off).
+#[test]
+fn friction_over_load_steps_balances_the_energy() {
+    let src = switched_with(
+        "enf_2d",
+        &[
+            "crack[0].contact={law=\"friction\",friction=0.3}",
+            "simulation.load_steps=30",
+            "output.history_interval=2e-4",
+        ],
+    );
+    let out = fissure::app::run::run(&src, &Default::default()).unwrap();
+    let e = out.history.rows.last().unwrap().energies;
+    assert!(e.friction_work > 0.0);
+    assert!(
+        (e.external_work - e.strain - e.friction_work).abs() <= 1e-4 * e.external_work,
+        "{e:?}"
+    );
+}
+
 /// The DCB turned 30 degrees to the grid, solved static: the particles at its loaded arm
 /// ends sit on sliver nodes that only the ghost stiffness holds, and the run stops saying
 /// so (the explicit solver runs this scene).

@@ -172,6 +172,7 @@ fn write_with<D: Dim>(
         c.add("cracks.x", &cr.geometry.x);
         c.add("cracks.top", &cr.geometry.top);
         c.add("cracks.bottom", &cr.geometry.bottom);
+        c.add("cracks.x0", &cr.geometry.x0);
         c.add("cracks.tips", &tips);
         c.add("cracks.solved", &solved);
     }
@@ -333,6 +334,21 @@ fn read_cracks<D: Dim>(r: &mut Reader, cr: &mut Cracks<D>) -> Result<(), Snapsho
     cr.geometry.x = r.column("cracks.x", nv)?;
     cr.geometry.top = r.column("cracks.top", nv)?;
     cr.geometry.bottom = r.column("cracks.bottom", nv)?;
+    // A static scene's undeformed places; none in an explicit run, or in a snapshot from a
+    // build that did not keep them (the next load step takes the crack where it is).
+    cr.geometry.x0 = match r.offset_of("cracks.x0") {
+        Some(_) => {
+            let x0: Vec<D::Vec> = r.column_any("cracks.x0")?;
+            if !x0.is_empty() && x0.len() != nv {
+                return Err(r.invalid(format!(
+                    "cracks.x0 holds {} places for {nv} crack vertices",
+                    x0.len()
+                )));
+            }
+            x0
+        }
+        None => Vec::new(),
+    };
     // A snapshot from a build without crack growth has no tip states: none grew.
     let fronts = cr.topology.fronts().len();
     cr.tips = if r.offset_of("cracks.tips").is_some() {

@@ -42,12 +42,22 @@ pub struct Positions<D: Dim> {
     pub top: Vec<D::Vec>,
     /// Bottom-surface position (m); moves with the field below the crack.
     pub bottom: Vec<D::Vec>,
+    /// Static scenes: each vertex's crack-plane position in the undeformed body (m), where
+    /// the classification takes the crack, the particles being at their initial places
+    /// there; empty in explicit runs.
+    pub x0: Vec<D::Vec>,
 }
 
 impl<D: Dim> Positions<D> {
     /// A new vertex (the next index) where vertex `v` is, with its surfaces, and `v` moved
     /// to `to` with both surfaces closed on it: how a tip or front vertex advances.
+    /// Where the undeformed places are kept, `v` keeps its displacement: the new vertex
+    /// takes its undeformed place and `v` moves there by as much as to `to`.
     fn leave_behind(&mut self, v: usize, to: D::Vec) {
+        if !self.x0.is_empty() {
+            self.x0.push(self.x0[v]);
+            self.x0[v] = to - (self.x[v] - self.x0[v]);
+        }
         self.x.push(self.x[v]);
         self.top.push(self.top[v]);
         self.bottom.push(self.bottom[v]);
@@ -63,6 +73,7 @@ impl<D: Dim> Default for Positions<D> {
             x: Vec::new(),
             top: Vec::new(),
             bottom: Vec::new(),
+            x0: Vec::new(),
         }
     }
 }
