@@ -641,9 +641,15 @@ fn validate_on_ranks_reports_what_one_process_does() {
             "{}",
             String::from_utf8_lossy(&done.stderr)
         );
-        // Each row without its last field, the wall time.
+        // Each row without its last field, the wall time, and the padding before it (its
+        // width follows the time's digits).
         (String::from_utf8_lossy(&done.stdout).lines())
-            .map(|l| l.rsplit_once(' ').map_or(l, |(row, _)| row).to_string())
+            .map(|l| {
+                l.rsplit_once(' ')
+                    .map_or(l, |(row, _)| row)
+                    .trim_end()
+                    .to_string()
+            })
             .collect()
     };
     let (one, three) = (table(None), table(Some(3)));
