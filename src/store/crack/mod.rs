@@ -51,8 +51,8 @@ pub struct Positions<D: Dim> {
 impl<D: Dim> Positions<D> {
     /// A new vertex (the next index) where vertex `v` is, with its surfaces, and `v` moved
     /// to `to` with both surfaces closed on it: how a tip or front vertex advances.
-    /// Where the undeformed places are kept, `v` keeps its displacement: the new vertex
-    /// takes its undeformed place and `v` moves there by as much as to `to`.
+    /// Where undeformed places are kept (`x0`), the new vertex takes `v`'s, and `v`'s moves
+    /// as `v` does: each vertex keeps its displacement.
     fn leave_behind(&mut self, v: usize, to: D::Vec) {
         if !self.x0.is_empty() {
             self.x0.push(self.x0[v]);
