@@ -67,6 +67,12 @@ const IMBALANCE: f64 = 1e-3;
 /// or on all.
 const GHOST: f64 = 1e-11;
 
+/// The ghost stiffness, as [`GHOST`], of the entries next to a crack that one particle alone
+/// reaches ([`scatter::lone_entries`]): their zero-energy modes are not loaded, yet held at
+/// 1e-11 the solver's round-off moved them by 0.1 m on a frictionless penny cutting the grid
+/// obliquely (the body's displacements 5 um) and its ghost share passed [`GHOST_SHARE`].
+const LONE_GHOST: f64 = 1e-8;
+
 /// An entry is light, and takes the ghost stiffness, below this fraction of the heaviest
 /// entry's mass. The sliver nodes of the turned DCB lie below it; a box's edge and corner
 /// nodes (a half and a quarter) above. At 3 % the turned DCB's K moved in the fourth digit.
@@ -171,6 +177,7 @@ fn plastic_step<D: Dim>(
     let pairs = faces::pairs(world);
     let any_pairs = world.domain.any(!pairs.is_empty());
     let mut faces = vec![Face::Open; pairs.len()];
+    let mut opened = vec![0; pairs.len()];
     let rubbing = world.domain.any(pairs.iter().any(|p| p.friction.is_some()));
     // The entries' displacement at the step's start, which the faces' overlap adds to:
     // where faces rub, the one the particles carry (their slip counts from there).
@@ -202,7 +209,13 @@ fn plastic_step<D: Dim>(
         let u: Vec<D::Vec> = (start.iter().zip(&step.du)).map(|(&a, &d)| a + d).collect();
         let zero = vec![D::zero(); u.len()];
         let law = Law::Given(&step.returned.stress);
-        let changes = faces_round(world, &pairs, &mut faces, (&u, &start), (law, &zero));
+        let changes = faces_round(
+            world,
+            &pairs,
+            (&mut faces, &mut opened),
+            (&u, &start),
+            (law, &zero),
+        );
         if changes.none() {
             break (dofs, step);
         }
@@ -321,6 +334,7 @@ fn with_contact<D: Dim>(
         Vec::new()
     };
     let mut faces = vec![Face::Open; pairs.len()];
+    let mut opened = vec![0; pairs.len()];
     let (mut iterations, mut factorizations) = (0, 0);
     let mut rounds = 0;
     let mut last = guess;
@@ -371,7 +385,13 @@ fn with_contact<D: Dim>(
         if !any_pairs {
             break (u, solved);
         }
-        let changes = faces_round(world, &pairs, &mut faces, (&u, &start), (Law::Elastic, &u));
+        let changes = faces_round(
+            world,
+            &pairs,
+            (&mut faces, &mut opened),
+            (&u, &start),
+            (Law::Elastic, &u),
+        );
         if changes.none() {
             break (u, solved);
         }
@@ -503,7 +523,7 @@ fn equilibrium<D: Dim>(
 fn faces_round<D: Dim>(
     world: &World<D>,
     pairs: &[faces::Pair<D::Vec>],
-    faces: &mut [Face<D::Vec>],
+    (faces, opened): (&mut [Face<D::Vec>], &mut [u8]),
     (u, start): (&[D::Vec], &[D::Vec]),
     (law, at): (Law<D>, &[D::Vec]),
 ) -> faces::Changes {
@@ -525,7 +545,7 @@ fn faces_round<D: Dim>(
     // Split across ranks, a pair on a shared node changes alike on each: its owner counts it.
     let counted = |p: &faces::Pair<D::Vec>| sums.owns(p.own);
     let tols = (gap_tol, force_tol, most_turn);
-    let mine = faces::update::<D>(pairs, faces, (u, start), &r, tols, counted);
+    let mine = faces::update::<D>(pairs, (faces, opened), (u, start), &r, tols, counted);
     faces::Changes {
         closed: sums.count(mine.closed),
         opened: sums.count(mine.opened),
@@ -728,8 +748,8 @@ fn leans_on_ghost<D: Dim>(
 }
 
 /// [`GHOST`] times K's diagonal on the entries that particles next to a crack reach (their
-/// sides' entries and the nodes they share) and on the light ones (below [`LIGHT`] of the
-/// heaviest), zero elsewhere.
+/// sides' entries and the nodes they share; [`LONE_GHOST`] on those one particle alone
+/// reaches) and on the light ones (below [`LIGHT`] of the heaviest), zero elsewhere.
 fn ghost_stiffness<D: Dim>(world: &World<D>, diag: &[D::Vec]) -> Vec<D::Vec> {
     // Split across ranks, a shared node is marked where any rank's particles reach it.
     let mut near = vec![D::zero(); diag.len()];
@@ -738,10 +758,15 @@ fn ghost_stiffness<D: Dim>(world: &World<D>, diag: &[D::Vec]) -> Vec<D::Vec> {
     });
     let mass = &world.grid.mass;
     let full = Sums::of(world).max(mass.iter().copied().fold(0.0, f64::max));
+    let lone = match world.cracks {
+        Some(_) => scatter::lone_entries(world),
+        None => Vec::new(),
+    };
     (0..diag.len())
-        .map(|e| match near[e] != D::zero() || mass[e] < LIGHT * full {
-            true => diag[e] * GHOST,
-            false => D::zero(),
+        .map(|e| match (near[e] != D::zero(), mass[e] < LIGHT * full) {
+            (true, _) if lone[e] => diag[e] * LONE_GHOST,
+            (true, _) | (_, true) => diag[e] * GHOST,
+            (false, false) => D::zero(),
         })
         .collect()
 }

@@ -11,6 +11,7 @@
 //! Computational Contact Mechanics, ch. 5-6).
 
 use super::fields;
+use super::scatter::lone_entries;
 use crate::base::dim::Dim;
 use crate::store::crack::{COLORS, ElementBins, Law};
 use crate::store::world::World;
@@ -51,6 +52,9 @@ pub(super) enum Face<V> {
         /// ([`turn_cap`]) on a pair just come unstuck, whose slip is not known yet, so that
         /// it starts to slide along its stuck force.
         turn: f64,
+        /// How the force's size changed in the round that set it (N; 0 when the pair came
+        /// from another state).
+        rise: f64,
     },
 }
 
@@ -74,7 +78,9 @@ impl<V> Pair<V> {
 
 /// Every pair of fields across a crack with frictionless or Coulomb contact whose entries
 /// both carry mass, in row order (a row behind two cracks at once has no single normal and
-/// is left open, as in the explicit solver).
+/// is left open, as in the explicit solver). A pair with an entry that one particle alone
+/// reaches ([`lone_entries`]) is frictionless: a friction force there loads motions that
+/// nothing but the ghost stiffness holds, and they moved without bound.
 pub(super) fn pairs<D: Dim>(world: &World<D>) -> Vec<Pair<D::Vec>> {
     let (Some(cracks), Some(f)) = (world.cracks.as_ref(), fields(world)) else {
         return Vec::new();
@@ -90,6 +96,12 @@ pub(super) fn pairs<D: Dim>(world: &World<D>) -> Vec<Pair<D::Vec>> {
     let cell = std::array::from_fn(|k| if k < D::D { h[k] } else { 1.0 });
     let mut bins: Vec<Option<ElementBins>> = Vec::new();
     bins.resize_with(COLORS, || None);
+    let rubs = (topo.cracks().iter()).any(|c| friction(c.contact.law).is_some_and(|mu| mu > 0.0));
+    let lone = if rubs {
+        lone_entries(world)
+    } else {
+        Vec::new()
+    };
     let mut out = Vec::new();
     for (r, &mask) in f.mask.iter().enumerate() {
         if mask.count_ones() != 1 {
@@ -113,7 +125,7 @@ pub(super) fn pairs<D: Dim>(world: &World<D>) -> Vec<Pair<D::Vec>> {
             own,
             row_above,
             normal,
-            friction: (mu > 0.0).then_some(mu),
+            friction: (mu > 0.0 && !lone[row] && !lone[own]).then_some(mu),
         });
     }
     out
@@ -191,7 +203,9 @@ pub(super) fn springs<D: Dim>(
     let length = |v: D::Vec| D::dot(v, v).sqrt();
     (pairs.iter().zip(faces))
         .filter_map(|(p, face)| match *face {
-            Face::Sliding { force, turn } if turn > 0.0 && length(force) > 0.0 && acting(p.row) => {
+            Face::Sliding { force, turn, .. }
+                if turn > 0.0 && length(force) > 0.0 && acting(p.row) =>
+            {
                 let (above, below) = p.above_below();
                 Some(Spring {
                     above,
@@ -236,22 +250,30 @@ pub(super) fn turn_cap<D: Dim>(world: &World<D>) -> f64 {
     TURN_CAP * e * (0..D::D).map(|a| h[a]).fold(f64::INFINITY, f64::min)
 }
 
+/// How often a pair may open in one load step. A pair that overlaps while open and pulls
+/// while closed would open and close for ever (on a random oblique penny, one pair pulled
+/// by 0.3 N where the pressed ones carried 20 to 50 N); the third time it closes it stays
+/// closed, so that the faces never overlap, at the price of that small pull.
+const MOST_OPENINGS: u8 = 2;
+
 /// Updates each pair's `faces` state from the solution `u` (every entry's displacement;
 /// `start`, the entries' displacement at the step's start, empty for zero) and
 /// `ku_less_f`, K u - f_ext per entry without ties folded and without the friction forces,
 /// so that on a closed pair's field above it is the force the face exerts on it (the
 /// constraint's and the friction's): a pair whose fields overlap along the normal by more
 /// than `gap_tol` closes, sliding freely; a closed pair whose face pulls (against the
-/// normal beyond `force_tol`) opens; a closed pair with friction then takes mu times its
+/// normal beyond `force_tol`) opens, unless it has `opened` [`MOST_OPENINGS`] times in
+/// the step already; a closed pair with friction then takes mu times its
 /// normal force against its slip over the step (stuck when it did not slip); a stuck pair
 /// whose tangential force exceeds mu times the normal one slides, with the friction force
 /// capped there; a sliding pair whose slip does not oppose its friction force sticks, and
-/// otherwise takes mu times its normal force against its slip. Each sliding pair's `turn`
-/// is set from its slip, at most `most_turn`. Counts the changes of the pairs `counted`
-/// takes.
+/// otherwise takes mu times its normal force against its slip (half way there when the
+/// force's size would turn back on its last change: the sizes swung between rounds, and
+/// the fixed point is the same). Each sliding pair's `turn` is set from its slip and the
+/// force's size, at most `most_turn`. Counts the changes of the pairs `counted` takes.
 pub(super) fn update<D: Dim>(
     pairs: &[Pair<D::Vec>],
-    faces: &mut [Face<D::Vec>],
+    (faces, opened): (&mut [Face<D::Vec>], &mut [u8]),
     (u, start): (&[D::Vec], &[D::Vec]),
     ku_less_f: &[D::Vec],
     (gap_tol, force_tol, most_turn): (f64, f64, f64),
@@ -260,7 +282,7 @@ pub(super) fn update<D: Dim>(
     let mut changes = Changes::default();
     let along = |v: D::Vec, n: D::Vec| v - n * D::dot(v, n);
     let length = |v: D::Vec| D::dot(v, v).sqrt();
-    for (p, face) in pairs.iter().zip(faces.iter_mut()) {
+    for ((p, face), opened) in pairs.iter().zip(faces.iter_mut()).zip(opened) {
         let (a, b) = p.above_below();
         let count = counted(p) as usize;
         let n = p.normal;
@@ -272,8 +294,9 @@ pub(super) fn update<D: Dim>(
             continue;
         }
         let push = D::dot(ku_less_f[a], n);
-        if push < -force_tol {
+        if push < -force_tol && *opened < MOST_OPENINGS {
             *face = Face::Open;
+            *opened += 1;
             changes.opened += count;
             continue;
         }
@@ -293,6 +316,7 @@ pub(super) fn update<D: Dim>(
                     Face::Sliding {
                         force: slip * (-cap / size),
                         turn,
+                        rise: 0.0,
                     }
                 };
                 changes.slid += count;
@@ -304,19 +328,32 @@ pub(super) fn update<D: Dim>(
                     *face = Face::Sliding {
                         force: t * (cap / size),
                         turn: most_turn,
+                        rise: 0.0,
                     };
                     changes.slid += count;
                 }
             }
-            Face::Sliding { force, .. } => {
+            Face::Sliding { force, rise, .. } => {
                 if size <= gap_tol || D::dot(slip, force) > 0.0 {
                     *face = Face::Stuck;
                     changes.slid += count;
                     continue;
                 }
-                let next = slip * (-cap / size);
+                let was = length(force);
+                // A size that turns back on its last change swings between rounds (the
+                // normal forces and the friction forces feed each other): half the step.
+                let by = match (cap - was) * rise < 0.0 {
+                    true => 0.5 * (cap - was),
+                    false => cap - was,
+                };
+                let next = slip * (-(was + by) / size);
                 if length(next - force) > FRICTION_TOL * length(next) + force_tol {
-                    *face = Face::Sliding { force: next, turn };
+                    let turn = ((was + by) / size).min(most_turn);
+                    *face = Face::Sliding {
+                        force: next,
+                        turn,
+                        rise: by,
+                    };
                     changes.slid += count;
                 }
             }

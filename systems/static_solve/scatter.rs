@@ -93,3 +93,15 @@ pub(super) fn near_crack_sums<D: Dim>(
         y[t.entry as usize] += t.value;
     }
 }
+
+/// Whether each grid entry is reached by at most one particle. Two or more such entries of
+/// one particle move in ways its strain does not see (more unknowns than the strain has
+/// components): near a crack, where the classification gives a particle fields of its own
+/// at nodes next to the front, they are zero-energy modes that only the ghost holds.
+pub(super) fn lone_entries<D: Dim>(world: &World<D>) -> Vec<bool> {
+    let count = entry_sums(
+        world,
+        |_, w, _| if w > 0.0 { D::unit_x() } else { D::zero() },
+    );
+    count.iter().map(|c| D::to_xyz(*c)[0] <= 1.0).collect()
+}
