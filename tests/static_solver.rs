@@ -843,7 +843,7 @@ fn conjugate_gradients_solve_faces_closed_across_the_axes() {
 /// Coulomb faces (mu = 0.2) on the sheared penny with its normal along (0.3, 0.9, 0.3),
 /// oblique to every axis: pressed at sigma_n = -54.5 MPa and sheared at tau = 68.9 MPa on
 /// its plane, it slides as the superposition says, mu sigma (tau - mu sigma) / tau^2 =
-/// 0.133 times the frictionless penny's extra strain energy; within 5 % (it reads -3.4 %,
+/// 0.133 times the frictionless penny's extra strain energy; within 5 % (it reads -3.8 %,
 /// against -0.84 % on the penny along the grid: the crack cutting the cells obliquely
 /// spreads the nodal normal forces less evenly than the uniform pressure of the
 /// superposition). Without the friction's tangent in K its slip directions cycled and the
