@@ -362,6 +362,11 @@ fn with_contact<D: Dim>(
         }
         let tied = |s: usize, m: usize| dofs.ties.binary_search(&(s, m)).is_ok();
         let kept_slip = faces::kept_slip::<D>(&pairs, &faces, &start, tied);
+        // Every rank alike, with or without stuck pairs of its own: K d is a collective.
+        let kept_slip = match world.domain.any(kept_slip.is_some()) {
+            true => Some(kept_slip.unwrap_or_else(|| vec![D::zero(); start.len()])),
+            false => None,
+        };
         if let Some(d) = &kept_slip {
             let mut kd = vec![D::zero(); d.len()];
             stiffness(
