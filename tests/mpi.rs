@@ -2,6 +2,9 @@
 //! `mpi` feature; each case starts `mpirun` as a child, since MPI starts once per process).
 //! Without the feature, a launch by mpirun is refused with a clear message.
 
+#[cfg(feature = "mpi")]
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -493,50 +496,15 @@ fn faces_stuck_on_some_ranks_only_solve_alike() {
     let dir = std::env::temp_dir().join(format!("fissure_mpi_{}_stuck", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("pressed_ellipse.toml");
-    std::fs::write(&scene, PRESSED_ELLIPSE).unwrap();
+    let ellipse = "{ center = [0.014497, 0.013514, 0.012051], axes = [[-0.0060298, \
+                   0.00058676, 0.002395], [-0.0012549, -0.0052853, -0.0018644]] }";
+    let text = common::pressed_cube([9136.75, -90000.0, 44246.16], ellipse, 0.2, 4);
+    // J and K on a tube of 2 cells, compared too.
+    std::fs::write(&scene, format!("{text}[fracture]\ndomain = 2\n")).unwrap();
     let cg = ["--set", "simulation.linear=\"cg\""];
     let files = ["energy.csv", "solver.csv", "fracture.csv"];
     alike_on_ranks(scene.to_str().unwrap(), &cg, &dir.join("out"), &files);
 }
-
-/// An oblique elliptical crack with Coulomb faces (mu = 0.2) in a 30 mm cube held at its
-/// base and pressed and sheared on its top, solved static in 4 load steps (J and K on a
-/// tube of 2 cells).
-#[cfg(feature = "mpi")]
-const PRESSED_ELLIPSE: &str = r#"
-[simulation]
-dimension = 3
-solver = "static"
-load_steps = 4
-duration = 1.0e-4
-[grid]
-min = [-0.004, -0.004, -0.004]
-max = [0.034, 0.034, 0.034]
-cell = [0.002, 0.002, 0.002]
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 8000.0
-[[body]]
-material = "steel"
-box = { min = [0.0, 0.0, 0.0], max = [0.03, 0.03, 0.03] }
-[[boundary]]
-region = { min = [-0.004, -0.004, -0.004], max = [0.034, 0.0, 0.034] }
-[[load]]
-region = { min = [0.0, 0.0295, 0.0], max = [0.03, 0.03, 0.03] }
-force = [9136.75, -90000.0, 44246.16]
-time = { kind = "ramp", rise = 1.0e-4 }
-[[crack]]
-name = "c"
-ellipse = { center = [0.014497, 0.013514, 0.012051], axes = [[-0.0060298, 0.00058676, 0.002395], [-0.0012549, -0.0052853, -0.0018644]] }
-contact = { law = "friction", friction = 0.2 }
-[fracture]
-domain = 2
-[output]
-interval = 2.5e-5
-history_interval = 2.5e-5
-"#;
 
 /// Static scenes (`solver = "static"`, conjugate gradients) split across ranks give one
 /// process's files byte for byte: a cantilever on its clamp (the reaction probe; and with

@@ -1513,47 +1513,6 @@ fn cell_mean_dilatation_unlocks_a_nearly_incompressible_sphere() {
     );
 }
 
-/// A 30 mm steel cube held at its base, its top loaded by `force` (N) ramped over 0.1 ms,
-/// with the elliptical crack `ellipse` (its TOML table) under Coulomb friction `mu`, 2 mm
-/// cells, solved static in `load_steps`: the random scenes of docs/static-solver.md.
-fn pressed_cube(force: [f64; 3], ellipse: &str, mu: f64, load_steps: usize) -> String {
-    let dt = 1.0e-4 / load_steps as f64;
-    format!(
-        r#"
-[simulation]
-dimension = 3
-solver = "static"
-load_steps = {load_steps}
-duration = 1.0e-4
-[grid]
-min = [-0.004, -0.004, -0.004]
-max = [0.034, 0.034, 0.034]
-cell = [0.002, 0.002, 0.002]
-[[material]]
-name = "steel"
-E = 200e9
-nu = 0.3
-rho = 8000.0
-[[body]]
-material = "steel"
-box = {{ min = [0.0, 0.0, 0.0], max = [0.03, 0.03, 0.03] }}
-[[boundary]]
-region = {{ min = [-0.004, -0.004, -0.004], max = [0.034, 0.0, 0.034] }}
-[[load]]
-region = {{ min = [0.0, 0.0295, 0.0], max = [0.03, 0.03, 0.03] }}
-force = {force:?}
-time = {{ kind = "ramp", rise = 1.0e-4 }}
-[[crack]]
-name = "c"
-ellipse = {ellipse}
-contact = {{ law = "friction", friction = {mu} }}
-[output]
-interval = {dt}
-history_interval = {dt}
-"#
-    )
-}
-
 /// Runs `text` and asserts that faces closed and rubbed, and that the loads' work equals
 /// the strain energy plus the friction's within `tolerance` of itself.
 fn rubs_and_balances(text: &str, tolerance: f64) {
@@ -1578,7 +1537,7 @@ fn rubs_and_balances(text: &str, tolerance: f64) {
 fn friction_leaves_fields_of_a_lone_particle_alone() {
     let ellipse = "{ center = [0.014497, 0.013514, 0.012051], axes = [[-0.0060298, \
                    0.00058676, 0.002395], [-0.0012549, -0.0052853, -0.0018644]] }";
-    let text = pressed_cube([9136.75, -90000.0, 44246.16], ellipse, 0.2, 4);
+    let text = common::pressed_cube([9136.75, -90000.0, 44246.16], ellipse, 0.2, 4);
     rubs_and_balances(&text, 1e-4);
 }
 
@@ -1593,6 +1552,6 @@ fn friction_leaves_fields_of_a_lone_particle_alone() {
 fn friction_forces_that_swing_between_rounds_settle() {
     let ellipse = "{ center = [0.017631, 0.015075, 0.012775], axes = [[0.0030610, \
                    -0.0050832, -0.0049230], [-0.0050739, -0.0025233, -0.00054946]] }";
-    let text = pressed_cube([14941.66, -90000.0, -4883.99], ellipse, 0.6, 1);
+    let text = common::pressed_cube([14941.66, -90000.0, -4883.99], ellipse, 0.6, 1);
     rubs_and_balances(&text, 1e-8);
 }

@@ -528,3 +528,45 @@ box = {{ min = [-0.03, -0.03], max = [0.03, 0.03] }}
         -g, -g
     )
 }
+
+/// A 30 mm steel cube held at its base, its top loaded by `force` (N) ramped over 0.1 ms,
+/// with the elliptical crack `ellipse` (its TOML table) under Coulomb friction `mu`, 2 mm
+/// cells, solved static in `load_steps`: the random scenes of docs/static-solver.md
+/// (tests/static_solver.rs; tests/mpi.rs on ranks).
+pub fn pressed_cube(force: [f64; 3], ellipse: &str, mu: f64, load_steps: usize) -> String {
+    let dt = 1.0e-4 / load_steps as f64;
+    format!(
+        r#"
+[simulation]
+dimension = 3
+solver = "static"
+load_steps = {load_steps}
+duration = 1.0e-4
+[grid]
+min = [-0.004, -0.004, -0.004]
+max = [0.034, 0.034, 0.034]
+cell = [0.002, 0.002, 0.002]
+[[material]]
+name = "steel"
+E = 200e9
+nu = 0.3
+rho = 8000.0
+[[body]]
+material = "steel"
+box = {{ min = [0.0, 0.0, 0.0], max = [0.03, 0.03, 0.03] }}
+[[boundary]]
+region = {{ min = [-0.004, -0.004, -0.004], max = [0.034, 0.0, 0.034] }}
+[[load]]
+region = {{ min = [0.0, 0.0295, 0.0], max = [0.03, 0.03, 0.03] }}
+force = {force:?}
+time = {{ kind = "ramp", rise = 1.0e-4 }}
+[[crack]]
+name = "c"
+ellipse = {ellipse}
+contact = {{ law = "friction", friction = {mu} }}
+[output]
+interval = {dt}
+history_interval = {dt}
+"#
+    )
+}
