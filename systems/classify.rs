@@ -14,7 +14,7 @@ use crate::base::error::Unstable;
 use crate::base::geometry::{Aabb, Element};
 use crate::physics::shape::{ShapeKind, Stencil, StencilCache};
 use crate::ranks::domain::Domain;
-use crate::store::crack::{self, Classified, Cracks, Fields, side_bit};
+use crate::store::crack::{self, Classified, Cracks, Fields, Split, side_bit};
 use crate::store::grid::GridGeom;
 use crate::store::tiles::Tiles;
 use crate::store::world::World;
@@ -39,6 +39,11 @@ struct Elements<'a, D: Dim> {
     neighbour: &'a [[u32; 3]],
     /// Box of all the elements (None without elements).
     all: Option<Aabb<D::Vec>>,
+    /// Per crack, whether it splits only pairs whose feet lie inside it ([`Split::Inside`]).
+    inside: Vec<bool>,
+    /// Per element, whether it belongs to such a crack and has a boundary feature (a front,
+    /// or an edge where the crack ends): the feet near it can move in or out.
+    inside_edge: Vec<bool>,
 }
 
 /// No element.
@@ -51,6 +56,7 @@ impl<'a, D: Dim> Elements<'a, D> {
         elem_crack: &'a [u16],
         color: &'a [u8],
         neighbour: &'a [[u32; 3]],
+        split: impl Iterator<Item = Split>,
     ) -> Self {
         let boxes: Vec<Aabb<D::Vec>> = elems.iter().map(|e| e.bounds(x)).collect();
         let all = (boxes.iter().copied()).reduce(|a, b| a.union(&b));
@@ -64,6 +70,11 @@ impl<'a, D: Dim> Elements<'a, D> {
             .iter()
             .map(|b| b.hi[axis] - b.lo[axis])
             .fold(0.0, f64::max);
+        let inside: Vec<bool> = split.map(|s| s == Split::Inside).collect();
+        let features = <D::Elem as Element>::FEATURES;
+        let inside_edge = (elem_crack.iter().zip(neighbour))
+            .map(|(&c, nb)| inside[c as usize] && nb[..features].contains(&NONE))
+            .collect();
         Elements {
             x,
             elems,
@@ -75,6 +86,8 @@ impl<'a, D: Dim> Elements<'a, D> {
             widest,
             neighbour,
             all,
+            inside,
+            inside_edge,
         }
     }
 
@@ -95,6 +108,33 @@ impl<'a, D: Dim> Elements<'a, D> {
         (self.run(b).iter()).any(|&e| b.overlaps(&self.boxes[e as usize]))
     }
 
+    /// Whether an element of a [`Split::Inside`] crack with a boundary feature meets `b`.
+    fn any_inside_edge(&self, b: &Aabb<D::Vec>) -> bool {
+        (self.run(b).iter())
+            .any(|&e| self.inside_edge[e as usize] && b.overlaps(&self.boxes[e as usize]))
+    }
+
+    /// Whether the foot of `y` on the plane of element `e0` lies inside `e0`'s crack: the
+    /// line from `y` to its mirror image in that plane crosses the crack an odd number of
+    /// times (a point on the plane is moved off it by a rounding's width first).
+    fn foot_inside(&self, y: D::Vec, e0: usize) -> bool {
+        let el = self.elems[e0];
+        let n = el.normal(self.x);
+        let a = self.x[el.vertices()[0] as usize];
+        let b = &self.boxes[e0];
+        let size = (0..D::D).map(|k| b.hi[k] - b.lo[k]).fold(0.0, f64::max);
+        let d = D::dot(n, y - a);
+        let y2 = y - n * (2.0 * d + (1e-9 * size).copysign(d));
+        let line = Aabb::span(y, y2);
+        let crack = self.elem_crack[e0];
+        let crossings = (self.run(&line).iter())
+            .map(|&e| e as usize)
+            .filter(|&e| self.elem_crack[e] == crack && line.overlaps(&self.boxes[e]))
+            .filter(|&e| self.elems[e].crossing(y, y2, self.x) != 0)
+            .count();
+        crossings % 2 == 1
+    }
+
     /// Replaces `out` with the elements whose boxes meet `b`, in increasing element order.
     fn meeting(&self, b: &Aabb<D::Vec>, out: &mut Vec<u32>) {
         out.clear();
@@ -104,10 +144,12 @@ impl<'a, D: Dim> Elements<'a, D> {
 
     /// Crack-side mask of the line from `xp` to `xn` against elements `near` (with the side
     /// of `xp` to each), taken in increasing element order so the result never depends on
-    /// how the elements were found.
+    /// how the elements were found. A [`Split::Inside`] crack also needs both feet inside
+    /// it, taken on the plane of the first element crossed.
     fn mask(&self, xp: D::Vec, xn: D::Vec, near: &[(u32, i8)]) -> u64 {
         let line = Aabb::span(xp, xn);
         let (mut odd, mut above) = (0u32, 0u32);
+        let mut first = [NONE; 32];
         for &(e, sp) in near {
             let e = e as usize;
             if !line.overlaps(&self.boxes[e]) {
@@ -115,7 +157,11 @@ impl<'a, D: Dim> Elements<'a, D> {
             }
             let s = self.elems[e].crossing_from(xp, sp, xn, self.x);
             if s != 0 {
-                let bit = 1u32 << self.color[self.elem_crack[e] as usize];
+                let c = self.color[self.elem_crack[e] as usize];
+                if first[c as usize] == NONE {
+                    first[c as usize] = e as u32;
+                }
+                let bit = 1u32 << c;
                 odd ^= bit;
                 if s > 0 {
                     above |= bit;
@@ -128,6 +174,12 @@ impl<'a, D: Dim> Elements<'a, D> {
         while odd != 0 {
             let c = odd.trailing_zeros() as usize;
             odd &= odd - 1;
+            let e0 = first[c] as usize;
+            if self.inside[self.elem_crack[e0] as usize]
+                && !(self.foot_inside(xp, e0) && self.foot_inside(xn, e0))
+            {
+                continue;
+            }
             mask |= side_bit(c, if above >> c & 1 == 1 { 1 } else { -1 });
         }
         mask
@@ -266,6 +318,13 @@ impl<D: Dim> Pass<'_, D> {
         s.near.clear();
         let x = elements.x;
         let mut clearance = if clear { self.skin } else { 0.0 };
+        // Feet of the box's points on a plane through it lie within its diagonal of it:
+        // near the edge of a `Split::Inside` crack they may move in or out with any motion,
+        // so such a particle is redone every step.
+        let diagonal = D::dot(node_box.hi - node_box.lo, node_box.hi - node_box.lo).sqrt();
+        if clearance > 0.0 && elements.any_inside_edge(&node_box.grown(diagonal + reach)) {
+            clearance = 0.0;
+        }
         for &e in &s.close {
             let el = elements.elems[e as usize];
             let sp = el.side(xp, x);
@@ -590,6 +649,7 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
             topology.elem_crack(),
             colors,
             &links.neighbour,
+            topology.cracks().iter().map(|c| c.split),
         ),
         skin: 0.25 * h_min,
         slack: 1e-6 * h_min,

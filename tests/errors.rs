@@ -432,6 +432,8 @@ fn bad_contact_settings_name_the_key() {
     let crack = "[[crack]]\npoints = [[0.006, 0.01], [0.012, 0.01]]\n";
     let e = error_with_text(&format!("{crack}contact = {{ law = \"glue\" }}\n"));
     assert_error(&e, "crack[0].contact.law", None, "unknown contact law");
+    let e = error_with_text(&format!("{crack}split = \"visible\"\n"));
+    assert_error(&e, "crack[0].split", None, "unknown split rule `visible`");
     let e = error_with_text(&format!("{crack}contact = {{ law = \"friction\" }}\n"));
     assert_error(&e, "crack[0].contact.friction", None, "coefficient");
     let e = error_with_text(&format!(

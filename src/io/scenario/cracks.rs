@@ -13,7 +13,7 @@ use crate::physics::growth::TipState;
 use crate::physics::material::{Material, Plane};
 use crate::ranks::domain::Domain;
 use crate::record::expect::{Along, Expect, Measure, Shape};
-use crate::store::crack::{COLORS, Contact, Cracks, Law, MAX_CRACKS, colors};
+use crate::store::crack::{COLORS, Contact, Cracks, Law, MAX_CRACKS, Split, colors};
 use crate::store::grid::GridGeom;
 use crate::store::particles::Particles;
 use glam::DVec3;
@@ -86,6 +86,7 @@ pub(super) fn build<D: Dim>(
             &piece.elems,
             &piece.fronts,
         );
+        store.topology.set_split(c, split(src, c, spec)?);
         store.geometry.x.extend(&piece.points);
     }
     let h_max = (0..D::D).map(|k| geom.h[k]).fold(0.0, f64::max);
@@ -294,6 +295,19 @@ fn polyline<D: Dim>(src: &Source, c: usize, spec: &CrackSpec, geom: &GridGeom<D>
             .map(|&end| (end, vec![if end == 0 { 0 } else { n - 1 }]))
             .collect(),
         points,
+    })
+}
+
+/// Crack `c`'s rule for splitting particle-node pairs (`split`, default "crossing").
+fn split(src: &Source, c: usize, spec: &CrackSpec) -> R<Split> {
+    let Some(name) = &spec.split else {
+        return Ok(Split::Crossing);
+    };
+    Split::named(name).ok_or_else(|| {
+        src.error(
+            &format!("crack[{c}].split"),
+            format!("unknown split rule `{name}` (crossing, inside)"),
+        )
     })
 }
 

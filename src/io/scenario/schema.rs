@@ -352,6 +352,8 @@ pub struct CrackSpec {
     pub tips: Option<Vec<String>>,
     /// Contact between the crack faces (default: none, an open crack).
     pub contact: Option<ContactSpec>,
+    /// Which particle-node pairs the crack splits: "crossing" (default) or "inside".
+    pub split: Option<String>,
     /// 2D: how the crack's tips grow (default: they do not).
     pub growth: Option<GrowthSpec>,
 }

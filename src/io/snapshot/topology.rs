@@ -88,6 +88,7 @@ pub fn read<D: Dim>(r: &mut Reader, built: &Topology<D>) -> Result<Topology<D>, 
             name: c.name.clone(),
             contact: c.contact,
             growth: c.growth,
+            split: c.split,
             vertices,
         });
     }

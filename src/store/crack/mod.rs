@@ -13,6 +13,7 @@ mod fields;
 mod law;
 mod node_lines;
 mod on_particles;
+mod split;
 mod tip_lines;
 mod topology;
 
@@ -22,6 +23,7 @@ pub use fields::{Classified, Displacements, Fields, Links, Scratch, side_bit};
 pub use law::{Contact, Law};
 pub use node_lines::{NodeLine, on_node_lines};
 pub use on_particles::particles_on;
+pub use split::Split;
 pub use tip_lines::tips_on_lines;
 pub use topology::{Crack, Front, Topology, TopologyError};
 

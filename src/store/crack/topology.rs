@@ -3,6 +3,7 @@
 //! something built from it (element neighbours, the classification record) to rebuild.
 
 use super::law::Contact;
+use super::split::Split;
 use crate::base::dim::Dim;
 use crate::base::geometry::Element;
 use crate::physics::growth::Growth;
@@ -17,6 +18,8 @@ pub struct Crack {
     pub contact: Contact,
     /// How its tips grow (None: they do not).
     pub growth: Option<Growth>,
+    /// Which particle-node pairs it splits between its sides' fields.
+    pub split: Split,
     /// Its vertices; in 2D the polyline in order from start to end.
     pub vertices: Vec<u32>,
 }
@@ -134,11 +137,20 @@ impl<D: Dim> Topology<D> {
             name,
             contact,
             growth,
+            split: Split::Crossing,
             vertices: (first..first + vertices as u32).collect(),
         });
         self.vertex_count += vertices;
         self.version += 1;
         first
+    }
+
+    /// Sets crack `c`'s rule for splitting particle-node pairs (added as `Crossing`).
+    pub fn set_split(&mut self, c: usize, split: Split) {
+        if self.cracks[c].split != split {
+            self.cracks[c].split = split;
+            self.version += 1;
+        }
     }
 
     /// Inserts vertex `new` (the next free index) into crack `c`'s 2D polyline just behind
