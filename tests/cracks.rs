@@ -5,6 +5,7 @@ mod common;
 use common::{final_world, source};
 use fissure::app::run::{RunOptions, run};
 use fissure::base::dim::D2;
+use fissure::fracture::plan::TipResult;
 use fissure::io::scenario::Source;
 use fissure::io::scenario::build;
 use fissure::pipeline::schedule::Schedule;
@@ -567,6 +568,27 @@ fn cracks_crowding_together_stop_the_run() {
     );
 }
 
+/// The last fracture rows (both tips) of `centre_crack_2d` solved static with its crack's
+/// half-length `a` (m) and the further settings `more`.
+fn centre_crack_static(a: f64, more: &[String]) -> Vec<TipResult> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/centre_crack_2d.toml"
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut sets = vec![
+        "simulation.solver=\"static\"".to_string(),
+        "output.history_interval=3e-4".to_string(),
+        format!("crack[0].line.start=[{:.7},0.06]", 0.02 - a),
+        format!("crack[0].line.end=[{:.7},0.06]", 0.02 + a),
+    ];
+    sets.extend_from_slice(more);
+    let src = Source::parse("centre_crack_2d.toml", &text, &sets).unwrap();
+    let h = run(&src, &RunOptions::default()).unwrap().history;
+    let last = h.fracture.last().unwrap().step;
+    h.fracture.into_iter().filter(|t| t.step == last).collect()
+}
+
 /// Where a tip lies within the particle spacing changes which particle-node lines cross
 /// the crack near it, and with them how long the discrete crack acts: on `centre_crack_2d`
 /// (static, 1 mm cells, two particles a cell) with both tips moved through one spacing in
@@ -578,26 +600,12 @@ fn cracks_crowding_together_stop_the_run() {
 /// half-length (Tada's form, scenarios/reference/README.md), and K_II within 0.1 % of it.
 #[test]
 fn default_k_holds_wherever_the_tip_lies_in_the_particle_spacing() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenarios/centre_crack_2d.toml"
-    );
-    let text = std::fs::read_to_string(path).unwrap();
     let e_mod = 200e9;
     let mut j_spread = (f64::INFINITY, f64::NEG_INFINITY);
     for eighths in [0, 2, 3, 5] {
         let a = 0.01 + 6.25e-5 * f64::from(eighths);
-        let sets = [
-            "simulation.solver=\"static\"".to_string(),
-            "output.history_interval=3e-4".to_string(),
-            format!("crack[0].line.start=[{:.7},0.06]", 0.02 - a),
-            format!("crack[0].line.end=[{:.7},0.06]", 0.02 + a),
-        ];
-        let src = Source::parse("centre_crack_2d.toml", &text, &sets).unwrap();
-        let h = run(&src, &RunOptions::default()).unwrap().history;
         let k_ref = common::feddersen(100e6, a, 0.02);
-        let last = h.fracture.last().unwrap().step;
-        for tip in h.fracture.iter().filter(|t| t.step == last) {
+        for tip in centre_crack_static(a, &[]) {
             let err = tip.k[0] / k_ref - 1.0;
             assert!(err.abs() < 0.02, "a {a}: K_I {} ({err:+.4})", tip.k[0]);
             assert!(tip.k[1].abs() < 1e-3 * k_ref, "a {a}: K_II {}", tip.k[1]);
@@ -619,27 +627,12 @@ fn default_k_holds_wherever_the_tip_lies_in_the_particle_spacing() {
 /// pair still jumps as a tip passes a particle).
 #[test]
 fn inside_split_keeps_the_discrete_crack_as_long_as_drawn() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenarios/centre_crack_2d.toml"
-    );
-    let text = std::fs::read_to_string(path).unwrap();
     let mean_j_error = |split: &str| {
         let mut sum = 0.0;
         for eighths in 0..8 {
             let a = 0.01 + 6.25e-5 * f64::from(eighths);
-            let sets = [
-                "simulation.solver=\"static\"".to_string(),
-                "output.history_interval=3e-4".to_string(),
-                format!("crack[0].line.start=[{:.7},0.06]", 0.02 - a),
-                format!("crack[0].line.end=[{:.7},0.06]", 0.02 + a),
-                format!("crack[0].split=\"{split}\""),
-            ];
-            let src = Source::parse("centre_crack_2d.toml", &text, &sets).unwrap();
-            let h = run(&src, &RunOptions::default()).unwrap().history;
             let k_ref = common::feddersen(100e6, a, 0.02);
-            let last = h.fracture.last().unwrap().step;
-            for tip in h.fracture.iter().filter(|t| t.step == last) {
+            for tip in centre_crack_static(a, &[format!("crack[0].split=\"{split}\"")]) {
                 sum += tip.j[0].hypot(tip.j[1]) / (k_ref * k_ref / 200e9) - 1.0;
             }
         }
