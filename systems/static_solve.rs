@@ -24,11 +24,13 @@ use crate::with_shape;
 use std::mem::discriminant;
 use std::sync::Arc;
 
+mod blocks;
 mod cg;
 mod cholesky;
 mod coarse;
 mod dilatation;
 mod direct;
+mod element;
 mod faces;
 mod frame;
 mod hold;

@@ -34,6 +34,7 @@ pub(super) fn conjugate_gradients<D: Dim>(
         ghost,
         modes,
         coarse,
+        blocks,
     } = frame;
     let diag = &with_springs(diag, dofs)[..];
     let n = f.len();
@@ -54,6 +55,9 @@ pub(super) fn conjugate_gradients<D: Dim>(
                 z
             })
             .collect();
+        if let Some(b) = blocks {
+            b.solve(r, &mut z);
+        }
         if let Some(c) = coarse {
             c.correct::<D>(sums, r, &mut z);
         }

@@ -6,7 +6,8 @@
 //! the pattern holds.
 
 use super::cholesky::{analyse, factorize};
-use super::dilatation::{Groups, isotropic, trace};
+use super::dilatation::Groups;
+use super::element::particle_stiffness;
 use super::faces::spring_force;
 use super::frame::Frame;
 use super::operator::{Law, apply};
@@ -15,7 +16,6 @@ use super::vectors::Sums;
 use super::{each_entry, fields, rigid};
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
-use crate::base::sym::SymTensor;
 use crate::record::solve_log::Solved;
 use crate::store::disjoint::Disjoint;
 use crate::store::world::World;
@@ -339,10 +339,8 @@ impl<D: Dim> Direct<D> {
     }
 
     /// Adds particle `i`'s stiffness under `law` on the entries of `support` (entry, grad
-    /// S): for each entry k and axis b, the stress of the unit strain of e_b (x) grad S_k,
-    /// and its force V sigma . grad S_l on each entry l, carried to the unknowns each
-    /// entry's displacement is made of. With the group's `mean` gradients the strain's
-    /// in-plane trace is the group's and the force carries the mean pressure (B-bar).
+    /// S), carried to the unknowns each entry's displacement is made of
+    /// ([`particle_stiffness`]; B-bar with the group's `mean` gradients).
     ///
     /// # Safety
     /// No other thread may write the columns of the support's entries' unknowns.
@@ -355,39 +353,18 @@ impl<D: Dim> Direct<D> {
         mean: Option<&[D::Vec]>,
         values: &Disjoint<f64>,
     ) {
-        let p = &world.particles;
-        let m = &world.materials[p.material[i] as usize];
-        let (plane, volume) = (world.settings.plane, p.volume[i]);
-        let per_axis = 1.0 / D::D as f64;
-        // stress[k * D + b]: the stress of the unit gradient e_b (x) grad S_k.
-        let mut stress = vec![D::Sym::default(); D::D * support.len()];
-        for (k, &(_, g)) in support.iter().enumerate() {
-            for b in 0..D::D {
-                let mut e = D::zero();
-                e[b] = 1.0;
-                let mut l = D::outer(e, g);
-                if let Some(mean) = mean {
-                    l = l + isotropic::<D>((mean[k][b] - g[b]) * per_axis);
-                }
-                stress[k * D::D + b] = law.stress(m, plane, i, &l);
-            }
-        }
-        let mut block = [D::zero(); 3];
-        for (lk, &(l, gl)) in support.iter().enumerate() {
-            for (k, &(kn, _)) in support.iter().enumerate() {
-                // block[b][a]: the force on entry l, axis a, per unit motion of k along b.
-                for (b, f) in block.iter_mut().enumerate().take(D::D) {
-                    let s = &stress[k * D::D + b];
-                    *f = D::stress_dot(s, gl);
-                    if let Some(mean) = mean {
-                        *f += (mean[lk] - gl) * (trace::<D>(&s.to_sym3()) * per_axis);
-                    }
-                    *f *= volume;
-                }
+        particle_stiffness(
+            world,
+            law,
+            i,
+            support,
+            mean,
+            |_, _| true,
+            |l, k, block| {
                 // SAFETY: passed on from the caller.
-                unsafe { self.add_block(values, l, kn, &block) };
-            }
-        }
+                unsafe { self.add_block(values, l, k, block) }
+            },
+        );
     }
 
     /// Adds the block of K between grid entries `l` and `k` (`block[b]`: the force on `l`

@@ -1,7 +1,8 @@
 //! What every linear solve on one set of unknowns shares: K's diagonal (the Jacobi
-//! preconditioner, from the elastic K), the coarse grid where there is one, the ghost
-//! stiffness and the free rigid motions.
+//! preconditioner, from the elastic K), the blocks of weakly supported entries and the
+//! coarse grid where there are any, the ghost stiffness and the free rigid motions.
 
+use super::blocks::Blocks;
 use super::coarse::Coarse;
 use super::ghost_stiffness;
 use super::operator::diagonal;
@@ -22,6 +23,8 @@ pub(super) struct Frame<D: Dim> {
     pub modes: Vec<Vec<D::Vec>>,
     /// The coarse grid under the Jacobi preconditioner, where the solver has one.
     pub coarse: Option<Arc<Coarse>>,
+    /// Block Jacobi on the weakly supported entries, where an iterative solve has any.
+    pub blocks: Option<Blocks<D>>,
 }
 
 impl<D: Dim> Frame<D> {
@@ -39,6 +42,7 @@ impl<D: Dim> Frame<D> {
             ghost,
             modes,
             coarse,
+            blocks: None,
         }
     }
 }

@@ -4,6 +4,7 @@
 //! solver's pattern and symbolic analysis, or the coarse grid's factor, made once here).
 
 use super::Kept;
+use super::blocks::Blocks;
 use super::cg::conjugate_gradients;
 use super::coarse::Coarse;
 use super::direct::Direct;
@@ -79,7 +80,7 @@ impl<D: Dim> Solver<D> {
                 Some(c)
             }
         };
-        let frame = Frame::new(world, dofs, coarse);
+        let mut frame = Frame::new(world, dofs, coarse);
         let (direct, too_large) = match world.settings.linear {
             LinearSolver::Cg | LinearSolver::TwoLevel => (None, false),
             LinearSolver::Auto if auto_two_level || split => (None, false),
@@ -95,6 +96,9 @@ impl<D: Dim> Solver<D> {
                 (Some(direct), false)
             }
         };
+        if direct.is_none() {
+            frame.blocks = Blocks::new(world, dofs, &frame.ghost);
+        }
         Ok(Solver {
             frame,
             direct,
