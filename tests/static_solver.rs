@@ -456,7 +456,7 @@ fn the_coarse_grid_changes_the_iterations_not_the_answer() {
 /// energy is the sparse factorization's within 1e-6 (both solves stop at 1e-8 of the load
 /// or below; they agree to 1e-10). Those nodes' shape functions are nearly combinations of
 /// their inward neighbours': Jacobi and the coarse grid took 435 iterations, the blocks of
-/// weakly supported entries take 48 (asserted under 100, uGIMP's 41 on the same cube being
+/// weakly supported entries take 43 (asserted under 100, uGIMP's 41 on the same cube being
 /// the mark), with the same bits on one thread and on two.
 #[test]
 fn a_b_spline_cube_solves_on_the_coarse_grid() {

@@ -8,8 +8,8 @@
 //! Verhoosel, van Zwieten & van Brummelen 2017 analyse for immersed B-splines): K scaled by
 //! its diagonal has eigenvalues a hundred times below the body's at the corners and edges,
 //! which neither Jacobi nor the coarse grid reaches, and conjugate gradients took ten times
-//! the iterations of uGIMP's stencils. Each block is a weak node with the two nodes inward of
-//! it along every axis across which the support changes (one either side along the others),
+//! the iterations of uGIMP's stencils. Each block is a weak node with the three nodes inward
+//! of it along every axis across which the support changes (one either side along the others),
 //! their K block factorized densely: an additive Schwarz preconditioner on non-overlapping
 //! blocks in place of Jacobi on their entries (Smith, Bjørstad & Gropp 1996, ch. 1).
 
@@ -29,6 +29,12 @@ use rayon::prelude::*;
 /// volume of particles: B-spline nodes a cell outside a face hold about 0.016, at the edges
 /// and corners far less, while the nodes on a face hold 0.25 or more.
 const WEAK: f64 = 0.1;
+
+/// How many nodes inward of a weak node its block takes along an axis across the surface:
+/// a cell past a face aligned with the grid needs two (the cube of `tests/static_solver.rs`:
+/// 435 iterations to 53; three, 49), a surface that cuts the cells obliquely three (a
+/// sphere: 531 to 148 with two, 77 with three; four, 77).
+const DEPTH: i64 = 3;
 
 /// Neighbours whose supports differ by less than this share of the larger lie along the
 /// surface, not across it.
@@ -155,7 +161,7 @@ fn blockable<D: Dim>(dofs: &Unknowns<D>) -> BitVec {
 }
 
 /// The blocks' entries: each weakly supported node, the lightest first, with the nodes
-/// two steps inward along each axis across which the support rises and one step either
+/// up to [`DEPTH`] steps inward along each axis across which the support rises and one step either
 /// way along the others, that no earlier block took, with every blockable entry of each.
 fn aggregate<D: Dim>(world: &World<D>, blockable: &BitVec) -> Vec<Vec<u32>> {
     let geom = &world.grid.geom;
@@ -195,12 +201,11 @@ fn aggregate<D: Dim>(world: &World<D>, blockable: &BitVec) -> Vec<Vec<u32>> {
         let mut box_nodes = vec![n];
         for a in 0..D::D {
             let (up, down) = (support_at(n, a, 1), support_at(n, a, -1));
-            let steps: &[i64] = if (up - down).abs() <= LEVEL * up.max(down) {
-                &[-1, 1]
-            } else if up > down {
-                &[1, 2]
+            let steps: Vec<i64> = if (up - down).abs() <= LEVEL * up.max(down) {
+                vec![-1, 1]
             } else {
-                &[-1, -2]
+                let inward = if up > down { 1 } else { -1 };
+                (1..=DEPTH).map(|s| s * inward).collect()
             };
             let grown: Vec<usize> = (box_nodes.iter())
                 .flat_map(|&m| steps.iter().filter_map(move |&s| neighbour(m, a, s)))
