@@ -16,6 +16,9 @@ pub struct Source {
     pub file: String,
     /// Effective text (after overrides).
     pub text: String,
+    /// The file's own text, where error lines are looked up: an override that adds a key
+    /// adds a line to `text`, which would move every later line.
+    own: String,
     /// Parsed scenario.
     pub scenario: Scenario,
     /// Keys set by `--set` (as `a.b[2].c`) with the argument that set each.
@@ -54,6 +57,7 @@ impl Source {
 
     /// Parses scenario `text` named `file`, after applying `overrides`.
     pub fn parse(file: &str, text: &str, overrides: &[String]) -> Result<Self, ScenarioError> {
+        let own = text.to_string();
         let text = apply_overrides(file, text, overrides)?;
         let set: Vec<(String, String)> = overrides
             .iter()
@@ -84,17 +88,17 @@ impl Source {
             let path = e.path().to_string();
             let inner = e.into_inner();
             let key = (path != ".").then_some(path);
-            err(
-                line_of(&text, inner.span()),
-                key,
-                inner.message().trim().to_string(),
-            )
+            let line = (key.as_deref())
+                .and_then(|k| find_line(&own, k))
+                .or_else(|| line_of(&text, inner.span()));
+            err(line, key, inner.message().trim().to_string())
         })?;
         Ok(Source {
             file: file.to_string(),
             text,
             scenario,
             set,
+            own,
         })
     }
 
@@ -103,7 +107,7 @@ impl Source {
     pub fn missing(&self, key: &str, message: impl Into<String>) -> ScenarioError {
         ScenarioError {
             file: self.file.clone(),
-            line: Some(self.text.lines().count().max(1)),
+            line: Some(self.own.lines().count().max(1)),
             key: Some(key.to_string()),
             message: message.into(),
         }
@@ -122,7 +126,7 @@ impl Source {
             },
             None => ScenarioError {
                 file: self.file.clone(),
-                line: find_line(&self.text, key),
+                line: find_line(&self.own, key),
                 key: Some(key.to_string()),
                 message,
             },
