@@ -42,13 +42,18 @@ const LEVEL: f64 = 0.05;
 
 /// The blocks of one set of unknowns.
 pub(super) struct Blocks<D: Dim> {
-    /// Per block: its entries, in increasing order.
-    entries: Vec<Vec<u32>>,
-    /// Per block: the Cholesky factor of K on its entries' components (held ones as
-    /// identity), component a of its j-th entry at j * D + a.
-    factors: Vec<Llt<f64>>,
-    /// Each block's entries' free components.
-    free: Vec<Vec<D::Vec>>,
+    blocks: Vec<Block<D>>,
+}
+
+/// One block: its entries and the factor of K on their components.
+struct Block<D: Dim> {
+    /// Its entries, in increasing order.
+    entries: Vec<u32>,
+    /// Each entry's free components.
+    free: Vec<D::Vec>,
+    /// The Cholesky factor of K on the entries' components (held ones as identity),
+    /// component a of the j-th entry at j * D + a.
+    factor: Llt<f64>,
 }
 
 impl<D: Dim> Blocks<D> {
@@ -98,48 +103,49 @@ impl<D: Dim> Blocks<D> {
                 }
             });
         }
-        let free: Vec<Vec<D::Vec>> = (groups.iter())
-            .map(|g| g.iter().map(|&e| dofs.free[e as usize]).collect())
-            .collect();
-        let factors: Option<Vec<Llt<f64>>> = (groups.par_iter().zip(&dense).zip(&free))
-            .map(|((g, a), free)| {
-                let m = g.len() * d;
+        // A block whose K does not factorize (a held component's row aside, it is a sum of
+        // the particles' stiffness and the ghost's: it should) keeps Jacobi.
+        let blocks: Vec<Block<D>> = (groups.into_par_iter().zip(dense))
+            .filter_map(|(entries, a)| {
+                let free: Vec<D::Vec> = entries.iter().map(|&e| dofs.free[e as usize]).collect();
+                let m = entries.len() * d;
                 let k = Mat::from_fn(m, m, |r, c| {
                     let (er, ar, ec, ac) = (r / d, r % d, c / d, c % d);
                     let (held_r, held_c) = (free[er][ar] == 0.0, free[ec][ac] == 0.0);
                     match (r == c, held_r || held_c) {
                         (true, true) => 1.0,
                         (false, true) => 0.0,
-                        (true, false) => a[r * m + c] + ghost[g[er] as usize][ar],
+                        (true, false) => a[r * m + c] + ghost[entries[er] as usize][ar],
                         (false, false) => a[r * m + c],
                     }
                 });
-                k.llt(Side::Lower).ok()
+                let factor = k.llt(Side::Lower).ok()?;
+                Some(Block {
+                    entries,
+                    free,
+                    factor,
+                })
             })
             .collect();
-        Some(Blocks {
-            entries: groups,
-            factors: factors?,
-            free,
-        })
+        (!blocks.is_empty()).then_some(Blocks { blocks })
     }
 
     /// Overwrites `z` on the blocked entries with each block's solve of K z = r.
     pub fn solve(&self, r: &[D::Vec], z: &mut [D::Vec]) {
         let d = D::D;
-        let solved: Vec<Mat<f64>> = (self.entries.par_iter().zip(&self.factors).zip(&self.free))
-            .map(|((g, llt), free)| {
-                let rhs = Mat::from_fn(g.len() * d, 1, |r_, _| {
-                    let (j, a) = (r_ / d, r_ % d);
-                    r[g[j] as usize][a] * free[j][a]
+        let solved: Vec<Mat<f64>> = (self.blocks.par_iter())
+            .map(|b| {
+                let rhs = Mat::from_fn(b.entries.len() * d, 1, |row, _| {
+                    let (j, a) = (row / d, row % d);
+                    r[b.entries[j] as usize][a] * b.free[j][a]
                 });
-                llt.solve(rhs)
+                b.factor.solve(rhs)
             })
             .collect();
-        for ((g, x), free) in self.entries.iter().zip(&solved).zip(&self.free) {
-            for (j, &e) in g.iter().enumerate() {
+        for (b, x) in self.blocks.iter().zip(&solved) {
+            for (j, &e) in b.entries.iter().enumerate() {
                 for a in 0..d {
-                    z[e as usize][a] = x[(j * d + a, 0)] * free[j][a];
+                    z[e as usize][a] = x[(j * d + a, 0)] * b.free[j][a];
                 }
             }
         }
