@@ -166,9 +166,10 @@ fn blockable<D: Dim>(dofs: &Unknowns<D>) -> BitVec {
     ok
 }
 
-/// The blocks' entries: each weakly supported node, the lightest first, with the nodes
-/// up to [`DEPTH`] steps inward along each axis across which the support rises and one step either
-/// way along the others, that no earlier block took, with every blockable entry of each.
+/// The blocks' entries: each weakly supported node, the lightest first, with the nodes up
+/// to [`DEPTH`] steps inward along each axis across which the support rises and one step
+/// either way along the others, that no earlier block took, with every blockable entry of
+/// each.
 fn aggregate<D: Dim>(world: &World<D>, blockable: &BitVec) -> Vec<Vec<u32>> {
     let geom = &world.grid.geom;
     let volume = &world.particles.volume;
