@@ -673,5 +673,29 @@ pub fn run<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
     }
     let extra = pass.fields(rec, world.particles.len(), &world.domain, fields);
     world.grid.set_extra_fields(extra);
-    Ok(())
+    clear_of_mirrors(world)
+}
+
+/// Refuses crack fields on a B-spline symmetry plane's image nodes or their sources: the
+/// images stand for one field of their source, and the crack's mirror half is not modelled.
+fn clear_of_mirrors<D: Dim>(world: &World<D>) -> Result<(), Unstable> {
+    let (Some(c), mirrors) = (world.cracks.as_ref(), &world.grid.mirrors) else {
+        return Ok(());
+    };
+    let split = |n: u32| !c.scratch.fields.rows_of(n).is_empty();
+    let Some(im) = (mirrors.images.iter()).find(|im| split(im.node) || split(im.source)) else {
+        return Ok(());
+    };
+    let x = D::to_xyz(world.grid.geom.node_position(im.source as usize));
+    let at: Vec<String> = (0..D::D).map(|a| format!("{:.6}", x[a])).collect();
+    Err(Unstable {
+        step: world.step,
+        time: world.time,
+        what: format!(
+            "a crack splits the grid node at ({}) m next to a symmetry plane \
+             on quadratic B-splines, whose nodes past the plane mirror the body's side: keep \
+             cracks three cells clear of such a plane, or give simulation.shape = \"ugimp\"",
+            at.join(", ")
+        ),
+    })
 }

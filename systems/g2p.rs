@@ -8,7 +8,7 @@ use crate::ranks::ABSENT;
 use crate::store::disjoint::Disjoint;
 use crate::store::particles::Particles;
 use crate::store::world::{CHUNK, World};
-use crate::systems::scatter_coded;
+use crate::systems::{mirror, scatter_coded};
 use crate::with_shape;
 use rayon::prelude::*;
 
@@ -109,6 +109,9 @@ pub fn run_with_remap<D: Dim>(world: &mut World<D>) {
             &world.domain,
             &mut world.grid,
         );
+    }
+    if !world.grid.mirrors.is_empty() {
+        mirror::fold_momentum(&mut world.grid);
     }
     finish(world, fastest);
 }

@@ -1,5 +1,6 @@
 //! `grid_update`: nodal velocities and accelerations from momenta and forces, damping
-//! (Guo & Nairn 2D (2004) Eq. 5), gravity and prescribed velocities.
+//! (Guo & Nairn 2D (2004) Eq. 5), gravity and prescribed velocities; image nodes take their
+//! sources' values ([`mirror`]).
 
 use crate::base::dim::Dim;
 use crate::base::exact_sum::ExactSum;
@@ -7,6 +8,7 @@ use crate::ranks::domain::Domain;
 use crate::store::crack::Fields;
 use crate::store::grid::Grid;
 use crate::store::world::{CHUNK, World};
+use crate::systems::mirror;
 use rayon::prelude::*;
 
 /// Overwrites prescribed components of the extrapolated momenta so that p/m equals the
@@ -43,6 +45,7 @@ pub fn run<D: Dim>(world: &mut World<D>) {
         velocity,
         accel,
         geom,
+        ..
     } = &mut world.grid;
     let (mass, momentum, force) = (&*mass, &*momentum, &*force);
     let (damped, weighed) = (alpha != 0.0, D::dot(gravity, gravity) != 0.0);
@@ -128,6 +131,9 @@ pub fn run<D: Dim>(world: &mut World<D>) {
             }
             bc.reaction[k] = reaction;
         }
+    }
+    if !g.mirrors.is_empty() {
+        mirror::reflect_velocity(g, true);
     }
     let mut sums = [damp, grav];
     domain.sum(&mut sums);

@@ -29,6 +29,7 @@ pub mod g2p;
 pub mod grid_update;
 pub mod grow;
 pub mod grow_front;
+pub mod mirror;
 pub mod p2g;
 pub mod scatter_coded;
 pub mod static_solve;

@@ -6,7 +6,7 @@ use crate::physics::shape::{Rows, Stencil};
 use crate::ranks::ABSENT;
 use crate::store::disjoint::Disjoint;
 use crate::store::world::{CHUNK, World};
-use crate::systems::scatter_coded;
+use crate::systems::{mirror, scatter_coded};
 use crate::with_shape;
 use rayon::prelude::*;
 
@@ -35,6 +35,9 @@ pub fn run<D: Dim>(world: &mut World<D>, internal: bool) {
         scatter::<D, false>(world);
     }
     scatter_loads(world);
+    if !world.grid.mirrors.is_empty() {
+        mirror::fold_scatter(&mut world.grid, world.settings.gravity);
+    }
 }
 
 /// One scatter pass over the tiles, colour class by colour class (Guo & Nairn 2D (2004)

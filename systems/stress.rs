@@ -10,6 +10,7 @@ use crate::physics::shape::{Rows, Stencil};
 use crate::store::disjoint::Disjoint;
 use crate::store::particles::Particles;
 use crate::store::world::{CHUNK, World};
+use crate::systems::mirror;
 use crate::with_shape;
 use rayon::prelude::*;
 
@@ -202,7 +203,8 @@ pub(crate) fn velocity_gradient<D: Dim, const N: usize>(
     l
 }
 
-/// Sets the grid velocity column to p/m (zero on nodes lighter than the mass tolerance).
+/// Sets the grid velocity column to p/m (zero on nodes lighter than the mass tolerance;
+/// image nodes their sources', reflected).
 pub(crate) fn node_velocities<D: Dim>(world: &mut World<D>) {
     let tol = world.settings.mass_tol;
     let g = &mut world.grid;
@@ -222,5 +224,8 @@ pub(crate) fn node_velocities<D: Dim>(world: &mut World<D>) {
                     };
                 }
             });
+    }
+    if !g.mirrors.is_empty() {
+        mirror::reflect_velocity(g, false);
     }
 }

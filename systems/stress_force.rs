@@ -8,8 +8,8 @@ use crate::store::grid::Grid;
 use crate::store::particles::Particles;
 use crate::store::world::World;
 use crate::systems::p2g::add_internal_force;
-use crate::systems::scatter_coded;
 use crate::systems::stress::{StressColumns, node_velocities, update_coded, velocity_gradient};
+use crate::systems::{mirror, scatter_coded};
 
 /// Updates every particle's stress over `fraction` of the step from grad v gathered off
 /// p/m (as [`stress::run`](crate::systems::stress::run)), then adds its internal force
@@ -71,5 +71,8 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
             &world.domain,
             &mut world.grid,
         );
+    }
+    if !world.grid.mirrors.is_empty() {
+        mirror::fold_force(&mut world.grid);
     }
 }

@@ -1360,22 +1360,48 @@ fn files_that_are_not_scenarios_are_refused_before_reading() {
     std::fs::remove_dir_all(dir).ok();
 }
 
-/// A symmetry plane on quadratic B-splines is refused at its key: their stencils reach the
-/// nodes a cell past the plane, which it leaves free (Hill's cylinder read its plastic
-/// radius about 30 % high that way); on uGIMP the same plane builds. The error names the
-/// plane's line in the file although `--set` added a line above it.
+/// On quadratic B-splines a plane boundary is a symmetry plane whose nodes past it mirror
+/// the body's side: one that holds a tangential component, moves, or has the body on both
+/// sides is refused at its key, with the line in the file although `--set` added a line
+/// above it; a plane at the body's edge builds, with image nodes, and on uGIMP the
+/// refused planes build as before.
 #[test]
-fn a_symmetry_plane_on_b_splines_is_refused() {
-    let plane = "[[boundary]]\nplane = { axis = \"x\", at = 0.004 }\n";
-    let text = format!("{GOOD}{plane}");
-    let parse = |shape: &str| {
+fn a_b_spline_plane_that_is_not_a_symmetry_plane_is_refused() {
+    let build_with = |shape: &str, plane: &str| {
+        let text = format!("{GOOD}[[boundary]]\n{plane}\n");
         let set = vec![format!("simulation.shape=\"{shape}\"")];
-        Source::parse("bad.toml", &text, &set).unwrap()
+        build::<D2>(&Source::parse("bad.toml", &text, &set).unwrap())
     };
-    assert!(build::<D2>(&parse("ugimp")).is_ok());
-    let e = match build::<D2>(&parse("bspline")) {
-        Ok(_) => panic!("a B-spline symmetry plane must be refused"),
-        Err(e) => e,
-    };
-    assert_error(&e, "boundary[0].plane", Some(19), "B-splines");
+    let edge = "plane = { axis = \"x\", at = 0.004 }";
+    let world = build_with("bspline", edge).unwrap().world;
+    // One column of nodes a cell past the plane and one two cells past, each 11 nodes high.
+    assert_eq!(world.grid.mirrors.images.len(), 22);
+    let cases = [
+        (
+            "plane = { axis = \"x\", at = 0.01 }",
+            "boundary[0].plane",
+            "both sides",
+        ),
+        (
+            "plane = { axis = \"x\", at = 0.004 }\nfix = [\"x\", \"y\"]",
+            "boundary[0].fix",
+            "normal component only",
+        ),
+        (
+            "plane = { axis = \"x\", at = 0.004 }\nvelocity = [0.1, 0.0]",
+            "boundary[0].velocity",
+            "at rest",
+        ),
+    ];
+    for (plane, key, words) in cases {
+        assert!(build_with("ugimp", plane).is_ok(), "{plane}");
+        match build_with("bspline", plane) {
+            Ok(_) => panic!("{plane}: must be refused on B-splines"),
+            Err(e) => assert_error(&e, key, None, words),
+        }
+    }
+    match build_with("bspline", "plane = { axis = \"x\", at = 0.01 }") {
+        Err(e) => assert_eq!(e.line, Some(19), "{e}"),
+        Ok(_) => unreachable!(),
+    }
 }

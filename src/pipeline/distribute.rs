@@ -86,6 +86,13 @@ fn bin_for_split<D: Dim>(world: &mut World<D>) -> Result<(), Unstable> {
 
 /// What a split run cannot do yet, refused by name.
 fn refuse_unsupported<D: Dim>(world: &World<D>) -> anyhow::Result<()> {
+    if !world.grid.mirrors.is_empty() {
+        anyhow::bail!(
+            "a symmetry plane on quadratic B-splines runs on one process only (its image \
+             nodes mirror nodes that another rank may hold); run on one process, or give \
+             simulation.shape = \"ugimp\""
+        );
+    }
     if world.settings.solver != Solver::Static {
         return Ok(());
     }

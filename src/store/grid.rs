@@ -2,6 +2,7 @@
 
 use crate::base::dim::Dim;
 use crate::physics::shape::ShapeKind;
+use crate::store::mirror::Mirrors;
 
 /// Geometry of a regular grid whose cells may be non-cubic.
 #[derive(Clone, Debug)]
@@ -108,6 +109,8 @@ pub struct Grid<D: Dim> {
     pub velocity: Vec<D::Vec>,
     /// Acceleration over the step (m/s^2), including velocity-boundary corrections.
     pub accel: Vec<D::Vec>,
+    /// The image nodes of the B-spline symmetry planes (none on other stencils).
+    pub mirrors: Mirrors<D>,
 }
 
 impl<D: Dim> Grid<D> {
@@ -121,6 +124,7 @@ impl<D: Dim> Grid<D> {
             force: vec![D::zero(); n],
             velocity: vec![D::zero(); n],
             accel: vec![D::zero(); n],
+            mirrors: Mirrors::default(),
         }
     }
 

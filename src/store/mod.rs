@@ -4,6 +4,7 @@
 pub mod crack;
 pub mod disjoint;
 pub mod grid;
+pub mod mirror;
 pub mod particles;
 pub mod tiles;
 pub mod world;

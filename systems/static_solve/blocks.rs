@@ -152,7 +152,8 @@ impl<D: Dim> Blocks<D> {
     }
 }
 
-/// The entries a block may hold: free on some component and tied to no other.
+/// The entries a block may hold: free on some component and tied to no other (nor a
+/// symmetry plane's image to its source).
 fn blockable<D: Dim>(dofs: &Unknowns<D>) -> BitVec {
     let mut ok: BitVec = dofs.free.iter().map(|&f| f != D::zero()).collect();
     for &(s, m) in &dofs.ties {
@@ -162,6 +163,10 @@ fn blockable<D: Dim>(dofs: &Unknowns<D>) -> BitVec {
     for &(s, m, _) in &dofs.normal_ties {
         ok.set(s, false);
         ok.set(m, false);
+    }
+    for im in &dofs.images {
+        ok.set(im.node as usize, false);
+        ok.set(im.source as usize, false);
     }
     ok
 }

@@ -18,6 +18,7 @@ use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::record::solve_log::Solved;
 use crate::store::disjoint::Disjoint;
+use crate::store::mirror::Mirrors;
 use crate::store::world::World;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::SymbolicSparseColMat;
@@ -451,6 +452,10 @@ impl<D: Dim> Layout<D> {
         }
         for &(s, m) in &dofs.ties {
             comb[s] = comb[m].clone();
+        }
+        for im in &dofs.images {
+            let reflect = |&(j, c): &(u32, D::Vec)| (j, Mirrors::<D>::reflect(im.sign, c));
+            comb[im.node as usize] = comb[im.source as usize].iter().map(reflect).collect();
         }
         Layout {
             own,

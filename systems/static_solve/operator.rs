@@ -76,7 +76,7 @@ pub(super) fn stiffness<D: Dim>(
     y: &mut [D::Vec],
 ) {
     let expanded;
-    let x = if dofs.ties.is_empty() && dofs.normal_ties.is_empty() {
+    let x = if dofs.ties.is_empty() && dofs.normal_ties.is_empty() && dofs.images.is_empty() {
         x
     } else {
         let mut e = x.to_vec();

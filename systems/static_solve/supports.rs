@@ -9,10 +9,11 @@ use crate::base::exact_sum::ExactSum;
 use crate::physics::loads::VelocityBc;
 use crate::store::crack::Fields;
 use crate::store::world::World;
-use crate::systems::p2g;
+use crate::systems::{mirror, p2g};
 
 /// Per grid entry, the displacement the moving supports prescribe at time `t` on their
-/// held components (zero elsewhere); None when no support moves.
+/// held components (zero elsewhere; an image node its source's, reflected); None when no
+/// support moves.
 pub(super) fn prescribed<D: Dim>(world: &World<D>, t: f64) -> Option<Vec<D::Vec>> {
     if !world.bcs.iter().any(moves) {
         return None;
@@ -28,6 +29,7 @@ pub(super) fn prescribed<D: Dim>(world: &World<D>, t: f64) -> Option<Vec<D::Vec>
             }
         }
     }
+    mirror::reflect_column(&world.grid.mirrors, &mut u);
     Some(u)
 }
 

@@ -2,12 +2,14 @@
 //! particle reaches the entry, no boundary holds it), the crack fields that hold a sliver
 //! of mass, tied to their node's heaviest entry, the closed crack faces that slide
 //! (frictionless or against friction), tied along the crack's normal, and the stuck ones,
-//! tied whole; with the sliding ones' friction tangents, which K carries.
+//! tied whole; with the sliding ones' friction tangents, which K carries, and the B-spline
+//! symmetry planes' image nodes, each its source reflected.
 
 use super::dilatation::Groups;
 use super::faces::{self, Face, Pair, Spring};
 use super::{entries, fields};
 use crate::base::dim::Dim;
+use crate::store::mirror::{Image, Mirrors};
 use crate::store::world::{Dilatation, World};
 
 /// Which entry components are unknowns, and which entries move with another.
@@ -24,6 +26,8 @@ pub(super) struct Unknowns<D: Dim> {
     pub groups: Option<Groups>,
     /// The sliding pairs' friction tangents (3D), part of K: [`faces::Spring`].
     pub springs: Vec<Spring<D::Vec>>,
+    /// The B-spline symmetry planes' image nodes, each its source's value reflected.
+    pub images: Vec<Image<D::Vec>>,
 }
 
 impl<D: Dim> Unknowns<D> {
@@ -71,6 +75,7 @@ impl<D: Dim> Unknowns<D> {
             normal_ties,
             groups,
             springs: Vec::new(),
+            images: world.grid.mirrors.images.clone(),
         };
         dofs.set_springs(pairs, faces);
         dofs
@@ -86,8 +91,12 @@ impl<D: Dim> Unknowns<D> {
 
     /// Gives each tied entry the value of the entry it moves with (along the normal for a
     /// frictionless pair): the faces' pairs first, so that a sliver whose heaviest entry is
-    /// a pair's tied one takes that entry's whole value.
+    /// a pair's tied one takes that entry's whole value; each image node its source's,
+    /// reflected.
     pub fn expand(&self, x: &mut [D::Vec]) {
+        for im in &self.images {
+            x[im.node as usize] = Mirrors::<D>::reflect(im.sign, x[im.source as usize]);
+        }
         for &(s, m, n) in &self.normal_ties {
             x[s] += n * D::dot(x[m] - x[s], n);
         }
@@ -109,14 +118,22 @@ impl<D: Dim> Unknowns<D> {
             y[m] += along;
             y[s] -= along;
         }
+        for im in self.images.iter().rev() {
+            let v = std::mem::replace(&mut y[im.node as usize], D::zero());
+            y[im.source as usize] += Mirrors::<D>::reflect(im.sign, v);
+        }
     }
 
     /// Folds a per-component diagonal of K into the diagonal on the unknowns: a tied
-    /// entry's whole into its partner's; for a closed pair tied along its unit normal n,
+    /// entry's whole into its partner's (an image's into its source's); for a closed pair tied along its unit normal n,
     /// the partner gains n_a^2 (n . D_s n) on axis a and the tied entry keeps the diagonal
     /// of (I - n n^T) D_s (I - n n^T), D_s its diagonal. Unlike [`Self::fold`] (a force),
     /// neither goes negative on a normal oblique to the axes.
     pub fn fold_diagonal(&self, d: &mut [D::Vec]) {
+        for im in &self.images {
+            let v = std::mem::replace(&mut d[im.node as usize], D::zero());
+            d[im.source as usize] += v;
+        }
         for &(s, m) in &self.ties {
             d[m] += d[s];
             d[s] = D::zero();
@@ -207,6 +224,7 @@ mod tests {
             normal_ties: vec![(1, 0, n)],
             groups: None,
             springs: Vec::new(),
+            images: Vec::new(),
         };
         let mut x = vec![DVec2::new(1.0, -2.0), DVec2::new(3.0, 5.0), DVec2::ZERO];
         dofs.project(&mut x);
@@ -239,6 +257,7 @@ mod tests {
             normal_ties: vec![(1, 0, n)],
             groups: None,
             springs: Vec::new(),
+            images: Vec::new(),
         };
         let k = [DVec2::new(3.0, 5.0), DVec2::new(2.0, 2.0)];
         let operator = |x: &[DVec2]| {

@@ -6,16 +6,7 @@ use super::region::region;
 use super::source::Source;
 use crate::base::dim::Dim;
 use crate::physics::loads::VelocityBc;
-use crate::physics::shape::ShapeKind;
 use crate::store::grid::GridGeom;
-
-/// Why a symmetry plane is refused on quadratic B-splines: their stencils reach the nodes a
-/// cell past the plane, which it leaves free, so the body's normal displacement on the
-/// plane is not held (measured on Hill's cylinder, docs/scenario-format.md).
-const BSPLINE_PLANE: &str = "a symmetry plane is not supported on quadratic B-splines yet: \
-     their stencils reach the nodes a cell past the plane, which it leaves free, so the body \
-     does not keep to the plane (Hill's cylinder read its plastic radius about 30 % high); \
-     use shape = \"ugimp\" or \"linear\", or model the whole body";
 
 /// Every `[[boundary]]`: its nodes (refused when it selects none), the components it
 /// holds (`fix`, else a plane's normal, else all) and their velocity and time function.
@@ -36,9 +27,6 @@ pub(super) fn boundaries<D: Dim>(src: &Source, geom: &GridGeom<D>) -> R<Vec<Velo
                 (nodes, None)
             }
             (None, Some(p)) => {
-                if sc.simulation.shape == ShapeKind::Bspline {
-                    return Err(src.error(&key("plane"), BSPLINE_PLANE));
-                }
                 let a = axis_index::<D>(src, &key("plane.axis"), &p.axis)?;
                 let nodes: Vec<u32> = (0..geom.node_count())
                     .filter(|&n| (geom.node_position(n)[a] - p.at).abs() <= 1e-6 * h[a])

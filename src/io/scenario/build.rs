@@ -64,10 +64,18 @@ pub fn build_share<D: Dim>(src: &Source, comm: Comm) -> R<Scene<D>> {
     let ppc = &filled.ppc;
     let (dt, dt_limit) =
         super::settings::time_step::<D>(src, &sim, &materials, &filled.used, &geom)?;
-    let bcs = super::boundaries::boundaries::<D>(src, &geom)?;
+    let mut bcs = super::boundaries::boundaries::<D>(src, &geom)?;
+    let mirrors = super::mirrors::mirrors::<D>(src, &geom, &particles.x, &domain, &mut bcs)?;
     let loads = super::loads::loads::<D>(src, &geom, &particles, ppc, &domain)?;
-    let probes =
-        super::probes::probes::<D>(src, &geom, &particles, ppc, &domain, &bcs, &materials)?;
+    let probes = super::probes::probes::<D>(
+        src,
+        &geom,
+        &particles,
+        ppc,
+        &domain,
+        (&bcs, &mirrors),
+        &materials,
+    )?;
     let expects =
         super::expects::expects::<D>(src, &probes, &geom, &materials, sim.plane, sim.thickness)?;
     let output = output_plan(src, sim.duration)?;
@@ -98,7 +106,10 @@ pub fn build_share<D: Dim>(src: &Source, comm: Comm) -> R<Scene<D>> {
         super::settings::solve_shape::<D>(s.solver, s.shape, &p.x0, &p.half, &geom, &domain);
     let world = World {
         tiles: filled.tiles,
-        grid: Grid::new(geom),
+        grid: Grid {
+            mirrors,
+            ..Grid::new(geom)
+        },
         particles,
         materials,
         settings: Settings {

@@ -17,6 +17,7 @@ mod loads;
 mod material;
 mod memory;
 mod mesh_body;
+mod mirrors;
 mod msh;
 mod output;
 mod probes;

@@ -1,0 +1,55 @@
+//! Image nodes of the symmetry planes on quadratic B-splines: the grid nodes past a plane
+//! that the body's stencils reach, each standing for a node on the body's side reflected
+//! across the plane (as the whole body's mirror half would move it).
+
+use crate::base::dim::Dim;
+
+/// One image node and the node on the body's side it reflects.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Image<V> {
+    /// The node past the plane (or planes, at a corner).
+    pub node: u32,
+    /// The node it reflects, on the body's side of every plane.
+    pub source: u32,
+    /// Per axis, -1 on the normal of each plane between them, +1 on the others: the
+    /// image's velocity is `sign` times the source's, component by component.
+    pub sign: V,
+}
+
+/// The scene's image nodes, in node order; none without a B-spline symmetry plane.
+#[derive(Clone, Debug)]
+pub struct Mirrors<D: Dim> {
+    /// The images, sorted by `node`; no source is an image.
+    pub images: Vec<Image<D::Vec>>,
+    /// The symmetry planes: their normal axis and coordinate (m).
+    pub planes: Vec<(usize, f64)>,
+}
+
+impl<D: Dim> Default for Mirrors<D> {
+    fn default() -> Self {
+        Mirrors {
+            images: Vec::new(),
+            planes: Vec::new(),
+        }
+    }
+}
+
+impl<D: Dim> Mirrors<D> {
+    /// Whether the scene has no image nodes.
+    pub fn is_empty(&self) -> bool {
+        self.images.is_empty()
+    }
+
+    /// Whether grid node `n` is an image.
+    pub fn is_image(&self, n: u32) -> bool {
+        self.images.binary_search_by_key(&n, |i| i.node).is_ok()
+    }
+
+    /// The component-wise reflection of `v` by `sign`.
+    #[inline(always)]
+    pub fn reflect(sign: D::Vec, v: D::Vec) -> D::Vec {
+        let mut out = v;
+        (0..D::D).for_each(|a| out[a] *= sign[a]);
+        out
+    }
+}
