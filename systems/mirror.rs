@@ -7,7 +7,7 @@
 
 use crate::base::dim::Dim;
 use crate::store::grid::Grid;
-use crate::store::mirror::Mirrors;
+use crate::store::mirror::{Image, Mirrors};
 
 /// Adds each image's mass, momentum and force (a `p2g` scatter, loads included) to its
 /// source's, reflected, and clears the image. `gravity` is applied later as g m on the
@@ -36,18 +36,19 @@ pub fn fold_scatter<D: Dim>(grid: &mut Grid<D>, gravity: D::Vec) {
 /// Adds each image's force (a later scatter of internal forces) to its source's,
 /// reflected, and clears the image.
 pub fn fold_force<D: Dim>(grid: &mut Grid<D>) {
-    fold_column(&grid.mirrors, &mut grid.force);
+    fold_images::<D>(&grid.mirrors.images, &mut grid.force);
 }
 
 /// Adds each image's momentum (the remap of the particles' momenta) to its source's,
 /// reflected, and clears the image.
 pub fn fold_momentum<D: Dim>(grid: &mut Grid<D>) {
-    fold_column(&grid.mirrors, &mut grid.momentum);
+    fold_images::<D>(&grid.mirrors.images, &mut grid.momentum);
 }
 
-/// Adds each image's entry of `column` to its source's, reflected, and clears the image.
-fn fold_column<D: Dim>(mirrors: &Mirrors<D>, column: &mut [D::Vec]) {
-    for im in &mirrors.images {
+/// Adds each image's entry of `column` to its source's, reflected, and clears the image
+/// (a force: the transpose of [`reflect_images`]).
+pub fn fold_images<D: Dim>(images: &[Image<D::Vec>], column: &mut [D::Vec]) {
+    for im in images {
         let v = std::mem::replace(&mut column[im.node as usize], D::zero());
         column[im.source as usize] += Mirrors::<D>::reflect(im.sign, v);
     }
@@ -55,16 +56,16 @@ fn fold_column<D: Dim>(mirrors: &Mirrors<D>, column: &mut [D::Vec]) {
 
 /// Gives each image its source's velocity, reflected, and, when `accel`, its acceleration.
 pub fn reflect_velocity<D: Dim>(grid: &mut Grid<D>, accel: bool) {
-    reflect_column(&grid.mirrors, &mut grid.velocity);
+    reflect_images::<D>(&grid.mirrors.images, &mut grid.velocity);
     if accel {
-        reflect_column(&grid.mirrors, &mut grid.accel);
+        reflect_images::<D>(&grid.mirrors.images, &mut grid.accel);
     }
 }
 
 /// Gives each image's entry of `column` its source's, reflected (a per-entry displacement
 /// or velocity).
-pub fn reflect_column<D: Dim>(mirrors: &Mirrors<D>, column: &mut [D::Vec]) {
-    for im in &mirrors.images {
+pub fn reflect_images<D: Dim>(images: &[Image<D::Vec>], column: &mut [D::Vec]) {
+    for im in images {
         column[im.node as usize] = Mirrors::<D>::reflect(im.sign, column[im.source as usize]);
     }
 }

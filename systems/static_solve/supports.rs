@@ -29,7 +29,7 @@ pub(super) fn prescribed<D: Dim>(world: &World<D>, t: f64) -> Option<Vec<D::Vec>
             }
         }
     }
-    mirror::reflect_column(&world.grid.mirrors, &mut u);
+    mirror::reflect_images::<D>(&world.grid.mirrors.images, &mut u);
     Some(u)
 }
 

@@ -9,8 +9,9 @@ use super::dilatation::Groups;
 use super::faces::{self, Face, Pair, Spring};
 use super::{entries, fields};
 use crate::base::dim::Dim;
-use crate::store::mirror::{Image, Mirrors};
+use crate::store::mirror::Image;
 use crate::store::world::{Dilatation, World};
+use crate::systems::mirror;
 
 /// Which entry components are unknowns, and which entries move with another.
 pub(super) struct Unknowns<D: Dim> {
@@ -94,9 +95,7 @@ impl<D: Dim> Unknowns<D> {
     /// a pair's tied one takes that entry's whole value; each image node its source's,
     /// reflected.
     pub fn expand(&self, x: &mut [D::Vec]) {
-        for im in &self.images {
-            x[im.node as usize] = Mirrors::<D>::reflect(im.sign, x[im.source as usize]);
-        }
+        mirror::reflect_images::<D>(&self.images, x);
         for &(s, m, n) in &self.normal_ties {
             x[s] += n * D::dot(x[m] - x[s], n);
         }
@@ -118,10 +117,7 @@ impl<D: Dim> Unknowns<D> {
             y[m] += along;
             y[s] -= along;
         }
-        for im in self.images.iter().rev() {
-            let v = std::mem::replace(&mut y[im.node as usize], D::zero());
-            y[im.source as usize] += Mirrors::<D>::reflect(im.sign, v);
-        }
+        mirror::fold_images::<D>(&self.images, y);
     }
 
     /// Folds a per-component diagonal of K into the diagonal on the unknowns: a tied
