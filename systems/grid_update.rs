@@ -134,6 +134,12 @@ pub fn run<D: Dim>(world: &mut World<D>) {
     }
     if !g.mirrors.is_empty() {
         mirror::reflect_velocity(g, true);
+        let m = &g.mirrors;
+        mirror::credit_reactions(m, &mut world.bcs, |k| {
+            let (share, node) = (&m.shares[k], m.images[k].node as usize);
+            let f = share.force - share.momentum * alpha + gravity * share.mass;
+            g.accel[node] * share.mass - f
+        });
     }
     let mut sums = [damp, grav];
     domain.sum(&mut sums);

@@ -6,13 +6,14 @@
 //! systems call these; a scene without images skips them.
 
 use crate::base::dim::Dim;
+use crate::physics::loads::VelocityBc;
 use crate::store::grid::Grid;
-use crate::store::mirror::{Image, Mirrors};
+use crate::store::mirror::{Image, Mirrors, Share};
 
 /// Adds each image's mass, momentum and force (a `p2g` scatter, loads included) to its
-/// source's, reflected, and clears the image. `gravity` is applied later as g m on the
-/// summed mass; the mirror half feels it reflected, so the difference (R g - g) m_image is
-/// added to the source's force here.
+/// source's, reflected, and clears the image, keeping what it held as the image's
+/// [`Share`]. `gravity` is applied later as g m on the summed mass; the mirror half feels it
+/// reflected, so the difference (R g - g) m_image is added to the source's force here.
 pub fn fold_scatter<D: Dim>(grid: &mut Grid<D>, gravity: D::Vec) {
     let Grid {
         mirrors,
@@ -21,22 +22,34 @@ pub fn fold_scatter<D: Dim>(grid: &mut Grid<D>, gravity: D::Vec) {
         force,
         ..
     } = grid;
-    for im in &mirrors.images {
+    for (im, share) in mirrors.images.iter().zip(&mut mirrors.shares) {
         let (i, s) = (im.node as usize, im.source as usize);
         let reflect = |v: D::Vec| Mirrors::<D>::reflect(im.sign, v);
-        let m = std::mem::take(&mut mass[i]);
-        mass[s] += m;
-        let p = std::mem::replace(&mut momentum[i], D::zero());
-        momentum[s] += reflect(p);
-        let f = std::mem::replace(&mut force[i], D::zero());
-        force[s] += reflect(f) + (reflect(gravity) - gravity) * m;
+        *share = Share {
+            mass: std::mem::take(&mut mass[i]),
+            momentum: std::mem::replace(&mut momentum[i], D::zero()),
+            force: std::mem::replace(&mut force[i], D::zero()),
+        };
+        mass[s] += share.mass;
+        momentum[s] += reflect(share.momentum);
+        force[s] += reflect(share.force) + reflected_gravity::<D>(im, gravity, share.mass);
     }
 }
 
+/// The force gravity adds to an image's source beyond g times their summed mass, for the
+/// image's mass `m`: the mirror half feels gravity reflected, (R g - g) m.
+pub fn reflected_gravity<D: Dim>(im: &Image<D::Vec>, gravity: D::Vec, m: f64) -> D::Vec {
+    (Mirrors::<D>::reflect(im.sign, gravity) - gravity) * m
+}
+
 /// Adds each image's force (a later scatter of internal forces) to its source's,
-/// reflected, and clears the image.
+/// reflected, and to its [`Share`], and clears the image.
 pub fn fold_force<D: Dim>(grid: &mut Grid<D>) {
-    fold_images::<D>(&grid.mirrors.images, &mut grid.force);
+    let Mirrors { images, shares, .. } = &mut grid.mirrors;
+    for (im, share) in images.iter().zip(shares) {
+        share.force += grid.force[im.node as usize];
+    }
+    fold_images::<D>(images, &mut grid.force);
 }
 
 /// Adds each image's momentum (the remap of the particles' momenta) to its source's,
@@ -67,5 +80,26 @@ pub fn reflect_velocity<D: Dim>(grid: &mut Grid<D>, accel: bool) {
 pub fn reflect_images<D: Dim>(images: &[Image<D::Vec>], column: &mut [D::Vec]) {
     for im in images {
         column[im.node as usize] = Mirrors::<D>::reflect(im.sign, column[im.source as usize]);
+    }
+}
+
+/// Adds to each symmetry plane's reaction the part of the force across it that reaches the
+/// body through the images past it. Over the whole grid the particles' internal forces sum
+/// to zero, so the force across the plane is the sum over every node the body reaches of
+/// its own residual rho = m a - f (the supports' reactions where held, zero at free nodes).
+/// At a source and its image the two residuals are equal on the plane's normal, and the
+/// source's free equation, which holds their reflected sum, sets only their difference to
+/// zero: the plane's nodes miss 2 rho of each image past it. `residual(k)` is image k's
+/// own rho (explicit: m a - f with the damping and gravity; static: K u - f), booked at
+/// its [`Credit`]s.
+pub fn credit_reactions<D: Dim>(
+    mirrors: &Mirrors<D>,
+    bcs: &mut [VelocityBc<D>],
+    residual: impl Fn(usize) -> D::Vec,
+) {
+    for c in &mirrors.credits {
+        let rho = residual(c.image as usize);
+        let a = c.axis as usize;
+        bcs[c.boundary as usize].reaction[c.place as usize][a] += 2.0 * rho[a];
     }
 }

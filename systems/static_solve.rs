@@ -19,7 +19,7 @@ use crate::ranks::ABSENT;
 use crate::record::solve_log::Solved;
 use crate::store::crack::Fields;
 use crate::store::world::World;
-use crate::systems::{bin, classify, crack_advect, p2g};
+use crate::systems::{bin, classify, crack_advect, mirror, p2g};
 use crate::with_shape;
 use std::mem::discriminant;
 use std::sync::Arc;
@@ -47,7 +47,7 @@ mod vectors;
 use coarse::Coarse;
 use direct::Analysis;
 use faces::Face;
-use operator::{Law, elastic, mask, stiffness};
+use operator::{Law, elastic, entry_stiffness, mask, stiffness};
 use scatter::entry_sums;
 use solver::Solver;
 use unknowns::{Unknowns, ones};
@@ -574,18 +574,27 @@ fn closed_count<D: Dim>(
 /// Each support's reaction on the body, f_int - f_ext on its held components (f_int the
 /// product of `law` with `u`: K u, or the internal force of the given stresses; the grid's
 /// force column still holds f_ext; a node's entries are summed, so a tied entry's force
-/// counts once, wherever it sits).
+/// counts once, wherever it sits), and on a B-spline symmetry plane its images' part
+/// ([`mirror::credit_reactions`]).
 fn reactions<D: Dim>(world: &mut World<D>, dofs: &Unknowns<D>, law: Law<D>, u: &[D::Vec]) {
     if world.bcs.is_empty() {
         return;
     }
     let mut ku = vec![D::zero(); u.len()];
-    stiffness(world, law, u, dofs, &mut ku);
+    entry_stiffness(world, law, u, dofs, &mut ku);
+    let g = world.settings.gravity;
+    let m = &world.grid.mirrors;
+    // Each image's own K u - f, before the fold takes it to its source.
+    let images: Vec<D::Vec> = (m.images.iter().zip(&m.shares))
+        .map(|(im, s)| ku[im.node as usize] - (s.force + g * s.mass))
+        .collect();
+    dofs.fold(&mut ku);
     let force = &world.grid.force;
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     supports::set_reactions(&mut world.bcs, |n| {
         (entries(n, fields)).fold(D::zero(), |r, e| r + ku[e] - force[e])
     });
+    mirror::credit_reactions(&world.grid.mirrors, &mut world.bcs, |k| images[k]);
 }
 
 /// The work of the particle loads and gravity over the step (particle displacements

@@ -16,6 +16,33 @@ pub struct Image<V> {
     pub sign: V,
 }
 
+/// What this step's scatter left on one image before the fold: the body's own share of the
+/// node, from which the image's part of the force across its planes follows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Share<V> {
+    /// Mass (kg).
+    pub mass: f64,
+    /// Momentum (kg m/s).
+    pub momentum: V,
+    /// Force (N): the loads, and the internal force once scattered.
+    pub force: V,
+}
+
+/// Where an image's part of a plane's reaction is booked: on the plane's normal `axis`,
+/// at the plane node `place` of boundary `boundary`'s nodes (the image's foot on the plane,
+/// reflected into the body's side across the other planes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Credit {
+    /// The image's index in [`Mirrors::images`].
+    pub image: u32,
+    /// The plane's boundary, by its index among the scene's boundaries.
+    pub boundary: u32,
+    /// The foot's place in that boundary's node list.
+    pub place: u32,
+    /// The plane's normal axis.
+    pub axis: u8,
+}
+
 /// The scene's image nodes, in node order; none without a B-spline symmetry plane.
 #[derive(Clone, Debug)]
 pub struct Mirrors<D: Dim> {
@@ -23,6 +50,10 @@ pub struct Mirrors<D: Dim> {
     pub images: Vec<Image<D::Vec>>,
     /// The symmetry planes: their normal axis and coordinate (m).
     pub planes: Vec<(usize, f64)>,
+    /// Per image, what the last scatter left on it (scratch, remade every step).
+    pub shares: Vec<Share<D::Vec>>,
+    /// Per image and plane it lies past, where its part of that plane's reaction goes.
+    pub credits: Vec<Credit>,
 }
 
 impl<D: Dim> Default for Mirrors<D> {
@@ -30,6 +61,8 @@ impl<D: Dim> Default for Mirrors<D> {
         Mirrors {
             images: Vec::new(),
             planes: Vec::new(),
+            shares: Vec::new(),
+            credits: Vec::new(),
         }
     }
 }

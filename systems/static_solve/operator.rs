@@ -75,6 +75,20 @@ pub(super) fn stiffness<D: Dim>(
     dofs: &Unknowns<D>,
     y: &mut [D::Vec],
 ) {
+    entry_stiffness(world, law, x, dofs, y);
+    dofs.fold(y);
+}
+
+/// [`stiffness`] on every grid entry before tied entries and images are folded into their
+/// partners and sources: each entry's own share of K x (a symmetry plane's reaction needs
+/// the images').
+pub(super) fn entry_stiffness<D: Dim>(
+    world: &World<D>,
+    law: Law<D>,
+    x: &[D::Vec],
+    dofs: &Unknowns<D>,
+    y: &mut [D::Vec],
+) {
     let expanded;
     let x = if dofs.ties.is_empty() && dofs.normal_ties.is_empty() && dofs.images.is_empty() {
         x
@@ -135,7 +149,6 @@ pub(super) fn stiffness<D: Dim>(
         });
     });
     add_spring_forces::<D>(&dofs.springs, x, y);
-    dofs.fold(y);
 }
 
 /// y = K x on the free components ([`stiffness`]), with `ghost`'s stiffness (per

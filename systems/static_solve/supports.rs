@@ -60,7 +60,7 @@ pub(super) fn start_forces<D: Dim>(world: &World<D>, t_start: f64) -> Vec<Vec<D:
             .map(|bc| vec![D::zero(); bc.nodes.len()])
             .collect();
     }
-    let r = entry_forces(world, t_start);
+    let (r, _) = entry_forces(world, t_start);
     let fields = fields(world);
     (world.bcs.iter())
         .map(|bc| {
@@ -77,9 +77,10 @@ pub(super) fn reactions_at_rest<D: Dim>(world: &mut World<D>, t: f64) {
     if world.bcs.is_empty() {
         return;
     }
-    let r = entry_forces(world, t);
+    let (r, images) = entry_forces(world, t);
     let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
     set_reactions(&mut world.bcs, |n| node_sum::<D>(&r, n, fields));
+    mirror::credit_reactions(&world.grid.mirrors, &mut world.bcs, |k| images[k]);
 }
 
 /// Sets each support's reaction at its nodes to `force(node)` on the components it holds.
@@ -94,8 +95,10 @@ pub(super) fn set_reactions<D: Dim>(bcs: &mut [VelocityBc<D>], force: impl Fn(u3
 }
 
 /// Each grid entry's force on the body from the particles' state: K u (their stresses,
-/// scattered as the internal force) less the loads and gravity at `t`.
-fn entry_forces<D: Dim>(world: &World<D>, t: f64) -> Vec<D::Vec> {
+/// scattered as the internal force) less the loads and gravity at `t`, with each image's
+/// folded into its source as the solve folds them; and each image's own force before the
+/// fold (for [`mirror::credit_reactions`]).
+fn entry_forces<D: Dim>(world: &World<D>, t: f64) -> (Vec<D::Vec>, Vec<D::Vec>) {
     let p = &world.particles;
     let mut r = entry_sums(world, |i, _, g| {
         D::stress_dot(&p.stress[i], g) * p.volume[i]
@@ -105,7 +108,17 @@ fn entry_forces<D: Dim>(world: &World<D>, t: f64) -> Vec<D::Vec> {
     for (e, r) in r.iter_mut().enumerate() {
         *r -= loads[e] + g * world.grid.mass[e];
     }
-    r
+    // An image's mass is its source's by now: its own weight is taken here, and the fold
+    // gives the source the mirror half's reflected weight in place of g m_image.
+    let m = &world.grid.mirrors;
+    let images = (m.images.iter().zip(&m.shares))
+        .map(|(im, s)| r[im.node as usize] - g * s.mass)
+        .collect();
+    mirror::fold_images::<D>(&m.images, &mut r);
+    for (im, s) in m.images.iter().zip(&m.shares) {
+        r[im.source as usize] -= mirror::reflected_gravity::<D>(im, g, s.mass);
+    }
+    (r, images)
 }
 
 /// The sum of `r` over node `n`'s entries.

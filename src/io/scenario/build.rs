@@ -67,15 +67,8 @@ pub fn build_share<D: Dim>(src: &Source, comm: Comm) -> R<Scene<D>> {
     let mut bcs = super::boundaries::boundaries::<D>(src, &geom)?;
     let mirrors = super::mirrors::mirrors::<D>(src, &geom, &particles.x, &domain, &mut bcs)?;
     let loads = super::loads::loads::<D>(src, &geom, &particles, ppc, &domain)?;
-    let probes = super::probes::probes::<D>(
-        src,
-        &geom,
-        &particles,
-        ppc,
-        &domain,
-        (&bcs, &mirrors),
-        &materials,
-    )?;
+    let probes =
+        super::probes::probes::<D>(src, &geom, &particles, ppc, &domain, &bcs, &materials)?;
     let expects =
         super::expects::expects::<D>(src, &probes, &geom, &materials, sim.plane, sim.thickness)?;
     let output = output_plan(src, sim.duration)?;

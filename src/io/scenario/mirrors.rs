@@ -9,17 +9,18 @@ use crate::physics::loads::VelocityBc;
 use crate::physics::shape::ShapeKind;
 use crate::ranks::domain::Domain;
 use crate::store::grid::GridGeom;
-use crate::store::mirror::{Image, Mirrors};
+use crate::store::mirror::{Credit, Image, Mirrors, Share};
 
 /// Nodes past a plane that can be images: a B-spline stencil reaches one cell past the
 /// plane from a particle on the body's side; the second layer covers a particle on the
 /// plane itself.
 const DEPTH: i64 = 2;
 
-/// A symmetry plane on the grid: its axis, its node index on that axis, and the side the
-/// body lies on (+1 towards higher indices).
+/// A symmetry plane on the grid: its boundary, its axis, its node index on that axis, and
+/// the side the body lies on (+1 towards higher indices).
 #[derive(Clone, Copy, Debug)]
 struct Plane {
+    boundary: usize,
     axis: usize,
     at: f64,
     index: i64,
@@ -77,6 +78,7 @@ pub(super) fn mirrors<D: Dim>(
         }
         let side = if hi > tol { 1 } else { -1 };
         let plane = Plane {
+            boundary: i,
             axis,
             at: p.at,
             index,
@@ -90,13 +92,58 @@ pub(super) fn mirrors<D: Dim>(
     let images: Vec<Image<D::Vec>> = (0..geom.node_count())
         .filter_map(|n| image_of(geom, &planes, n))
         .collect();
-    let planes = planes.iter().map(|p| (p.axis, p.at)).collect();
-    let mirrors = Mirrors { images, planes };
+    let mut mirrors = Mirrors {
+        shares: vec![
+            Share {
+                mass: 0.0,
+                momentum: D::zero(),
+                force: D::zero(),
+            };
+            images.len()
+        ],
+        images,
+        planes: planes.iter().map(|p| (p.axis, p.at)).collect(),
+        credits: Vec::new(),
+    };
     for bc in bcs.iter_mut() {
         bc.nodes.retain(|&n| !mirrors.is_image(n));
         bc.reaction.truncate(bc.nodes.len());
     }
+    mirrors.credits = credits(geom, &planes, &mirrors.images, bcs);
     Ok(mirrors)
+}
+
+/// Per image and plane it lies past, the plane node its part of the plane's reaction goes
+/// to: its source's foot on the plane (the image's own foot, reflected across any other
+/// plane it lies past, onto a node the plane's boundary holds).
+fn credits<D: Dim>(
+    geom: &GridGeom<D>,
+    planes: &[Plane],
+    images: &[Image<D::Vec>],
+    bcs: &[VelocityBc<D>],
+) -> Vec<Credit> {
+    let mut out = Vec::new();
+    for (k, im) in images.iter().enumerate() {
+        let at = geom.node_ijk(im.node as usize).map(|c| c as i64);
+        let source = geom.node_ijk(im.source as usize);
+        for p in planes {
+            if (p.index - at[p.axis]) * p.side <= 0 {
+                continue;
+            }
+            let mut foot = source;
+            foot[p.axis] = p.index as usize;
+            let node = (0..3).map(|a| foot[a] * geom.stride[a]).sum::<usize>() as u32;
+            if let Ok(place) = bcs[p.boundary].nodes.binary_search(&node) {
+                out.push(Credit {
+                    image: k as u32,
+                    boundary: p.boundary as u32,
+                    place: place as u32,
+                    axis: p.axis as u8,
+                });
+            }
+        }
+    }
+    out
 }
 
 /// Node `n` as an image: past at least one plane, by at most [`DEPTH`] nodes past each,

@@ -11,7 +11,6 @@ use crate::physics::material::Material;
 use crate::ranks::domain::Domain;
 use crate::record::probe::{Probe, ProbeQty};
 use crate::store::grid::GridGeom;
-use crate::store::mirror::Mirrors;
 use crate::store::particles::Particles;
 
 /// Every `[[probe]]`: its quantity and component, and the particles it averages (by their
@@ -23,7 +22,7 @@ pub(super) fn probes<D: Dim>(
     particles: &Particles<D>,
     ppc: &[f64],
     domain: &Domain,
-    (bcs, mirrors): (&[VelocityBc<D>], &Mirrors<D>),
+    bcs: &[VelocityBc<D>],
     materials: &[Material],
 ) -> R<Vec<Probe>> {
     let sc = &src.scenario;
@@ -36,8 +35,7 @@ pub(super) fn probes<D: Dim>(
         }
         let (qty, comp, component) = quantity::<D>(src, &key, p)?;
         if qty == ProbeQty::Reaction {
-            let held = (bcs, mirrors);
-            let (supports, centre) = supports::<D>(src, &key, &p.region, held, geom, comp)?;
+            let (supports, centre) = supports::<D>(src, &key, &p.region, bcs, geom, comp)?;
             probes.push(Probe {
                 name: p.name.clone(),
                 particles: Vec::new(),
@@ -153,26 +151,17 @@ fn quantity<'a, D: Dim>(
     Ok((qty, comp, component))
 }
 
-/// Why a reaction probe may not sum a B-spline symmetry plane's normal: part of the force
-/// across the plane reaches the body through the image nodes past it, which no support
-/// holds, so the plane's nodes carry only the rest.
-const MIRRORED_REACTION: &str = "a reaction probe on the normal of a symmetry plane on \
-     quadratic B-splines is not supported yet: part of the force across the plane passes \
-     through the nodes past it, so the plane's own nodes do not carry the whole reaction; \
-     give simulation.shape = \"ugimp\" to measure it";
-
 /// A prescribed-velocity node: (its boundary, its place in that boundary's node list).
 type Support = (u32, u32);
 
 /// A reaction probe's nodes, with their centroid: every prescribed-velocity node inside
 /// `region` (within a millionth of a cell, as boundaries select them), as (boundary, place
-/// in its node list), refused when none of them prescribes component `comp`, and on the
-/// normal of a B-spline symmetry plane ([`MIRRORED_REACTION`]).
+/// in its node list), refused when none of them prescribes component `comp`.
 fn supports<D: Dim>(
     src: &Source,
     key: &dyn Fn(&str) -> String,
     spec: &RegionSpec,
-    (bcs, mirrors): (&[VelocityBc<D>], &Mirrors<D>),
+    bcs: &[VelocityBc<D>],
     geom: &GridGeom<D>,
     comp: usize,
 ) -> R<(Vec<Support>, [f64; 3])> {
@@ -192,13 +181,6 @@ fn supports<D: Dim>(
             "a reaction probe's region holds no grid node of a [[boundary]] that prescribes \
              its component",
         ));
-    }
-    let on_plane = |&(b, k): &Support| {
-        let x = geom.node_position(bcs[b as usize].nodes[k as usize] as usize);
-        (mirrors.planes.iter()).any(|&(a, at)| a == comp && (x[a] - at).abs() <= tol)
-    };
-    if supports.iter().any(on_plane) {
-        return Err(src.error(&key("region"), MIRRORED_REACTION));
     }
     let mut centre = [0.0; 3];
     for &(b, k) in &supports {
