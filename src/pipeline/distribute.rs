@@ -100,7 +100,7 @@ fn refuse_unsupported<D: Dim>(world: &World<D>) -> anyhow::Result<()> {
         anyhow::bail!(
             "simulation.linear = \"direct\": the sparse direct solver runs on one process \
              only; give linear = \"two_level\" or \"cg\" (or \"auto\", which takes \
-             conjugate gradients on several ranks)"
+             the coarse grid's conjugate gradients on several ranks)"
         );
     }
     Ok(())

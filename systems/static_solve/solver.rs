@@ -60,7 +60,7 @@ impl<D: Dim> Solver<D> {
             what,
         };
         let split = world.domain.is_split();
-        let auto_two_level = D::D == 3 || (!split && newton_pays_for_two_level(world));
+        let auto_two_level = D::D == 3 || split || newton_pays_for_two_level(world);
         let coarse = match world.settings.linear {
             LinearSolver::TwoLevel => true,
             LinearSolver::Auto => auto_two_level,
@@ -83,7 +83,7 @@ impl<D: Dim> Solver<D> {
         let mut frame = Frame::new(world, dofs, coarse);
         let (direct, too_large) = match world.settings.linear {
             LinearSolver::Cg | LinearSolver::TwoLevel => (None, false),
-            LinearSolver::Auto if auto_two_level || split => (None, false),
+            LinearSolver::Auto if auto_two_level => (None, false),
             LinearSolver::Auto => {
                 match Direct::new(world, dofs, &frame.modes, &mut kept.analysis) {
                     Ok(d) => (Some(d), false),
