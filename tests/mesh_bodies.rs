@@ -196,7 +196,8 @@ fn turned_block_from_an_obj_file_is_the_box() {
 
 /// A surface with a hole, a file neither STL nor OBJ, an OBJ file with no faces, a
 /// truncated binary STL file, a missing file
-/// and a mesh body in 2D are refused, naming the key, the file and what is wrong.
+/// and a closed surface as a 2D body (whose mesh must be flat) are refused, naming the key,
+/// the file and what is wrong.
 #[test]
 fn bad_mesh_files_are_named() {
     let dir = folder("bad");
@@ -262,7 +263,7 @@ fn bad_mesh_files_are_named() {
             .to_string(),
         Err(e) => e.to_string(),
     };
-    assert!(e.contains("a mesh body is 3D"), "{e}");
+    assert!(e.contains("one plane z = const"), "{e}");
     std::fs::remove_dir_all(dir).ok();
 }
 

@@ -1,6 +1,6 @@
 //! Body geometries and filling them with particles.
 
-use crate::base::geometry::ClosedSurface;
+use crate::base::geometry::{ClosedSurface, Outline};
 
 /// A body's shape, in padded 3-component coordinates (z = 0 in 2D).
 #[derive(Clone, Debug)]
@@ -39,6 +39,8 @@ pub enum Solid {
     },
     /// The inside of a closed triangulated surface (3D).
     Mesh(std::sync::Arc<ClosedSurface>),
+    /// The region closed outlines bound in x-y (2D: a flat mesh's boundary, holes included).
+    Outline(std::sync::Arc<Outline>),
     /// Polygon in x-y, extruded over `z` in 3D.
     Polygon {
         /// Vertices (m).
@@ -78,6 +80,7 @@ impl Solid {
                 (0.0..=*length).contains(&along) && r2 <= radius * radius && r2 >= inner * inner
             }
             Solid::Mesh(surface) => surface.contains(x),
+            Solid::Outline(outline) => outline.contains([x[0], x[1]]),
             Solid::Polygon { points, z } => {
                 if let Some([z0, z1]) = z
                     && !(x[2] >= *z0 && x[2] <= *z1)
@@ -127,6 +130,10 @@ impl Solid {
                 (lo, hi)
             }
             Solid::Mesh(surface) => surface.bounds(),
+            Solid::Outline(outline) => {
+                let (lo, hi) = outline.bounds();
+                ([lo[0], lo[1], 0.0], [hi[0], hi[1], 0.0])
+            }
             Solid::Polygon { points, z } => {
                 let mut lo = [f64::INFINITY, f64::INFINITY, 0.0];
                 let mut hi = [f64::NEG_INFINITY, f64::NEG_INFINITY, 0.0];

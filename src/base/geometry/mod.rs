@@ -6,10 +6,12 @@ mod bounds;
 mod closed_surface;
 mod distance;
 mod element;
+mod outline;
 mod point;
 
 pub use bounds::{Aabb, meeting_pairs};
 pub use closed_surface::{ClosedSurface, SurfaceDefect, TriangleList};
 pub use distance::{point_segment, point_segment_sq, point_triangle, segment_segment};
 pub use element::{Element, NUDGE, Segment, Triangle};
+pub use outline::Outline;
 pub use point::Point;

@@ -248,14 +248,14 @@ fn geometry<D: Dim>(src: &Source, b: usize, body: &BodySpec) -> R<Solid> {
         return Err(src.error(
             &format!("body[{b}]"),
             "give exactly one geometry: box, disc (2D), sphere (3D), cylinder (3D), polygon or \
-             mesh (3D)",
+             mesh",
         ));
     }
     if let Some(m) = &body.mesh {
-        if D::D != 3 {
-            return Err(src.error(&key("mesh"), "a mesh body is 3D; use polygon in 2D"));
-        }
-        return super::mesh_body::solid(src, &key("mesh"), m);
+        return match D::D {
+            2 => super::mesh_outline::outline(src, &key("mesh"), m),
+            _ => super::mesh_body::solid(src, &key("mesh"), m),
+        };
     }
     if let Some(bx) = &body.box_ {
         let (min, max) = box_corners::<D>(src, &key("box"), bx)?;

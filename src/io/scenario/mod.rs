@@ -17,6 +17,7 @@ mod loads;
 mod material;
 mod memory;
 mod mesh_body;
+mod mesh_outline;
 mod mirrors;
 mod msh;
 mod output;
