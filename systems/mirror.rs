@@ -87,11 +87,11 @@ pub fn reflect_images<D: Dim>(images: &[Image<D::Vec>], column: &mut [D::Vec]) {
 /// body through the images past it. Over the whole grid the particles' internal forces sum
 /// to zero, so the force across the plane is the sum over every node the body reaches of
 /// its own residual rho = m a - f (the supports' reactions where held, zero at free nodes).
-/// At a source and its image the two residuals are equal on the plane's normal, and the
-/// source's free equation, which holds their reflected sum, sets only their difference to
-/// zero: the plane's nodes miss 2 rho of each image past it. `residual(k)` is image k's
-/// own rho (explicit: m a - f with the damping and gravity; static: K u - f), booked at
-/// its [`Credit`]s.
+/// A free source's folded equation holds its residual less its image's on the plane's
+/// normal (the reflection flips the image's there), so the two are equal, not zero, and the
+/// plane's own nodes miss 2 rho of each image past it. `residual(k)` is image k's own rho
+/// (explicit: m a - f with the damping and gravity; static: K u - f), booked at its
+/// [`Credit`]s.
 pub fn credit_reactions<D: Dim>(
     mirrors: &Mirrors<D>,
     bcs: &mut [VelocityBc<D>],
