@@ -23,12 +23,14 @@ pub mod bin;
 pub mod classify;
 pub mod contact;
 pub mod crack_advect;
+pub mod dilatation;
 pub mod fracture;
 pub mod fracture_front;
 pub mod g2p;
 pub mod grid_update;
 pub mod grow;
 pub mod grow_front;
+pub mod mean_stress;
 pub mod mirror;
 pub mod p2g;
 pub mod scatter_coded;
@@ -41,8 +43,10 @@ use crate::base::dim::{D2, D3, Dim};
 use crate::base::error::Unstable;
 use crate::fracture::plan::{FracturePlan, Measured};
 use crate::physics::growth::GrowthRow;
+use crate::physics::shape::{ShapeKind, Stencil};
 use crate::store::crack::Fields;
 use crate::store::world::World;
+use crate::with_shape;
 
 /// Whether particle `i` sees no crack (`fields`, the crack store's per-particle fields, when
 /// the scene has cracks): the particle systems handle it in their common loop, the coded
@@ -50,6 +54,36 @@ use crate::store::world::World;
 #[inline(always)]
 pub(crate) fn is_free(fields: Option<&Fields>, i: usize) -> bool {
     !fields.is_some_and(|f| f.is_coded(i))
+}
+
+/// Calls `f(entry, weight, grad S)` for each node of particle `i`'s stencil, on the entry
+/// of the particle's side where a crack splits the node.
+pub(crate) fn each_entry<D: Dim>(
+    world: &World<D>,
+    i: usize,
+    mut f: impl FnMut(usize, f64, D::Vec),
+) {
+    let shape: ShapeKind = world.settings.shape;
+    let stride = &world.grid.geom.stride;
+    let targets = world
+        .cracks
+        .as_ref()
+        .and_then(|c| c.scratch.fields.targets_of(i));
+    with_shape!(shape, S, N => {
+        let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
+        match targets {
+            Some(t) => st.for_each_target::<D>(stride, t, &mut f),
+            None => st.for_each::<D>(stride, &mut f),
+        }
+    });
+}
+
+/// The gradient at particle `i` of a field given on the grid entries (`u`: displacements
+/// in a static solve, velocities in an explicit step).
+pub(crate) fn entry_gradient<D: Dim>(world: &World<D>, i: usize, u: &[D::Vec]) -> D::Mat {
+    let mut l = D::mat_zero();
+    each_entry(world, i, |n, _, g| l = l + D::outer(u[n], g));
+    l
 }
 
 /// The systems whose algorithm differs by dimension: J and K at crack tips in 2D and at

@@ -14,13 +14,13 @@
 use crate::base::dim::Dim;
 use crate::base::error::Unstable;
 use crate::base::exact_sum::ExactSum;
-use crate::physics::shape::{ShapeKind, Stencil};
 use crate::ranks::ABSENT;
 use crate::record::solve_log::Solved;
 use crate::store::crack::Fields;
 use crate::store::world::World;
-use crate::systems::{bin, classify, crack_advect, mirror, p2g};
-use crate::with_shape;
+use crate::systems::{
+    bin, classify, crack_advect, each_entry, entry_gradient as gradient, mirror, p2g,
+};
 use std::mem::discriminant;
 use std::sync::Arc;
 
@@ -28,7 +28,6 @@ mod blocks;
 mod cg;
 mod cholesky;
 mod coarse;
-mod dilatation;
 mod direct;
 mod element;
 mod faces;
@@ -702,7 +701,10 @@ fn gather<D: Dim>(world: &World<D>, u: &[D::Vec]) -> Vec<D::Vec> {
 fn set_particles<D: Dim>(world: &mut World<D>, dofs: &Unknowns<D>, u: &[D::Vec], disp: &[D::Vec]) {
     let plane = world.settings.plane;
     let keep = !world.particles.grad_u.is_empty();
-    let grouped = dofs.groups.as_ref().map(|g| g.gradients(world, u));
+    let grouped = dofs
+        .groups
+        .as_ref()
+        .map(|g| g.gradients(world, |i| gradient(world, i, u)));
     for (i, &d) in disp.iter().enumerate() {
         let l = gradient(world, i, u);
         let p = &mut world.particles;
@@ -804,26 +806,4 @@ fn fields<D: Dim>(world: &World<D>) -> Option<&Fields> {
 fn entries(n: u32, fields: Option<&Fields>) -> impl Iterator<Item = usize> {
     let extra = fields.map_or(0..0, |f| f.rows_of(n));
     std::iter::once(n as usize).chain(extra)
-}
-
-/// Calls `f(entry, weight, grad S)` for each node of particle `i`'s stencil, on the entry
-/// of the particle's side where a crack splits the node.
-fn each_entry<D: Dim>(world: &World<D>, i: usize, mut f: impl FnMut(usize, f64, D::Vec)) {
-    let shape: ShapeKind = world.settings.shape;
-    let stride = &world.grid.geom.stride;
-    let targets = fields(world).and_then(|c| c.targets_of(i));
-    with_shape!(shape, S, N => {
-        let st = Stencil::<N>::cached::<D>(S, &world.tiles.stencils, i);
-        match targets {
-            Some(t) => st.for_each_target::<D>(stride, t, &mut f),
-            None => st.for_each::<D>(stride, &mut f),
-        }
-    });
-}
-
-/// grad u at particle `i` from the entries' displacements `u`.
-fn gradient<D: Dim>(world: &World<D>, i: usize, u: &[D::Vec]) -> D::Mat {
-    let mut l = D::mat_zero();
-    each_entry(world, i, |n, _, g| l = l + D::outer(u[n], g));
-    l
 }

@@ -80,3 +80,20 @@ fn front_fracture_is_bitwise_identical_across_thread_counts() {
         assert!(one == tips(threads), "front K differs at {threads} threads");
     }
 }
+
+/// The cell's mean dilatation (`dilatation = "cell_mean"`) sums each group's mean in one
+/// order: a 2D scene with an edge crack (USAVG) and a 3D one (USF) are bitwise the same
+/// for any thread count.
+#[test]
+fn cell_mean_dilatation_is_bitwise_identical_across_thread_counts() {
+    let mean = |t: String| {
+        t.replace(
+            "damping = 1000.0",
+            "damping = 1000.0\ndilatation = \"cell_mean\"",
+        )
+    };
+    let crack = "[[crack]]\nline = { start = [0.02, 0.001], end = [0.02, 0.007] }\n";
+    same_bits_for_thread_counts::<D2>(&(mean(mixed_scene(2, "ugimp", "usavg")) + crack));
+    let short = mixed_scene(3, "bspline", "usf").replace("duration = 1e-5", "duration = 2e-6");
+    same_bits_for_thread_counts::<D3>(&mean(short));
+}

@@ -77,3 +77,55 @@ fn fused_stress_bin_matches_stress_then_bin() {
         assert!(bits(&fused) == bits(&apart), "{shape} {update}");
     }
 }
+
+/// The cell's mean dilatation swaps the fused stress updates for `mean_stress` (no binning:
+/// the next step's `bin` does it) and scatters the internal force apart (`mean_force`),
+/// after the opening update or, in USL, after the momenta.
+#[test]
+fn cell_mean_dilatation_updates_and_scatters_apart() {
+    let mean = |update| {
+        let text = common::block_2d(1e-5, 0.004, 0.016, "").replace(
+            "dimension = 2",
+            &format!("dimension = 2\nupdate = \"{update}\"\ndilatation = \"cell_mean\""),
+        );
+        let world = build::<D2>(&source(&text)).unwrap().world;
+        let names: Vec<_> = (Schedule::for_world(&world, None).systems.iter())
+            .map(|s| s.name())
+            .collect();
+        names
+    };
+    assert_eq!(
+        mean("usf"),
+        [
+            "bin",
+            "p2g",
+            "mean_stress",
+            "mean_force",
+            "grid_update",
+            "g2p"
+        ]
+    );
+    assert_eq!(
+        mean("usl"),
+        [
+            "bin",
+            "p2g",
+            "mean_force",
+            "grid_update",
+            "g2p_remap",
+            "mean_stress"
+        ]
+    );
+    assert_eq!(
+        mean("usavg"),
+        [
+            "bin",
+            "p2g",
+            "mean_stress",
+            "mean_force",
+            "grid_update",
+            "g2p_remap",
+            "mean_stress"
+        ]
+    );
+}

@@ -10,7 +10,7 @@ use crate::ranks::domain::Domain;
 use crate::ranks::partition::{Partition, TileGrid};
 use crate::record::probe::Probe;
 use crate::store::particles::{ColumnOp, Particles};
-use crate::store::world::{LinearSolver, Solver, World};
+use crate::store::world::{Dilatation, LinearSolver, Solver, World};
 use crate::systems::bin;
 use std::borrow::Cow;
 
@@ -94,6 +94,14 @@ fn refuse_unsupported<D: Dim>(world: &World<D>) -> anyhow::Result<()> {
         );
     }
     if world.settings.solver != Solver::Static {
+        if world.settings.dilatation == Dilatation::CellMean {
+            anyhow::bail!(
+                "simulation.dilatation = \"cell_mean\" in an explicit scene runs on one \
+                 process only (a particle that crosses into another rank's cell within a \
+                 step would join that cell's mean there); run on one process, or give \
+                 solver = \"static\""
+            );
+        }
         return Ok(());
     }
     if world.settings.linear == LinearSolver::Direct {

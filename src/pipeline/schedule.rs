@@ -5,10 +5,10 @@ use crate::base::error::Unstable;
 use crate::fracture::plan::{FracturePlan, Measured};
 use crate::pipeline::warm::with_warm_workers;
 use crate::record::solve_log::Solved;
-use crate::store::world::{Solver, Update, World};
+use crate::store::world::{Dilatation, Solver, Update, World};
 use crate::systems::{
-    DimSystems, bin, classify, contact, crack_advect, g2p, grid_update, grow, p2g, static_solve,
-    stress, stress_bin, stress_force,
+    DimSystems, bin, classify, contact, crack_advect, g2p, grid_update, grow, mean_stress, p2g,
+    static_solve, stress, stress_bin, stress_force,
 };
 use std::time::Instant;
 
@@ -46,6 +46,15 @@ pub enum System {
         /// Fraction of the step.
         fraction: f64,
     },
+    /// A stress update with each particle's dilatation its cell's mean (`dilatation =
+    /// "cell_mean"`), in place of `StressForce`'s update and `StressBin`.
+    MeanStress {
+        /// Fraction of the step.
+        fraction: f64,
+    },
+    /// The internal-force scatter of the cell-mean dilatation's B-bar stresses, after the
+    /// opening update (USF, USAVG) or the scatter of momenta (USL).
+    MeanForce,
     /// Integrate nodal momenta, apply damping, gravity and prescribed velocities.
     GridUpdate,
     /// Gather to particles: velocities, positions, displacements (USF).
@@ -73,6 +82,8 @@ impl System {
             System::MomentumBc { .. } => "grid_bc",
             System::StressForce { .. } => "stress_force",
             System::StressBin { .. } => "stress_bin",
+            System::MeanStress { .. } => "mean_stress",
+            System::MeanForce => "mean_force",
             System::GridUpdate => "grid_update",
             System::G2p => "g2p",
             System::G2pRemap => "g2p_remap",
@@ -106,7 +117,9 @@ impl Schedule {
     /// shape functions); USAVG does half of each.
     /// Prescribed velocities add `grid_bc` after each scatter of momenta; cracks add
     /// `classify` after binning and `crack_advect` after the particles move; a fracture
-    /// plan adds `fracture` at the end of the steps that end at an output row.
+    /// plan adds `fracture` at the end of the steps that end at an output row. The cell's
+    /// mean dilatation trades the fused updates for `mean_stress` and `mean_force` (the
+    /// next step's `bin` then bins the moved particles).
     pub fn for_world<D: Dim>(world: &World<D>, fracture: Option<FracturePlan>) -> Self {
         use System::*;
         if world.settings.solver == Solver::Static {
@@ -138,12 +151,13 @@ impl Schedule {
                 .iter()
                 .any(|c| c.contact.law != crate::store::crack::Law::None)
         });
+        let mean = world.settings.dilatation == Dilatation::CellMean;
         let mut s = vec![Bin];
         if cracks {
             s.push(Classify);
         }
         s.push(P2g {
-            internal: update == Update::Usl,
+            internal: update == Update::Usl && !mean,
         });
         if bc {
             s.push(MomentumBc { end: false });
@@ -153,7 +167,13 @@ impl Schedule {
         }
         if update != Update::Usl {
             let fraction = if update == Update::Usf { 1.0 } else { 0.5 };
-            s.push(StressForce { fraction });
+            s.extend(if mean {
+                vec![MeanStress { fraction }, MeanForce]
+            } else {
+                vec![StressForce { fraction }]
+            });
+        } else if mean {
+            s.push(MeanForce);
         }
         s.push(GridUpdate);
         if contact {
@@ -170,7 +190,11 @@ impl Schedule {
             let fraction = if update == Update::Usl { 1.0 } else { 0.5 };
             // The closing update also bins the particles for the next step (see
             // `step_measuring` for the steps after which J is measured).
-            s.push(StressBin { fraction });
+            s.push(if mean {
+                MeanStress { fraction }
+            } else {
+                StressBin { fraction }
+            });
         }
         let fracture = fracture.filter(|_| cracks);
         if fracture.is_some() {
@@ -323,6 +347,8 @@ impl Schedule {
                     let binned = stress_bin::run(world, fraction);
                     world.domain.agree(binned)?;
                 }
+                System::MeanStress { fraction } => mean_stress::run(world, fraction),
+                System::MeanForce => mean_stress::force(world),
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),
                 System::G2pRemap => g2p::run_with_remap(world),

@@ -46,7 +46,7 @@ pub enum Dilatation {
     #[default]
     Particle,
     /// The volume-weighted mean over the particles of its cell, material and crack side
-    /// (`systems::static_solve::dilatation`): relieves the volumetric locking of
+    /// (`systems::dilatation`): relieves the volumetric locking of
     /// isochoric plastic flow in plane strain and 3D.
     CellMean,
 }

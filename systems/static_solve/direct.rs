@@ -6,7 +6,6 @@
 //! the pattern holds.
 
 use super::cholesky::{analyse, factorize};
-use super::dilatation::Groups;
 use super::element::particle_stiffness;
 use super::faces::spring_force;
 use super::frame::Frame;
@@ -20,6 +19,7 @@ use crate::record::solve_log::Solved;
 use crate::store::disjoint::Disjoint;
 use crate::store::mirror::Mirrors;
 use crate::store::world::World;
+use crate::systems::dilatation::Groups;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::SymbolicSparseColMat;
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky};

@@ -1,11 +1,11 @@
 //! One particle's stiffness V B^T C B between the entries of its stencil, block by block:
 //! what the direct solver assembles into K and the block preconditioner into its blocks.
 
-use super::dilatation::{isotropic, trace};
 use super::operator::Law;
 use crate::base::dim::Dim;
 use crate::base::sym::SymTensor;
 use crate::store::world::World;
+use crate::systems::dilatation::{isotropic, trace};
 
 /// Calls `add(l, k, block)` for each pair of entries of particle `i`'s `support` (entry,
 /// grad S) that `wanted(l, k)` (positions in `support`) accepts, `block[b]` the force on

@@ -273,7 +273,10 @@ fn continuum<D: Dim>(world: &World<D>) -> Vec<Option<Tangent>> {
 fn return_map<D: Dim>(world: &World<D>, dofs: &Unknowns<D>, du: &[D::Vec]) -> Returned<D> {
     let p = &world.particles;
     let plane = world.settings.plane;
-    let grouped = dofs.groups.as_ref().map(|g| g.gradients(world, du));
+    let grouped = dofs
+        .groups
+        .as_ref()
+        .map(|g| g.gradients(world, |i| gradient(world, i, du)));
     let states: Vec<_> = (0..p.len())
         .into_par_iter()
         .map(|i| {

@@ -67,7 +67,7 @@ pub(super) fn elastic<D: Dim>(m: &Material, plane: Plane, l: &D::Mat) -> D::Sym 
 /// thread count), the sliding faces' friction tangents added (`dofs.springs`), tied
 /// entries' forces folded into their partners'. With mean-dilatation
 /// groups the stresses come first, from the group-mean strains, and scatter with their
-/// groups' mean pressure ([`Groups`](super::dilatation::Groups)).
+/// groups' mean pressure ([`Groups`](crate::systems::dilatation::Groups)).
 pub(super) fn stiffness<D: Dim>(
     world: &World<D>,
     law: Law<D>,
@@ -106,11 +106,12 @@ pub(super) fn entry_stiffness<D: Dim>(
                 Law::Given(s) => s.to_vec(),
                 _ => {
                     let plane = world.settings.plane;
-                    (groups.gradients(world, x).par_iter().enumerate())
-                        .map(|(i, l)| {
-                            law.stress(&world.materials[p.material[i] as usize], plane, i, l)
-                        })
-                        .collect()
+                    (groups
+                        .gradients(world, |i| gradient(world, i, x))
+                        .par_iter()
+                        .enumerate())
+                    .map(|(i, l)| law.stress(&world.materials[p.material[i] as usize], plane, i, l))
+                    .collect()
                 }
             };
             grouped = groups.effective(world, &stresses);

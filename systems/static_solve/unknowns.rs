@@ -5,12 +5,12 @@
 //! tied whole; with the sliding ones' friction tangents, which K carries, and the B-spline
 //! symmetry planes' image nodes, each its source reflected.
 
-use super::dilatation::Groups;
 use super::faces::{self, Face, Pair, Spring};
 use super::{entries, fields};
 use crate::base::dim::Dim;
 use crate::store::mirror::Image;
 use crate::store::world::{Dilatation, World};
+use crate::systems::dilatation::Groups;
 use crate::systems::mirror;
 
 /// Which entry components are unknowns, and which entries move with another.

@@ -570,3 +570,76 @@ history_interval = {dt}
 "#
     )
 }
+
+/// Lame's thick shell (bore a = 0.1 m, outside b = 0.2 m) under a bore pressure of 100 MPa
+/// rising under the table `points` (E = 200 GPa, nu = `nu`): in 2D a quarter of a cylinder
+/// in plane strain on 5 mm cells, in 3D an eighth of a sphere on 10 mm cells (29,318
+/// particles), on symmetry planes; `simulation` adds its lines to `[simulation]`. Probes
+/// `axis` and `diagonal` read the x displacement at r = 0.15 m next to the x axis and on
+/// the diagonal.
+pub fn pressed_shell(dim: usize, nu: f64, simulation: &str, points: &str) -> String {
+    let (plane, cell, body, reach, axis, diagonal) = if dim == 2 {
+        (
+            "plane = \"strain\"",
+            0.005,
+            "disc = { center = [0.0, 0.0], radius = 0.2, inner_radius = 0.1 }\n\
+             clip = { polygon = [[0.0, 0.0], [0.21, 0.0], [0.21, 0.21], [0.0, 0.21]] }",
+            0.1025,
+            "center = [0.15, 0.0025], radius = 0.003",
+            "center = [0.10607, 0.10607], radius = 0.004",
+        )
+    } else {
+        (
+            "",
+            0.01,
+            "sphere = { center = [0.0, 0.0, 0.0], radius = 0.2, inner_radius = 0.1 }\n\
+             clip = { min = [0.0, 0.0, 0.0], max = [0.21, 0.21, 0.21] }",
+            0.105,
+            "center = [0.15, 0.0025, 0.0025], radius = 0.006",
+            "center = [0.0866, 0.0866, 0.0866], radius = 0.006",
+        )
+    };
+    let planes: String = ["x", "y", "z"][..dim]
+        .iter()
+        .map(|a| format!("[[boundary]]\nplane = {{ axis = \"{a}\", at = 0.0 }}\n"))
+        .collect();
+    let o = v(dim, 0.0, 0.0);
+    format!(
+        r#"
+[simulation]
+dimension = {dim}
+{plane}
+{simulation}
+[grid]
+min = {}
+max = {}
+cell = {}
+[[material]]
+name = "m"
+E = 200e9
+nu = {nu}
+rho = 7800.0
+[[body]]
+material = "m"
+{body}
+{planes}
+[[load]]
+region = {{ center = {o}, radius = {reach} }}
+pressure = {{ value = 100e6, center = {o}, face = "inner" }}
+time = {{ kind = "table", points = {points} }}
+[[probe]]
+name = "axis"
+region = {{ {axis} }}
+quantity = "displacement"
+component = "x"
+[[probe]]
+name = "diagonal"
+region = {{ {diagonal} }}
+quantity = "displacement"
+component = "x"
+"#,
+        v(dim, -0.01, -0.01),
+        v(dim, 0.21, 0.21),
+        v(dim, cell, cell),
+    )
+}

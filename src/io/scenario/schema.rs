@@ -89,7 +89,7 @@ pub struct Simulation {
     /// A static scene's linear solver: "auto" (default), "direct", "cg" or "two_level".
     pub linear: Option<LinearSolver>,
     /// The volumetric strain a particle's stress sees: "particle" (its own, default) or
-    /// "cell_mean" (its cell's mean: static scenes in plane strain and 3D).
+    /// "cell_mean" (its cell's mean: plane strain and 3D, static or explicit).
     #[serde(default)]
     pub dilatation: Dilatation,
 }

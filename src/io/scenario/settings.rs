@@ -53,21 +53,12 @@ pub(super) fn simulation<D: Dim>(src: &Source) -> R<Simulation> {
         (_, Some(_)) => return Err(src.error("simulation.plane", "applies to 2D scenes only")),
         _ => Plane::None,
     };
-    if sim.dilatation == Dilatation::CellMean {
-        if plane == Plane::Stress {
-            return Err(src.error(
-                "simulation.dilatation",
-                "\"cell_mean\" relieves a volume constraint that plane stress does not have \
-                 (sigma_zz = 0 lets the thickness change): use it in plane strain or 3D",
-            ));
-        }
-        if sim.solver != Solver::Static {
-            return Err(src.error(
-                "simulation.dilatation",
-                "\"cell_mean\" is implemented in the static solver only so far: add \
-                 solver = \"static\" to [simulation]",
-            ));
-        }
+    if sim.dilatation == Dilatation::CellMean && plane == Plane::Stress {
+        return Err(src.error(
+            "simulation.dilatation",
+            "\"cell_mean\" relieves a volume constraint that plane stress does not have \
+             (sigma_zz = 0 lets the thickness change): use it in plane strain or 3D",
+        ));
     }
     let thickness = match (D::D, sim.thickness) {
         (2, Some(t)) => positive(src, "simulation.thickness", t, "m")?,

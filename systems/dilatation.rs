@@ -1,4 +1,5 @@
-//! The mean dilatation of `[simulation] dilatation = "cell_mean"`: each particle's
+//! The mean dilatation of `[simulation] dilatation = "cell_mean"`, for the static solve and
+//! the explicit step alike: each particle's
 //! volumetric strain replaced by the volume-weighted mean over its group, the particles of
 //! its cell with its material on its side of every crack (Nagtegaal, Parks & Rice 1974;
 //! in the strain-operator form B-bar of Hughes 1980, Eq. 9). Isochoric plastic flow then
@@ -11,15 +12,16 @@
 //! of its stress, B-bar^T sigma, is B^T of sigma + (mean(tr sigma) - tr sigma) / D I: the
 //! stress each particle scatters carries its group's mean pressure.
 
-use super::{fields, gradient};
 use crate::base::dim::Dim;
 use crate::base::sym::{Sym3, SymTensor};
 use crate::store::world::World;
 use rayon::prelude::*;
 
-/// The particles grouped by cell, material and crack side, each group's members in
-/// ascending index order (so every mean is summed in one order for any thread count).
-pub(super) struct Groups {
+/// The particles grouped by cell, material and crack side, tile by tile of the last binning
+/// (a particle that left its tile's cells since joins its new cell's particles of the same
+/// tile), each group's members in ascending index order (so every mean is summed in one
+/// order for any thread count).
+pub(crate) struct Groups {
     /// Group of each particle.
     of: Vec<u32>,
     /// `start[g]..start[g + 1]` indexes `members` for group `g`.
@@ -31,11 +33,13 @@ pub(super) struct Groups {
 }
 
 impl Groups {
-    /// The groups of the particles at their binned positions, after `classify`.
+    /// The groups of the particles at their positions, after `bin` and `classify`: each
+    /// tile's particles sorted by (cell, material, crack sides, index), in parallel over the
+    /// tiles (no sort spans the scene).
     pub fn new<D: Dim>(world: &World<D>) -> Self {
-        let p = &world.particles;
+        let (p, tiles) = (&world.particles, &world.tiles);
         let geom = &world.grid.geom;
-        let fields = fields(world);
+        let fields = world.cracks.as_ref().map(|c| &c.scratch.fields);
         // A particle's crack sides: the masks of the crack fields its stencil reaches
         // across a crack (zero away from cracks).
         let side = |i: usize| -> u64 {
@@ -46,35 +50,46 @@ impl Groups {
                 .filter(|&&t| t as usize >= f.nodes)
                 .fold(0, |m, &t| m | f.mask[t as usize - f.nodes])
         };
-        let mut keys: Vec<(u64, u32, u64, u32)> = (0..p.len())
+        let key = |i: u32| {
+            let x = p.x[i as usize];
+            let mut cell = 0;
+            for a in (0..D::D).rev() {
+                let c = ((x[a] - geom.origin[a]) * geom.inv_h[a]).floor();
+                let c = c.clamp(0.0, (geom.cells[a] - 1) as f64) as u64;
+                cell = cell * geom.cells[a] as u64 + c;
+            }
+            (cell, p.material[i as usize], side(i as usize), i)
+        };
+        let group = |k: &(u64, u16, u64, u32)| (k.0, k.1, k.2);
+        // Per tile: its particles in group order, and where each of its groups starts.
+        let per_tile: Vec<(Vec<u32>, Vec<u32>)> = (0..tiles.start.len().saturating_sub(1))
             .into_par_iter()
-            .map(|i| {
-                let mut cell = 0;
-                for a in (0..D::D).rev() {
-                    let c = ((p.x[i][a] - geom.origin[a]) * geom.inv_h[a]).floor();
-                    let c = c.clamp(0.0, (geom.cells[a] - 1) as f64) as u64;
-                    cell = cell * geom.cells[a] as u64 + c;
-                }
-                (cell, p.material[i] as u32, side(i), i as u32)
+            .map(|t| {
+                let mut keys: Vec<_> = tiles.particles(t as u32).iter().map(|&i| key(i)).collect();
+                keys.sort_unstable();
+                let starts = (0..keys.len())
+                    .filter(|&k| k == 0 || group(&keys[k - 1]) != group(&keys[k]))
+                    .map(|k| k as u32)
+                    .collect();
+                (keys.into_iter().map(|k| k.3).collect(), starts)
             })
             .collect();
-        keys.par_sort_unstable();
         let mut of = vec![0; p.len()];
         let mut start = Vec::new();
         let mut members = Vec::with_capacity(p.len());
-        for (k, key) in keys.iter().enumerate() {
-            let last = k.checked_sub(1).map(|j| keys[j]);
-            if last.is_none_or(|l| (l.0, l.1, l.2) != (key.0, key.1, key.2)) {
-                start.push(k as u32);
-            }
-            of[key.3 as usize] = (start.len() - 1) as u32;
-            members.push(key.3);
+        for (list, starts) in per_tile {
+            let base = members.len() as u32;
+            start.extend(starts.iter().map(|s| base + s));
+            members.extend(list);
         }
         start.push(members.len() as u32);
-        let volume = (start.windows(2))
-            .map(|w| {
+        let volume: Vec<f64> = (start.windows(2).enumerate())
+            .map(|(g, w)| {
                 (members[w[0] as usize..w[1] as usize].iter())
-                    .map(|&i| p.volume[i as usize])
+                    .map(|&i| {
+                        of[i as usize] = g as u32;
+                        p.volume[i as usize]
+                    })
                     .sum()
             })
             .collect();
@@ -124,12 +139,16 @@ impl Groups {
             .collect()
     }
 
-    /// Every particle's displacement gradient from the entries' `u`, its in-plane trace
-    /// replaced by its group's mean.
-    pub fn gradients<D: Dim>(&self, world: &World<D>, u: &[D::Vec]) -> Vec<D::Mat> {
+    /// Every particle's gradient `gradient(i)` (of the displacements in a static solve, of
+    /// the velocities in an explicit step), its in-plane trace replaced by its group's mean.
+    pub fn gradients<D: Dim>(
+        &self,
+        world: &World<D>,
+        gradient: impl Fn(usize) -> D::Mat + Sync + Send,
+    ) -> Vec<D::Mat> {
         let l: Vec<D::Mat> = (0..world.particles.len())
             .into_par_iter()
-            .map(|i| gradient(world, i, u))
+            .map(gradient)
             .collect();
         let traces: Vec<f64> = l.par_iter().map(|l| trace::<D>(&D::sym_part(l))).collect();
         let means = self.means(&world.particles.volume, &traces);
@@ -154,13 +173,13 @@ impl Groups {
 
 /// The trace over the scene's D axes.
 #[inline(always)]
-pub(super) fn trace<D: Dim>(s: &Sym3) -> f64 {
+pub(crate) fn trace<D: Dim>(s: &Sym3) -> f64 {
     [s.xx, s.yy, s.zz][..D::D].iter().sum()
 }
 
 /// The identity on the scene's D axes, as a symmetric tensor.
 #[inline(always)]
-pub(super) fn in_plane<D: Dim>() -> Sym3 {
+pub(crate) fn in_plane<D: Dim>() -> Sym3 {
     Sym3 {
         xx: 1.0,
         yy: 1.0,
@@ -171,7 +190,7 @@ pub(super) fn in_plane<D: Dim>() -> Sym3 {
 
 /// `c` times the identity on the scene's D axes, as a gradient.
 #[inline(always)]
-pub(super) fn isotropic<D: Dim>(c: f64) -> D::Mat {
+pub(crate) fn isotropic<D: Dim>(c: f64) -> D::Mat {
     (0..D::D).fold(D::mat_zero(), |m, a| {
         let mut e = D::zero();
         e[a] = 1.0;
