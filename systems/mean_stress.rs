@@ -16,12 +16,22 @@ use crate::systems::{entry_gradient, mirror, scatter_coded};
 use rayon::prelude::*;
 
 /// Updates every particle's stress over `fraction` of the step from grad v gathered off
-/// p/m on its side's entries, its in-plane trace replaced by its group's mean.
-pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
+/// p/m on its side's entries, its in-plane trace replaced by its group's mean; with
+/// `force` then scatters the internal forces of the new stresses, on the same groups (as
+/// [`force`]).
+pub fn run<D: Dim>(world: &mut World<D>, fraction: f64, force: bool) {
+    let groups = Groups::new(world);
+    update(world, fraction, &groups);
+    if force {
+        scatter_effective(world, &groups);
+    }
+}
+
+/// The stress update of [`run`] on `groups`.
+fn update<D: Dim>(world: &mut World<D>, fraction: f64, groups: &Groups) {
     node_velocities(world);
     let dt = world.settings.dt * fraction;
     let plane = world.settings.plane;
-    let groups = Groups::new(world);
     let velocity = &world.grid.velocity;
     let l = groups.gradients(world, |i| entry_gradient(world, i, velocity));
     let materials = &world.materials;
@@ -41,7 +51,11 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
 /// (2004) Eq. 6 with B-bar), tile by tile in colour classes, then the particles near a
 /// crack field by field.
 pub fn force<D: Dim>(world: &mut World<D>) {
-    let groups = Groups::new(world);
+    scatter_effective(world, &Groups::new(world));
+}
+
+/// The internal-force scatter of [`force`] on `groups`.
+fn scatter_effective<D: Dim>(world: &mut World<D>, groups: &Groups) {
     let effective = groups.effective(world, &world.particles.stress);
     // The coded scatter reads the stress column: it holds sigma_bar for the scatter only.
     let stress = std::mem::replace(&mut world.particles.stress, effective);

@@ -47,13 +47,15 @@ pub enum System {
         fraction: f64,
     },
     /// A stress update with each particle's dilatation its cell's mean (`dilatation =
-    /// "cell_mean"`), in place of `StressForce`'s update and `StressBin`.
+    /// "cell_mean"`), in place of `StressForce` (with `force`) and `StressBin`.
     MeanStress {
         /// Fraction of the step.
         fraction: f64,
+        /// Also scatter the internal forces of the B-bar stresses (the opening update).
+        force: bool,
     },
-    /// The internal-force scatter of the cell-mean dilatation's B-bar stresses, after the
-    /// opening update (USF, USAVG) or the scatter of momenta (USL).
+    /// The internal-force scatter of the cell-mean dilatation's B-bar stresses after the
+    /// scatter of momenta (USL).
     MeanForce,
     /// Integrate nodal momenta, apply damping, gravity and prescribed velocities.
     GridUpdate,
@@ -118,8 +120,8 @@ impl Schedule {
     /// Prescribed velocities add `grid_bc` after each scatter of momenta; cracks add
     /// `classify` after binning and `crack_advect` after the particles move; a fracture
     /// plan adds `fracture` at the end of the steps that end at an output row. The cell's
-    /// mean dilatation trades the fused updates for `mean_stress` and `mean_force` (the
-    /// next step's `bin` then bins the moved particles).
+    /// mean dilatation trades the fused updates for `mean_stress` (the next step's `bin`
+    /// then bins the moved particles), USL's internal forces for `mean_force`.
     pub fn for_world<D: Dim>(world: &World<D>, fracture: Option<FracturePlan>) -> Self {
         use System::*;
         if world.settings.solver == Solver::Static {
@@ -167,10 +169,13 @@ impl Schedule {
         }
         if update != Update::Usl {
             let fraction = if update == Update::Usf { 1.0 } else { 0.5 };
-            s.extend(if mean {
-                vec![MeanStress { fraction }, MeanForce]
+            s.push(if mean {
+                MeanStress {
+                    fraction,
+                    force: true,
+                }
             } else {
-                vec![StressForce { fraction }]
+                StressForce { fraction }
             });
         } else if mean {
             s.push(MeanForce);
@@ -191,7 +196,10 @@ impl Schedule {
             // The closing update also bins the particles for the next step (see
             // `step_measuring` for the steps after which J is measured).
             s.push(if mean {
-                MeanStress { fraction }
+                MeanStress {
+                    fraction,
+                    force: false,
+                }
             } else {
                 StressBin { fraction }
             });
@@ -347,7 +355,7 @@ impl Schedule {
                     let binned = stress_bin::run(world, fraction);
                     world.domain.agree(binned)?;
                 }
-                System::MeanStress { fraction } => mean_stress::run(world, fraction),
+                System::MeanStress { fraction, force } => mean_stress::run(world, fraction, force),
                 System::MeanForce => mean_stress::force(world),
                 System::GridUpdate => grid_update::run(world),
                 System::G2p => g2p::run(world),
