@@ -10,9 +10,10 @@ use crate::store::disjoint::Disjoint;
 use crate::store::grid::Grid;
 use crate::store::world::{CHUNK, World};
 use crate::systems::dilatation::Groups;
+use crate::systems::entry_gradient;
 use crate::systems::p2g::add_internal_force;
 use crate::systems::stress::{StressColumns, node_velocities};
-use crate::systems::{entry_gradient, mirror, scatter_coded};
+use crate::systems::stress_force::close_internal_forces;
 use rayon::prelude::*;
 
 /// Updates every particle's stress over `fraction` of the step from grad v gathered off
@@ -87,18 +88,5 @@ fn scatter<D: Dim>(world: &mut World<D>) {
         domain.waits(),
         |classes, run| domain.settle_pass(classes, &[&force_w], run),
     );
-    if let Some(c) = world.cracks.as_ref() {
-        let stencils = &world.tiles.stencils;
-        scatter_coded::run::<D, false, false, true>(
-            &c.scratch.fields,
-            &world.particles,
-            shape,
-            stencils,
-            &world.domain,
-            &mut world.grid,
-        );
-    }
-    if !world.grid.mirrors.is_empty() {
-        mirror::fold_force(&mut world.grid);
-    }
+    close_internal_forces(world);
 }

@@ -61,13 +61,19 @@ pub fn run<D: Dim>(world: &mut World<D>, fraction: f64) {
     );
     if world.cracks.is_some() {
         update_coded(world, dt);
-        let f = &world.cracks.as_ref().expect("cracks").scratch.fields;
-        let stencils = &world.tiles.stencils;
+    }
+    close_internal_forces(world);
+}
+
+/// Closes an internal-force scatter over the tiles: the particles near a crack field by
+/// field, from their stress column, then the image nodes' forces folded onto their sources.
+pub(crate) fn close_internal_forces<D: Dim>(world: &mut World<D>) {
+    if let Some(c) = world.cracks.as_ref() {
         scatter_coded::run::<D, false, false, true>(
-            f,
+            &c.scratch.fields,
             &world.particles,
-            shape,
-            stencils,
+            world.settings.shape,
+            &world.tiles.stencils,
             &world.domain,
             &mut world.grid,
         );
